@@ -1,0 +1,191 @@
+#include "app/design_command.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "app/tuning_source.hpp"
+#include "control/diophantine.hpp"
+#include "control/pole_placement_design.hpp"
+#include "core/paper_reference.hpp"
+
+namespace epa::app {
+
+using core::Polynomial;
+
+void add_design_command(CLI::App& app, DesignOptions& o) {
+  auto* cmd = app.add_subcommand("design", "Pole-placement design and closed-loop analysis (default: the paper's eq 9-15)");
+  cmd->add_option("--model", o.model_path, "Model file (epa-model/1 TOML); default: the paper's eq 9-10")->check(CLI::ExistingFile);
+  cmd->add_option("--design", o.design_path, "Analyse the F, G, H of an epa-design/1 file")->check(CLI::ExistingFile);
+  cmd->add_option("--T", o.T, "Solve A F + B G = T for this T: 'paper' (eq 11) or coefficients of q^0, q^-1, ...")->delimiter(',');
+  cmd->add_option("--overshoot", o.overshoot_pct, "Design T from a spec: overshoot of the dominant pair, %");
+  cmd->add_option("--settling", o.settling_s, "Design T from a spec: 2 % settling time, s");
+  cmd->add_option("--observer-pole", o.observer_pole, "Spec design: z-location of the other poles")->capture_default_str();
+  cmd->add_option("--input-decimals", o.input_decimals, "Decimals the A, B, T coefficients were printed with")->capture_default_str();
+  cmd->add_option("--json", o.json_path, "Write the design as epa-design/1 JSON");
+}
+
+namespace {
+
+std::string list(const std::vector<double>& v, int precision = 5) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%s%.*g", i ? ", " : "", precision, v[i]);
+    s += buf;
+  }
+  return s + "]";
+}
+
+double max_abs_diff(const std::vector<double>& a, const std::vector<double>& b) {
+  double m = 0.0;
+  for (std::size_t i = 0; i < std::max(a.size(), b.size()); ++i)
+    m = std::max(m, std::abs((i < a.size() ? a[i] : 0.0) - (i < b.size() ? b[i] : 0.0)));
+  return m;
+}
+
+core::Result<Polynomial> parse_T(const std::vector<std::string>& words) {
+  if (words.size() == 1 && words[0] == "paper") return core::paper::T();
+  std::vector<double> c;
+  for (const auto& w : words) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(w, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != w.size() || !std::isfinite(v)) return core::invalid_argument("--T: '" + w + "' is not a number (give 'paper' or coefficients)");
+    c.push_back(v);
+  }
+  return Polynomial(std::move(c));
+}
+
+// The conditioning warning: how many digits of F, G the printed digits of A, B, T determine.
+void explain_conditioning(std::ostream& out, double cond, int decimals, const Polynomial& A, const Polynomial& B,
+                          const Polynomial& T) {
+  double scale = 0.0;
+  for (const Polynomial* p : {&A, &B, &T})
+    for (double v : p->coefficients()) scale = std::max(scale, std::abs(v));
+  const double rounding = 0.5 * std::pow(10.0, -decimals) / std::max(scale, 1e-300);
+  const double amplified = cond * rounding;
+  const double digits = std::max(0.0, -std::log10(amplified));
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "  Sylvester matrix condition number %.0f. A, B, T printed to %d decimals carry a relative rounding\n"
+                "  of up to %.1e; the solution can move by up to %.1e relative: only about %.1f significant digits\n"
+                "  of F and G are determined by the inputs.%s\n",
+                cond, decimals, rounding, amplified, digits,
+                amplified > 1e-3 ? " ILL-CONDITIONED: do not trust digits beyond that." : "");
+  out << buf;
+}
+
+}  // namespace
+
+int run_design(const DesignOptions& o, std::ostream& out, std::ostream& err) {
+  auto model_file = load_model(o.model_path);
+  if (!model_file) return err << "epa design: " << model_file.error().message << "\n", 1;
+  const core::HammersteinModel& m = model_file->model;
+  const bool paper_model = o.model_path.empty();
+  const bool spec_given = o.overshoot_pct >= 0.0 || o.settling_s >= 0.0;
+  if (spec_given && !o.T.empty()) return err << "epa design: give either --T or a spec (--overshoot, --settling), not both\n", 1;
+  if (spec_given && (o.overshoot_pct < 0.0 || o.settling_s <= 0.0))
+    return err << "epa design: a spec needs both --overshoot (%) and --settling (s > 0)\n", 1;
+
+  Polynomial F, G, H, T;
+  std::string controller_source;
+  double cond = 0.0;
+  bool solved = false;
+  if (!o.T.empty() || spec_given) {
+    if (spec_given) {
+      auto t = control::characteristic_from_spec({o.overshoot_pct, o.settling_s, m.Ts, o.observer_pole},
+                                                 m.A.degree() + m.B.degree() - 1);
+      if (!t) return err << "epa design: " << t.error().message << "\n", 1;
+      T = *t;
+      controller_source = "designed from the spec";
+    } else {
+      auto t = parse_T(o.T);
+      if (!t) return err << "epa design: " << t.error().message << "\n", 1;
+      T = *t;
+      controller_source = "solved from the given T";
+    }
+    auto sol = control::solve_diophantine(m.A, m.B, T);
+    if (!sol) return err << "epa design: " << sol.error().message << "\n", 1;
+    // The law needs a monic F; scaling F, G (and T) together leaves the controller unchanged.
+    const double f0 = sol->F[0];
+    F = sol->F * (1.0 / f0);
+    G = sol->G * (1.0 / f0);
+    T = T * (1.0 / f0);
+    H = G;
+    cond = sol->condition_number;
+    solved = true;
+  } else {
+    auto p = load_controller_polynomials(o.design_path);
+    if (!p) return err << "epa design: " << p.error().message << "\n", 1;
+    F = p->F;
+    G = p->G;
+    H = p->H;
+    controller_source = p->source;
+    T = paper_model && o.design_path.empty() ? core::paper::T() : m.A * F + m.B * G;
+    auto sol = control::solve_diophantine(m.A, m.B, T);
+    cond = sol ? sol->condition_number : INFINITY;
+  }
+
+  out << "Model: " << model_file->source << " (Ts = " << m.Ts << " s)\n"
+      << "  A = " << m.A.to_string() << "\n  B = " << m.B.to_string() << "\n"
+      << "  dead zone: m_r = " << m.dead_zone.m_r << ", m_l = " << m.dead_zone.m_l << ", b_r = " << m.dead_zone.b_r
+      << " V, b_l = " << m.dead_zone.b_l << " V\n\n";
+  out << "Controller: " << controller_source << "\n  F = " << F.to_string() << "\n  G = " << G.to_string()
+      << "\n  H = " << H.to_string() << (H.coefficients() == G.coefficients() ? "  (H = G: error feedback)" : "")
+      << "\n  T = " << T.to_string() << "\n";
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "  residual max |A F + B G - T| = %.2e\n",
+                control::diophantine_residual(m.A, m.B, T, F, G));
+  out << buf;
+  explain_conditioning(out, cond, o.input_decimals, m.A, m.B, T);
+  if (solved && paper_model && T.coefficients() == core::paper::T().coefficients()) {
+    std::snprintf(buf, sizeof buf,
+                  "  Compared with the printed eq 12-13: max |F - F_paper| = %.2e, max |G - G_paper| = %.2e.\n"
+                  "  Neither is wrong: the printed digits of A, B, T cannot tell them apart.\n",
+                  max_abs_diff(F.coefficients(), core::paper::F().coefficients()),
+                  max_abs_diff(G.coefficients(), core::paper::G().coefficients()));
+    out << buf;
+  }
+
+  const auto branches = control::analyse_branches(m, F, G);
+  out << "\nClosed loop (P in descending powers of z):\n";
+  for (const auto& b : branches) {
+    std::snprintf(buf, sizeof buf, "  %-8s A F + %.4f B G: max |root| = %.4f, Jury: %s\n", b.name.c_str(), b.gain,
+                  b.max_root_abs, control::to_string(b.jury.verdict));
+    out << buf << "    P = " << list(b.P.coefficients()) << "\n";
+    for (const auto& c : b.jury.conditions) {
+      std::snprintf(buf, sizeof buf, "      %-18s %12.6g vs %-12.6g %s\n", c.text.c_str(), c.lhs, c.rhs,
+                    c.holds ? "holds" : c.boundary ? "BOUNDARY" : "FAILS");
+      out << buf;
+    }
+  }
+  if (paper_model && !solved && o.design_path.empty()) {
+    const std::vector<double> eq14(core::paper::kEq14.begin(), core::paper::kEq14.end());
+    const std::vector<double> eq15(core::paper::kEq15.begin(), core::paper::kEq15.end());
+    std::snprintf(buf, sizeof buf, "\n  left  vs eq 14: max coefficient difference %.1e\n  right vs eq 15: max coefficient difference %.1e\n",
+                  max_abs_diff(branches[1].P.coefficients(), eq14), max_abs_diff(branches[2].P.coefficients(), eq15));
+    out << buf;
+  }
+
+  if (!o.json_path.empty()) {
+    nlohmann::json j = {{"schema", "epa-design/1"}, {"F", F.coefficients()}, {"G", G.coefficients()},
+                        {"H", H.coefficients()},   {"T", T.coefficients()}, {"condition_number", cond},
+                        {"closed_loop", nlohmann::json::array()}};
+    for (const auto& b : branches)
+      j["closed_loop"].push_back({{"branch", b.name}, {"P", b.P.coefficients()}, {"max_root_abs", b.max_root_abs},
+                                  {"jury_stable", b.jury.verdict == control::Stability::kStable}});
+    std::ofstream f(o.json_path, std::ios::trunc);
+    if (!(f << j.dump(1) << "\n") || !f.flush()) return err << "epa design: cannot write " << o.json_path << "\n", 1;
+    out << "\ndesign written to " << o.json_path << "\n";
+  }
+  return 0;
+}
+
+}  // namespace epa::app

@@ -1,0 +1,31 @@
+// The `epa` command: one executable, one subcommand per job.
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
+
+#include "app/design_command.hpp"
+#include "app/simulate_command.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"epa: electro-pneumatic actuator controller appliance (pole placement with feed-forward "
+               "inverse dead-zone compensation)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "epa 0.1.0");
+  epa::app::SimulateOptions simulate;
+  epa::app::DesignOptions design;
+  epa::app::add_simulate_command(app, simulate);
+  epa::app::add_design_command(app, design);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    if (app.got_subcommand("simulate")) return epa::app::run_simulate(simulate, std::cout, std::cerr);
+    if (app.got_subcommand("design")) return epa::app::run_design(design, std::cout, std::cerr);
+  } catch (const std::exception& e) {  // third-party code (CLI11, JSON, filesystem) at the edge
+    std::cerr << "epa: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

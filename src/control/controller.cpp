@@ -1,0 +1,80 @@
+#include "control/controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "control/dead_zone_compensation.hpp"
+
+namespace epa::control {
+
+namespace {
+
+core::Status load_polynomial(const core::Polynomial& p, const char* name, std::array<double, kMaxLawOrder + 1>& out,
+                             std::size_t& degree) {
+  if (p.size() == 0) return core::invalid_argument(std::string("controller: ") + name + " is empty");
+  if (p.size() > kMaxLawOrder + 1)
+    return core::invalid_argument(std::string("controller: ") + name + " has " + std::to_string(p.size()) +
+                                  " coefficients, at most " + std::to_string(kMaxLawOrder + 1) + " are supported");
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!std::isfinite(p[i]))
+      return core::invalid_argument(std::string("controller: ") + name + "[" + std::to_string(i) + "] is not a finite number");
+    out[i] = p[i];
+  }
+  degree = p.size() - 1;
+  return core::ok();
+}
+
+}  // namespace
+
+core::Result<ControllerParams> ControllerParams::make(const ControllerConfig& c) {
+  ControllerParams p;
+  p.kind_ = c.kind;
+  if (auto s = load_polynomial(c.F, "F", p.rst_.F, p.rst_.nF); !s) return s.error();
+  if (std::abs(c.F[0] - 1.0) > 1e-12)
+    return core::invalid_argument("controller: F must be monic (F[0] = 1), got F[0] = " + std::to_string(c.F[0]));
+  if (auto s = load_polynomial(c.G, "G", p.rst_.G, p.rst_.nG); !s) return s.error();
+  const core::Polynomial& H = c.H.size() == 0 ? c.G : c.H;
+  if (auto s = load_polynomial(H, "H", p.rst_.H, p.rst_.nH); !s) return s.error();
+  if (auto s = c.dead_zone.validate(); !s) return core::invalid_argument("controller: " + s.error().message);
+  if (!(c.lc_v >= 0.0) || !std::isfinite(c.lc_v))
+    return core::invalid_argument("controller: l_c must be a finite number >= 0, got " + std::to_string(c.lc_v));
+  if (!(c.valve_limit_v > 0.0) || !std::isfinite(c.valve_limit_v))
+    return core::invalid_argument("controller: valve limit must be > 0 V, got " + std::to_string(c.valve_limit_v));
+  if (!std::isfinite(c.safe_valve_v) || std::abs(c.safe_valve_v) > c.valve_limit_v)
+    return core::invalid_argument("controller: safe valve command must lie within the valve limit");
+  p.dead_zone_ = c.dead_zone;
+  p.lc_v_ = c.lc_v;
+  p.valve_limit_v_ = c.valve_limit_v;
+  p.safe_valve_v_ = c.safe_valve_v;
+  return p;
+}
+
+ControllerOutput controller_step(const ControllerParams& p, ControllerState& state, double r_v, double y_v) noexcept {
+  ControllerOutput out;
+  if (!std::isfinite(r_v) || !std::isfinite(y_v)) {
+    out.valve_v = p.safe_valve_v();
+    out.fault = true;
+    return out;
+  }
+  const RstState before = state.rst;
+  const double u = rst_step(p.rst(), state.rst, r_v, y_v);
+  if (!std::isfinite(u)) {  // overflow of a diverging loop: do not poison the state
+    state.rst = before;
+    out.valve_v = p.safe_valve_v();
+    out.fault = true;
+    return out;
+  }
+  double valve = u;
+  switch (p.kind()) {
+    case ControllerKind::kPp: break;
+    case ControllerKind::kPpNgidz: valve = ngidz_command(p.dead_zone(), u); break;
+    case ControllerKind::kPpFfidz: valve = ffidz_command(p.dead_zone(), u, r_v - y_v, p.lc_v()); break;
+  }
+  out.controller_v = u;
+  out.valve_v = std::clamp(valve, -p.valve_limit_v(), p.valve_limit_v());
+  out.saturated = out.valve_v != valve;
+  return out;
+}
+
+}  // namespace epa::control

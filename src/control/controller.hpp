@@ -1,0 +1,60 @@
+#pragma once
+// The three position controllers as pure control laws: validated immutable ControllerParams,
+// explicit ControllerState, and controller_step() which allocates nothing, reads no clock and does
+// no I/O. All signals are in the model's units: reference and position in sensor volts, valve in V.
+#include "control/controller_kind.hpp"
+#include "control/rst_law.hpp"
+#include "core/dead_zone.hpp"
+#include "core/polynomial.hpp"
+#include "core/result.hpp"
+
+namespace epa::control {
+
+// What a user or a file provides; checked by ControllerParams::make.
+struct ControllerConfig {
+  ControllerKind kind = ControllerKind::kPpFfidz;
+  core::Polynomial F, G, H;  // H empty: H = G (error feedback, NOTES.md)
+  core::DeadZone dead_zone;  // what NG-IDZ and FF-IDZ invert
+  double lc_v = 0.1;         // FF-IDZ switch-off band l_c, sensor volts (5 mm at 50 mm/V)
+  double valve_limit_v = 5.0;  // final valve command saturates at +-limit (paper section 4.1)
+  double safe_valve_v = 0.0;   // command on a fault (non-finite input): 5/3 valve centred
+};
+
+class ControllerParams {
+ public:
+  // Errors name what is wrong: non-monic F, an order above kMaxLawOrder, a non-finite coefficient
+  // (with its index), a non-positive slope, b_l > b_r, a negative l_c, a bad limit.
+  static core::Result<ControllerParams> make(const ControllerConfig& config);
+
+  ControllerKind kind() const { return kind_; }
+  const RstCoefficients& rst() const { return rst_; }
+  const core::DeadZone& dead_zone() const { return dead_zone_; }
+  double lc_v() const { return lc_v_; }
+  double valve_limit_v() const { return valve_limit_v_; }
+  double safe_valve_v() const { return safe_valve_v_; }
+
+ private:
+  ControllerParams() = default;
+  ControllerKind kind_ = ControllerKind::kPp;
+  RstCoefficients rst_;
+  core::DeadZone dead_zone_;
+  double lc_v_ = 0.0, valve_limit_v_ = 5.0, safe_valve_v_ = 0.0;
+};
+
+struct ControllerState {
+  RstState rst;
+};
+
+struct ControllerOutput {
+  double valve_v = 0.0;       // command for the valve, after compensation and saturation
+  double controller_v = 0.0;  // pole-placement output u before compensation (uc_V in run files)
+  bool saturated = false;     // the valve command hit its limit
+  bool fault = false;         // non-finite input or output: valve_v is the safe command, state kept
+};
+
+// One sample: reads r(k), y(k) (sensor volts), returns the valve command to hold until k+1.
+// No anti-windup: the paper's law runs on the unsaturated u (its F has no pole at 1).
+ControllerOutput controller_step(const ControllerParams& params, ControllerState& state, double r_v,
+                                 double y_v) noexcept;
+
+}  // namespace epa::control

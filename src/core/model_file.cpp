@@ -1,0 +1,122 @@
+#include "core/model_file.hpp"
+
+#include <cstdio>
+#include <locale>
+#include <fstream>
+#include <sstream>
+#include <toml++/toml.h>
+
+namespace epa::core {
+
+namespace {
+
+constexpr const char* kSchema = "epa-model/1";
+
+Result<double> number_at(const toml::table& t, const char* table_name, const char* key, const std::string& src) {
+  const auto* node = t.get(key);
+  const std::string where = src + ": " + (table_name[0] ? std::string("[") + table_name + "] " : std::string()) + key;
+  if (!node) return parse_error(where + " is missing");
+  if (auto v = node->value<double>()) return *v;
+  return parse_error(where + " must be a number");
+}
+
+Result<Polynomial> array_at(const toml::table& t, const char* key, const std::string& src) {
+  const auto* arr = t.get_as<toml::array>(key);
+  if (!arr) return parse_error(src + ": [arx] " + key + " is missing or not an array of numbers");
+  std::vector<double> c;
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    auto v = arr->get(i)->value<double>();
+    if (!v) return parse_error(src + ": [arx] " + key + "[" + std::to_string(i) + "] is not a number");
+    c.push_back(*v);
+  }
+  return Polynomial(std::move(c));
+}
+
+}  // namespace
+
+Result<ModelFile> parse_model_toml(const std::string& text, const std::string& src) {
+  toml::table root;
+  try {
+    root = toml::parse(text, src);
+  } catch (const toml::parse_error& e) {
+    return parse_error(src + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()));
+  }
+  const auto schema = root["schema"].value<std::string>();
+  if (!schema) return parse_error(src + ": schema is missing (expected \"" + kSchema + "\")");
+  if (*schema != kSchema) return parse_error(src + ": schema \"" + *schema + "\" is not supported (expected \"" + kSchema + "\")");
+
+  ModelFile f;
+  auto Ts = number_at(root, "", "Ts", src);
+  if (!Ts) return Ts.error();
+  f.model.Ts = *Ts;
+  if (root.contains("mm_per_volt")) {
+    auto s = number_at(root, "", "mm_per_volt", src);
+    if (!s) return s.error();
+    f.model.mm_per_volt = *s;
+  }
+  f.source = root["source"].value_or(std::string());
+
+  const auto* arx = root["arx"].as_table();
+  if (!arx) return parse_error(src + ": table [arx] is missing");
+  auto A = array_at(*arx, "A", src);
+  if (!A) return A.error();
+  auto B = array_at(*arx, "B", src);
+  if (!B) return B.error();
+  f.model.A = *A;
+  f.model.B = *B;
+
+  const auto* dz = root["dead_zone"].as_table();
+  if (!dz) return parse_error(src + ": table [dead_zone] is missing");
+  double* fields[] = {&f.model.dead_zone.m_r, &f.model.dead_zone.m_l, &f.model.dead_zone.b_r, &f.model.dead_zone.b_l};
+  const char* names[] = {"m_r", "m_l", "b_r", "b_l"};
+  for (int i = 0; i < 4; ++i) {
+    auto v = number_at(*dz, "dead_zone", names[i], src);
+    if (!v) return v.error();
+    *fields[i] = *v;
+  }
+  if (auto s = f.model.validate(); !s) return invalid_argument(src + ": " + s.error().message);
+  return f;
+}
+
+Result<ModelFile> read_model_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return io_error(path + ": cannot open model file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_model_toml(ss.str(), path);
+}
+
+std::string format_model_toml(const ModelFile& f) {
+  const auto& m = f.model;
+  std::ostringstream out;
+  out.imbue(std::locale::classic());
+  out.precision(10);
+  auto list = [&](const Polynomial& p) {
+    out << '[';
+    for (std::size_t i = 0; i < p.size(); ++i) out << (i ? ", " : "") << p[i];
+    out << "]\n";
+  };
+  out << "schema = \"" << kSchema << "\"\n"
+      << "Ts = " << m.Ts << "\nmm_per_volt = " << m.mm_per_volt << "\n"
+      << "source = " << toml::value<std::string>(f.source) << "\n\n[arx]\nA = ";
+  list(m.A);
+  out << "B = ";
+  list(m.B);
+  out << "\n[dead_zone]\nm_r = " << m.dead_zone.m_r << "\nm_l = " << m.dead_zone.m_l << "\nb_r = " << m.dead_zone.b_r
+      << "\nb_l = " << m.dead_zone.b_l << "\n";
+  return out.str();
+}
+
+Status write_model_file(const std::string& path, const ModelFile& file) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    if (!out) return io_error(path + ": cannot write model file");
+    out << format_model_toml(file);
+    if (!out.flush()) return io_error(path + ": write failed");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) return io_error(path + ": cannot replace the model file");
+  return ok();
+}
+
+}  // namespace epa::core

@@ -1,0 +1,35 @@
+#pragma once
+// Model files (TOML, `epa-model/1`): a Hammerstein model that `epa design` and `epa simulate`
+// accept with --model and that `epa identify` writes. config/paper-model.toml is the paper's.
+//
+//   schema = "epa-model/1"
+//   Ts = 0.005            # s
+//   mm_per_volt = 50.0    # sensor scale
+//   source = "..."        # free text: where the model came from
+//   [arx]
+//   A = [1.0, -0.9094, -0.6110, 0.5204]   # coefficients of q^0, q^-1, ...
+//   B = [0.0, 1.024, -2.046, 1.029]
+//   [dead_zone]
+//   m_r = 1.7627
+//   m_l = 1.0707
+//   b_r = 1.232     # V
+//   b_l = -1.722    # V
+#include <string>
+
+#include "core/hammerstein_model.hpp"
+#include "core/result.hpp"
+
+namespace epa::core {
+
+struct ModelFile {
+  HammersteinModel model;
+  std::string source;  // provenance text
+};
+
+// Errors name the file, and the line for syntax errors, and the key that is missing or wrong.
+Result<ModelFile> parse_model_toml(const std::string& text, const std::string& source_name);
+Result<ModelFile> read_model_file(const std::string& path);
+std::string format_model_toml(const ModelFile& file);
+Status write_model_file(const std::string& path, const ModelFile& file);
+
+}  // namespace epa::core

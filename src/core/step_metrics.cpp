@@ -1,0 +1,47 @@
+#include "core/step_metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace epa::core {
+
+StepMetrics step_metrics(std::span<const double> y_mm, double r_mm, const StepMetricsOptions& o) {
+  StepMetrics m;
+  const std::size_t n = y_mm.size();
+  if (n == 0 || !(o.Ts > 0.0)) return m;
+
+  const std::size_t window = std::clamp<std::size_t>(static_cast<std::size_t>(std::lround(o.ess_window_s / o.Ts)), 1, n);
+  double sum_y = 0.0, sum_e = 0.0;
+  for (std::size_t k = n - window; k < n; ++k) {
+    sum_y += y_mm[k];
+    sum_e += std::abs(r_mm - y_mm[k]);
+  }
+  m.final_mm = sum_y / static_cast<double>(window);
+  m.ess_mm = sum_e / static_cast<double>(window);
+
+  const double y0 = y_mm[0];
+  const double move = m.final_mm - y0;
+  m.moved = std::abs(move) > o.settling_band * std::abs(r_mm - y0) && move != 0.0;
+  if (!m.moved) return m;
+
+  // Normalised progress: 0 at the start, 1 at the final value, whatever the direction.
+  auto progress = [&](std::size_t k) { return (y_mm[k] - y0) / move; };
+
+  std::optional<std::size_t> k_low, k_high;
+  double peak = 0.0;
+  std::optional<std::size_t> last_outside;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double p = progress(k);
+    if (!k_low && p >= o.rise_low) k_low = k;
+    if (!k_high && p >= o.rise_high) k_high = k;
+    peak = std::max(peak, p);
+    if (std::abs(p - 1.0) > o.settling_band) last_outside = k;
+  }
+  if (k_low && k_high) m.rise_s = static_cast<double>(*k_high - *k_low) * o.Ts;
+  if (!last_outside) m.settling_s = 0.0;
+  else if (*last_outside + 1 < n) m.settling_s = static_cast<double>(*last_outside + 1) * o.Ts;
+  m.overshoot_pct = std::max(0.0, peak - 1.0) * 100.0;
+  return m;
+}
+
+}  // namespace epa::core

@@ -1,0 +1,56 @@
+#pragma once
+// The paper's plant as a simulator: valve dead zone, then the ARX model A y = B u_d (y in sensor
+// volts), with end stops at both ends of the stroke and optional seeded sensor noise.
+// Timing: step(u) applies the valve command u(k), held over [k, k+1), and advances to k+1;
+// the one-sample delay is the model's own (B[0] = 0), none is added.
+#include <array>
+
+#include "core/hammerstein_model.hpp"
+#include "core/random.hpp"
+#include "core/result.hpp"
+
+namespace epa::plant {
+
+struct PlantOptions {
+  double initial_position_mm = 0.0;  // at rest here at k = 0
+  double noise_std_mm = 0.0;         // Gaussian sensor noise (measurement only, not the piston)
+  std::uint64_t seed = 1;            // for the noise
+  double stroke_mm = 500.0;          // end stops at 0 and stroke_mm
+};
+
+class HammersteinPlant {
+ public:
+  // All the plant's memory, so a run can be saved and replayed from any sample.
+  struct State {
+    std::array<double, core::kMaxModelOrder> y_past{};   // y(k), y(k-1), ... true position, V
+    std::array<double, core::kMaxModelOrder> ud_past{};  // u_d(k-1), u_d(k-2), ... after the dead zone
+    double measured_v = 0.0;                             // y(k) + noise, what the sensor reads
+    core::Random rng;
+  };
+
+  // Errors: invalid model (see HammersteinModel::validate), negative noise, bad stroke or start.
+  static core::Result<HammersteinPlant> make(const core::HammersteinModel& model, const PlantOptions& options);
+
+  double measured_v() const { return state_.measured_v; }        // sensor reading at k, V
+  double measured_mm() const { return state_.measured_v * mm_per_volt_; }
+  double position_v() const { return state_.y_past[0]; }         // true position at k, V
+  double position_mm() const { return state_.y_past[0] * mm_per_volt_; }
+
+  // Applies valve command u(k) (V; non-finite is taken as 0 V, the centred valve) and advances.
+  void step(double valve_v) noexcept;
+
+  const State& state() const { return state_; }
+  void set_state(const State& state) { state_ = state; }
+
+ private:
+  HammersteinPlant() = default;
+  std::array<double, core::kMaxModelOrder + 1> a_{}, b_{};
+  std::size_t na_ = 0, nb_ = 0;
+  core::DeadZone dead_zone_;
+  double mm_per_volt_ = 50.0, max_v_ = 10.0, noise_std_v_ = 0.0;
+  State state_;
+
+  void sample_sensor() noexcept;
+};
+
+}  // namespace epa::plant
