@@ -1,0 +1,135 @@
+// The `epa` command as a user runs it: a real process, real files, exit codes and messages.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "core/run_file.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+Outcome run_epa(const std::string& args) {
+  const std::string cmd = std::string(EPA_BINARY) + " " + args + " 2>&1";
+  Outcome o;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return o;
+  std::array<char, 4096> buf{};
+  std::size_t n = 0;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) o.output.append(buf.data(), n);
+  const int status = pclose(pipe);
+  o.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return o;
+}
+
+class EpaCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("epa_cli_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+TEST_F(EpaCli, SimulateWritesTableRunsJsonAndPicture) {
+  const auto o = run_epa("simulate --steps 25,50 --out-dir " + path("runs") + " --json " + path("sim.json") +
+                         " --plot " + path("resp.svg"));
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  EXPECT_NE(o.output.find("PP FF-IDZ"), std::string::npos);
+  EXPECT_NE(o.output.find("14.72"), std::string::npos);  // the paper's column is printed beside ours
+
+  const auto j = read_json(path("sim.json"));
+  EXPECT_EQ(j["schema"], "epa-sim/1");
+  EXPECT_EQ(j["Ts"], 0.005);
+  ASSERT_EQ(j["results"].size(), 6u);
+  for (const auto& r : j["results"]) {
+    if (r["controller"] == "pp" && r["step_mm"] == 25) {
+      EXPECT_TRUE(r["rise_s"].is_null());  // never moved
+    }
+    if (r["controller"] == "pp-ffidz") {
+      EXPECT_TRUE(r["rise_s"].is_number());
+    }
+  }
+
+  auto run = epa::core::read_run_file(path("runs/pp-ffidz_50mm.csv"), 0.005);
+  ASSERT_TRUE(run.has_value()) << run.error().message;
+  EXPECT_EQ(run->meta("controller"), "pp-ffidz");
+  EXPECT_EQ(run->size(), 4000u);
+  EXPECT_FALSE(run->uc_V.empty());
+
+  std::ifstream svg(path("resp.svg"));
+  std::stringstream s;
+  s << svg.rdbuf();
+  EXPECT_EQ(s.str().rfind("<svg", 0), 0u);
+  EXPECT_NE(s.str().find("dead band"), std::string::npos);
+}
+
+TEST_F(EpaCli, UnknownControllerIsRefusedWithTheChoices) {
+  const auto o = run_epa("simulate --controller pid");
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_NE(o.output.find("unknown controller 'pid'"), std::string::npos) << o.output;
+}
+
+TEST_F(EpaCli, BadModelFileIsNamedInTheError) {
+  std::ofstream(path("bad.toml")) << "schema = \"epa-model/1\"\nTs = 0.005\n[arx]\nA = [1.0, -0.5]\n";
+  const auto o = run_epa("simulate --model " + path("bad.toml"));
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_NE(o.output.find("bad.toml"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("B"), std::string::npos) << o.output;
+}
+
+TEST_F(EpaCli, DesignReproducesEq14And15AndWritesJson) {
+  const auto o = run_epa("design --json " + path("design.json"));
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  const auto j = read_json(path("design.json"));
+  EXPECT_EQ(j["schema"], "epa-design/1");
+  EXPECT_EQ(j["F"], nlohmann::json({1, -1.778, 0.7828}));
+  EXPECT_GT(j["condition_number"].get<double>(), 3.4e3);
+  EXPECT_LT(j["condition_number"].get<double>(), 3.8e3);
+  ASSERT_EQ(j["closed_loop"].size(), 3u);
+  const double eq14[] = {1.0, -3.0551, 3.7470, -2.7583, 1.5027, -0.4362};
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_NEAR(j["closed_loop"][1]["P"][i].get<double>(), eq14[i], 5e-4);
+  for (const auto& b : j["closed_loop"]) EXPECT_TRUE(b["jury_stable"].get<bool>()) << b["branch"];
+}
+
+TEST_F(EpaCli, ResolvingThePaperEquationReportsIllConditioning) {
+  const auto o = run_epa("design --T paper");
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  EXPECT_NE(o.output.find("ILL-CONDITIONED"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("marginal"), std::string::npos) << o.output;  // root at z = 1
+}
+
+TEST_F(EpaCli, DesignFromSpecFeedsSimulate) {
+  ASSERT_EQ(run_epa("design --overshoot 5 --settling 0.5 --observer-pole 0.5 --json " + path("d.json")).exit_code, 0);
+  const auto o = run_epa("simulate --controller pp-ngidz --steps 50 --design " + path("d.json") + " --json " + path("s.json"));
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  const auto j = read_json(path("s.json"));
+  EXPECT_NEAR(j["results"][0]["ess_mm"].get<double>(), 0.0, 1.0);  // the designed loop reaches 50 mm
+}
+
+TEST_F(EpaCli, SpecAndTTogetherAreRefused) {
+  const auto o = run_epa("design --T paper --overshoot 2 --settling 2");
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_NE(o.output.find("either --T or a spec"), std::string::npos) << o.output;
+}
+
+}  // namespace
