@@ -34,6 +34,12 @@ void add_simulate_command(CLI::App& app, SimulateOptions& o) {
 
 namespace {
 
+std::string format_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 nlohmann::json optional_json(std::optional<double> v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
 
 bool write_text(const std::string& path, const std::string& text, std::ostream& err) {
@@ -73,7 +79,7 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
       auto run = sim::simulate_step(model, *params, {.step_mm = step, .initial_mm = 0.0, .duration_s = o.duration_s,
                                                      .noise_std_mm = o.noise_mm, .seed = o.seed});
       if (!run) return err << "epa simulate: step " << step << " mm: " << run.error().message << "\n", 1;
-      run->run.set_meta("lc_mm", std::to_string(o.lc_mm));
+      if (kind == control::ControllerKind::kPpFfidz) run->run.set_meta("lc_mm", format_number(o.lc_mm));
       cases.push_back({kind, step, std::move(*run)});
     }
   }
@@ -110,7 +116,7 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
   }
 
   if (!o.plot_path.empty()) {
-    const std::string title = "Closed-loop step responses (" + model_file->source + ", Ts = " + std::to_string(model.Ts).substr(0, 5) + " s)";
+    const std::string title = "Closed-loop step responses (" + model_file->source + ", Ts = " + format_number(model.Ts) + " s)";
     if (!write_text(o.plot_path, render_response_plot(cases, model.dead_zone, o.plot_window_s, title), err)) return 1;
     out << "picture written to " << o.plot_path << "\n";
   }

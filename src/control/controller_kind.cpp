@@ -4,27 +4,28 @@
 
 namespace epa::control {
 
-std::string_view to_string(ControllerKind kind) {
-  switch (kind) {
-    case ControllerKind::kPp: return "pp";
-    case ControllerKind::kPpNgidz: return "pp-ngidz";
-    case ControllerKind::kPpFfidz: return "pp-ffidz";
-  }
-  return "?";
-}
+namespace {
+struct KindNames {
+  ControllerKind kind;
+  std::string_view name, display;
+};
+constexpr KindNames kNames[] = {{ControllerKind::kPp, "pp", "PP"},
+                                {ControllerKind::kPpNgidz, "pp-ngidz", "PP NG-IDZ"},
+                                {ControllerKind::kPpFfidz, "pp-ffidz", "PP FF-IDZ"}};
 
-std::string_view display_name(ControllerKind kind) {
-  switch (kind) {
-    case ControllerKind::kPp: return "PP";
-    case ControllerKind::kPpNgidz: return "PP NG-IDZ";
-    case ControllerKind::kPpFfidz: return "PP FF-IDZ";
-  }
-  return "?";
+const KindNames& names_of(ControllerKind kind) {
+  for (const auto& n : kNames)
+    if (n.kind == kind) return n;
+  return kNames[0];  // unreachable for a valid enumerator
 }
+}  // namespace
+
+std::string_view to_string(ControllerKind kind) { return names_of(kind).name; }
+std::string_view display_name(ControllerKind kind) { return names_of(kind).display; }
 
 core::Result<ControllerKind> parse_controller_kind(std::string_view name) {
-  for (ControllerKind k : kAllControllerKinds)
-    if (to_string(k) == name) return k;
+  for (const auto& n : kNames)
+    if (n.name == name) return n.kind;
   return core::invalid_argument("unknown controller '" + std::string(name) + "': expected pp, pp-ngidz or pp-ffidz");
 }
 
