@@ -19,10 +19,10 @@ std::string format_number(double v) {
 core::Result<StepRun> simulate_step(const core::HammersteinModel& model, const control::ControllerParams& params,
                                     const StepRunOptions& o) {
   if (!(o.duration_s > 0.0) || !std::isfinite(o.duration_s))
-    return core::invalid_argument("simulate: duration must be > 0 s");
+    return core::invalid_argument("duration must be > 0 s");
   const double target_mm = o.initial_mm + o.step_mm;
   if (!std::isfinite(target_mm) || target_mm < 0.0 || target_mm > core::kStrokeMm)
-    return core::invalid_argument("simulate: target " + format_number(target_mm) + " mm lies outside the stroke [0, 500] mm");
+    return core::invalid_argument("target " + format_number(target_mm) + " mm lies outside the stroke [0, 500] mm");
   auto plant = plant::HammersteinPlant::make(model, {.initial_position_mm = o.initial_mm,
                                                      .noise_std_mm = o.noise_std_mm,
                                                      .seed = o.seed,
