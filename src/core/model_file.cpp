@@ -1,7 +1,7 @@
 #include "core/model_file.hpp"
 
+#include <charconv>
 #include <cstdio>
-#include <locale>
 #include <fstream>
 #include <sstream>
 #include <toml++/toml.h>
@@ -87,24 +87,27 @@ Result<ModelFile> read_model_file(const std::string& path) {
 }
 
 std::string format_model_toml(const ModelFile& f) {
-  const auto& m = f.model;
-  std::ostringstream out;
-  out.imbue(std::locale::classic());
-  out.precision(10);
-  auto list = [&](const Polynomial& p) {
-    out << '[';
-    for (std::size_t i = 0; i < p.size(); ++i) out << (i ? ", " : "") << p[i];
-    out << "]\n";
+  // Shortest text that reads back to the same double: identified models round-trip exactly and
+  // the paper's values stay as printed (0.9094, not 0.90939999999999999).
+  auto num = [](double v) {
+    char buf[32];
+    const auto res = std::to_chars(buf, buf + sizeof buf, v);
+    std::string s(buf, res.ptr);
+    if (s.find_first_of(".en") == std::string::npos) s += ".0";  // keep TOML floats floats
+    return s;
   };
-  out << "schema = \"" << kSchema << "\"\n"
-      << "Ts = " << m.Ts << "\nmm_per_volt = " << m.mm_per_volt << "\n"
-      << "source = " << toml::value<std::string>(f.source) << "\n\n[arx]\nA = ";
-  list(m.A);
-  out << "B = ";
-  list(m.B);
-  out << "\n[dead_zone]\nm_r = " << m.dead_zone.m_r << "\nm_l = " << m.dead_zone.m_l << "\nb_r = " << m.dead_zone.b_r
-      << "\nb_l = " << m.dead_zone.b_l << "\n";
-  return out.str();
+  auto list = [&](const Polynomial& p) {
+    std::string s = "[";
+    for (std::size_t i = 0; i < p.size(); ++i) s += (i ? ", " : "") + num(p[i]);
+    return s + "]";
+  };
+  const auto& m = f.model;
+  std::ostringstream source;
+  source << toml::value<std::string>(f.source);  // TOML string escaping by the library
+  return "schema = \"" + std::string(kSchema) + "\"\nTs = " + num(m.Ts) + "\nmm_per_volt = " + num(m.mm_per_volt) +
+         "\nsource = " + source.str() + "\n\n[arx]\nA = " + list(m.A) + "\nB = " + list(m.B) +
+         "\n\n[dead_zone]\nm_r = " + num(m.dead_zone.m_r) + "\nm_l = " + num(m.dead_zone.m_l) +
+         "\nb_r = " + num(m.dead_zone.b_r) + "\nb_l = " + num(m.dead_zone.b_l) + "\n";
 }
 
 Status write_model_file(const std::string& path, const ModelFile& file) {

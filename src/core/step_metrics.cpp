@@ -24,23 +24,24 @@ StepMetrics step_metrics(std::span<const double> y_mm, double r_mm, const StepMe
   m.moved = std::abs(move) > o.settling_band * std::abs(r_mm - y0) && move != 0.0;
   if (!m.moved) return m;
 
-  // Normalised progress: 0 at the start, 1 at the final value, whatever the direction.
-  auto progress = [&](std::size_t k) { return (y_mm[k] - y0) / move; };
-
-  std::optional<std::size_t> k_low, k_high;
-  double peak = 0.0;
-  std::optional<std::size_t> last_outside;
+  // Compared in mm, not as a ratio to the move, so a sample exactly on a band edge lands on the
+  // side the definition says (a ratio like 98/100 - 1 rounds past 0.02).
+  const double direction = move > 0.0 ? 1.0 : -1.0;
+  const double size = std::abs(move);
+  const double band = o.settling_band * size;
+  std::optional<std::size_t> k_low, k_high, last_outside;
+  double peak = 0.0;  // furthest progress towards and beyond the final value, mm
   for (std::size_t k = 0; k < n; ++k) {
-    const double p = progress(k);
-    if (!k_low && p >= o.rise_low) k_low = k;
-    if (!k_high && p >= o.rise_high) k_high = k;
-    peak = std::max(peak, p);
-    if (std::abs(p - 1.0) > o.settling_band) last_outside = k;
+    const double progress = direction * (y_mm[k] - y0);
+    if (!k_low && progress >= o.rise_low * size) k_low = k;
+    if (!k_high && progress >= o.rise_high * size) k_high = k;
+    peak = std::max(peak, progress);
+    if (std::abs(y_mm[k] - m.final_mm) > band) last_outside = k;
   }
   if (k_low && k_high) m.rise_s = static_cast<double>(*k_high - *k_low) * o.Ts;
   if (!last_outside) m.settling_s = 0.0;
   else if (*last_outside + 1 < n) m.settling_s = static_cast<double>(*last_outside + 1) * o.Ts;
-  m.overshoot_pct = std::max(0.0, peak - 1.0) * 100.0;
+  m.overshoot_pct = std::max(0.0, peak - size) / size * 100.0;
   return m;
 }
 

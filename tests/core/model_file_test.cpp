@@ -1,1 +1,255 @@
-// placeholder: written next
+#include "core/model_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/paper_reference.hpp"
+
+namespace epa::core {
+namespace {
+
+const std::string kPaperModelPath = std::string(EPA_SOURCE_DIR) + "/config/paper-model.toml";
+
+::testing::AssertionResult contains(const std::string& text, const std::string& part) {
+  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "'" << part << "' not found in: " << text;
+}
+
+// Field-by-field equality (HammersteinModel has no operator==), exact: every value in these
+// files is a short decimal that parses to the same double as the C++ literal.
+void expect_same_model(const HammersteinModel& actual, const HammersteinModel& expected) {
+  EXPECT_EQ(actual.A.coefficients(), expected.A.coefficients());
+  EXPECT_EQ(actual.B.coefficients(), expected.B.coefficients());
+  EXPECT_EQ(actual.dead_zone, expected.dead_zone);
+  EXPECT_EQ(actual.dead_zone.m_r, expected.dead_zone.m_r);
+  EXPECT_EQ(actual.dead_zone.m_l, expected.dead_zone.m_l);
+  EXPECT_EQ(actual.dead_zone.b_r, expected.dead_zone.b_r);
+  EXPECT_EQ(actual.dead_zone.b_l, expected.dead_zone.b_l);
+  EXPECT_EQ(actual.Ts, expected.Ts);
+  EXPECT_EQ(actual.mm_per_volt, expected.mm_per_volt);
+}
+
+// A valid file in the documented layout; tests break one thing at a time.
+const std::string kValidText = R"(schema = "epa-model/1"
+Ts = 0.005
+mm_per_volt = 50.0
+source = "hand-written test model"
+
+[arx]
+A = [1.0, -0.9094, -0.6110, 0.5204]
+B = [0.0, 1.024, -2.046, 1.029]
+
+[dead_zone]
+m_r = 1.7627
+m_l = 1.0707
+b_r = 1.232
+b_l = -1.722
+)";
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "test setup: '" << from << "' not in the text";
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+std::string temp_path(const std::string& stem) {
+  const auto ticks = std::chrono::steady_clock::now().time_since_epoch().count();
+  return (std::filesystem::temp_directory_path() / (stem + "-" + std::to_string(ticks) + ".toml")).string();
+}
+
+TEST(ModelFile, PaperModelFileEqualsThePaperReference) {
+  const auto file = read_model_file(kPaperModelPath);
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  expect_same_model(file->model, paper::model());
+  EXPECT_FALSE(file->source.empty());
+}
+
+TEST(ModelFile, ValidTextParsesToTheDocumentedFields) {
+  const auto file = parse_model_toml(kValidText, "test.toml");
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  EXPECT_EQ(file->model.A.coefficients(), (std::vector<double>{1.0, -0.9094, -0.6110, 0.5204}));
+  EXPECT_EQ(file->model.B.coefficients(), (std::vector<double>{0.0, 1.024, -2.046, 1.029}));
+  EXPECT_EQ(file->model.dead_zone.m_r, 1.7627);
+  EXPECT_EQ(file->model.dead_zone.m_l, 1.0707);
+  EXPECT_EQ(file->model.dead_zone.b_r, 1.232);
+  EXPECT_EQ(file->model.dead_zone.b_l, -1.722);
+  EXPECT_EQ(file->model.Ts, 0.005);
+  EXPECT_EQ(file->model.mm_per_volt, 50.0);
+  EXPECT_EQ(file->source, "hand-written test model");
+}
+
+TEST(ModelFile, IntegerValuesAreAcceptedAsNumbers) {
+  // A hand-written file may well say "mm_per_volt = 50" or "b_r = 1".
+  std::string text = replaced(kValidText, "mm_per_volt = 50.0", "mm_per_volt = 50");
+  text = replaced(text, "b_r = 1.232", "b_r = 1");
+  text = replaced(text, "A = [1.0,", "A = [1,");
+  const auto file = parse_model_toml(text, "int.toml");
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  EXPECT_EQ(file->model.mm_per_volt, 50.0);
+  EXPECT_EQ(file->model.dead_zone.b_r, 1.0);
+  EXPECT_EQ(file->model.A[0], 1.0);
+}
+
+TEST(ModelFile, FormatThenParseRoundTripsThePaperModel) {
+  const ModelFile original{paper::model(), "round trip"};
+  const auto back = parse_model_toml(format_model_toml(original), "formatted");
+  ASSERT_TRUE(back.has_value()) << back.error().message;
+  expect_same_model(back->model, original.model);
+  EXPECT_EQ(back->source, original.source);
+}
+
+TEST(ModelFile, FormatThenParseRoundTripsOtherShortDecimals) {
+  ModelFile original;
+  original.model.A = {1.0, -1.25, 0.375};
+  original.model.B = {0.0, 0.5, 0.125, -0.0625};
+  original.model.dead_zone = {.m_r = 2.5, .m_l = 0.75, .b_r = 0.5, .b_l = -0.25};
+  original.model.Ts = 0.01;
+  original.model.mm_per_volt = 25.0;
+  original.source = "identified on bench 2";
+  const auto back = parse_model_toml(format_model_toml(original), "formatted");
+  ASSERT_TRUE(back.has_value()) << back.error().message;
+  expect_same_model(back->model, original.model);
+  EXPECT_EQ(back->source, original.source);
+}
+
+// format_model_toml writes the shortest text that reads back to the same double.
+TEST(ModelFile, FormatRoundTripsArbitraryValuesExactly) {
+  ModelFile original{paper::model(), ""};
+  original.model.A = {1.0, -0.90941234567891234, -0.61101234567891234, 0.52041234567891234};
+  original.model.dead_zone.m_r = 1.0 / 3.0;
+  const auto back = parse_model_toml(format_model_toml(original), "formatted");
+  ASSERT_TRUE(back.has_value()) << back.error().message;
+  for (std::size_t i = 0; i < original.model.A.size(); ++i)
+    EXPECT_EQ(back->model.A[i], original.model.A[i]) << i;
+  EXPECT_EQ(back->model.dead_zone.m_r, 1.0 / 3.0);
+}
+
+TEST(ModelFile, SourceWithQuotesAndBackslashesRoundTrips) {
+  ModelFile original{paper::model(), "bench \"2\", C:\\runs\\a.csv; line\tend"};
+  const auto back = parse_model_toml(format_model_toml(original), "formatted");
+  ASSERT_TRUE(back.has_value()) << back.error().message;
+  EXPECT_EQ(back->source, original.source);
+}
+
+TEST(ModelFile, SyntaxErrorNamesTheFileAndLine) {
+  // Line 3 is broken.
+  const std::string text = "schema = \"epa-model/1\"\nTs = 0.005\nmm_per_volt = = 50\n";
+  const auto file = parse_model_toml(text, "name");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_EQ(file.error().code, ErrorCode::kParse);
+  EXPECT_EQ(file.error().message.rfind("name:3:", 0), 0u) << file.error().message;
+}
+
+TEST(ModelFile, MissingArxTableIsNamed) {
+  std::string text = replaced(kValidText, "[arx]\nA = [1.0, -0.9094, -0.6110, 0.5204]\nB = [0.0, 1.024, -2.046, 1.029]\n", "");
+  const auto file = parse_model_toml(text, "no-arx.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "[arx]"));
+  EXPECT_TRUE(contains(file.error().message, "missing"));
+  EXPECT_TRUE(contains(file.error().message, "no-arx.toml"));
+}
+
+TEST(ModelFile, MissingDeadZoneKeyIsNamed) {
+  const auto file = parse_model_toml(replaced(kValidText, "b_l = -1.722\n", ""), "dz.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "b_l"));
+  EXPECT_TRUE(contains(file.error().message, "missing"));
+  EXPECT_TRUE(contains(file.error().message, "dz.toml"));
+}
+
+TEST(ModelFile, MissingDeadZoneTableIsNamed) {
+  const auto file =
+      parse_model_toml(replaced(kValidText, "[dead_zone]\nm_r = 1.7627\nm_l = 1.0707\nb_r = 1.232\nb_l = -1.722\n", ""),
+                       "dz.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "dead_zone"));
+}
+
+TEST(ModelFile, WrongSchemaIsRefused) {
+  const auto file = parse_model_toml(replaced(kValidText, "epa-model/1", "epa-model/2"), "v2.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "schema"));
+  EXPECT_TRUE(contains(file.error().message, "epa-model/2"));
+}
+
+TEST(ModelFile, MissingSchemaIsRefused) {
+  const auto file = parse_model_toml(replaced(kValidText, "schema = \"epa-model/1\"\n", ""), "old.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "schema"));
+}
+
+TEST(ModelFile, NonMonicAIsRefused) {
+  const auto file = parse_model_toml(replaced(kValidText, "A = [1.0,", "A = [2.0,"), "a.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "monic"));
+}
+
+TEST(ModelFile, NonNumberInBIsNamedByIndex) {
+  const auto file = parse_model_toml(replaced(kValidText, "B = [0.0, 1.024,", "B = [0.0, \"x\","), "b.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "B[1]"));
+}
+
+TEST(ModelFile, NonNumberTsIsRefused) {
+  const auto file = parse_model_toml(replaced(kValidText, "Ts = 0.005", "Ts = \"fast\""), "ts.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "Ts"));
+}
+
+TEST(ModelFile, InvalidDeadZoneIsRefusedNamingTheField) {
+  const auto file = parse_model_toml(replaced(kValidText, "m_l = 1.0707", "m_l = -1.0707"), "slope.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "m_l"));
+}
+
+TEST(ModelFile, WriteThenReadGivesTheSameModel) {
+  const std::string path = temp_path("epa-model-test");
+  const ModelFile original{paper::model(), "written by model_file_test"};
+  const Status written = write_model_file(path, original);
+  ASSERT_TRUE(written.has_value()) << written.error().message;
+  const auto back = read_model_file(path);
+  std::filesystem::remove(path);
+  ASSERT_TRUE(back.has_value()) << back.error().message;
+  expect_same_model(back->model, original.model);
+  EXPECT_EQ(back->source, original.source);
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+}
+
+TEST(ModelFile, WriteReplacesAnExistingFile) {
+  const std::string path = temp_path("epa-model-replace");
+  ModelFile first{paper::model(), "first"};
+  ASSERT_TRUE(write_model_file(path, first).has_value());
+  ModelFile second = first;
+  second.source = "second";
+  second.model.Ts = 0.01;
+  ASSERT_TRUE(write_model_file(path, second).has_value());
+  const auto back = read_model_file(path);
+  std::filesystem::remove(path);
+  ASSERT_TRUE(back.has_value()) << back.error().message;
+  EXPECT_EQ(back->source, "second");
+  EXPECT_EQ(back->model.Ts, 0.01);
+}
+
+TEST(ModelFile, ReadingAMissingFileNamesThePath) {
+  const std::string path = "/nonexistent-epa-dir/model.toml";
+  const auto file = read_model_file(path);
+  ASSERT_FALSE(file.has_value());
+  EXPECT_EQ(file.error().code, ErrorCode::kIo);
+  EXPECT_TRUE(contains(file.error().message, path));
+}
+
+TEST(ModelFile, WritingIntoAMissingDirectoryIsAnError) {
+  const std::string path = "/nonexistent-epa-dir/model.toml";
+  const Status s = write_model_file(path, ModelFile{paper::model(), ""});
+  ASSERT_FALSE(s.has_value());
+  EXPECT_TRUE(contains(s.error().message, path));
+}
+
+}  // namespace
+}  // namespace epa::core
