@@ -8,6 +8,8 @@ packages=(
   libeigen3-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libjs-chart.js
+  libmodbus-dev libcomedi-dev libspdlog-dev libsystemd-dev
+  rt-tests mbpoll
 )
 
 missing=()
