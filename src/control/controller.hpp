@@ -22,6 +22,9 @@ struct ControllerConfig {
 
 class ControllerParams {
  public:
+  // A default-constructed ControllerParams is the zero controller (u = 0, valve at 0 V): a safe
+  // placeholder in fixed-size storage. Real parameters come only from make().
+  ControllerParams() = default;
   // Errors name what is wrong: non-monic F, an order above kMaxLawOrder, a non-finite coefficient
   // (with its index), a non-positive slope, b_l > b_r, a negative l_c, a bad limit.
   static core::Result<ControllerParams> make(const ControllerConfig& config);
@@ -34,7 +37,6 @@ class ControllerParams {
   double safe_valve_v() const { return safe_valve_v_; }
 
  private:
-  ControllerParams() = default;
   ControllerKind kind_ = ControllerKind::kPp;
   RstCoefficients rst_;
   core::DeadZone dead_zone_;

@@ -1,0 +1,42 @@
+#pragma once
+// What other threads ask of the scan cycle. Commands are validated by their producer (Modbus,
+// web, command line) against the configured ranges, queued, and applied at the start of the
+// next cycle, whole, or refused there (wrong mode, latched fault) and counted as rejected.
+#include <cstdint>
+
+#include "control/controller_kind.hpp"
+#include "runtime/mode.hpp"
+#include "runtime/tuning.hpp"
+
+namespace epa::runtime {
+
+enum class CommandKind : std::uint8_t {
+  kSetpoint,     // value = setpoint, mm
+  kMode,         // mode = stop, run or manual (refused while FAULT is latched)
+  kManualValve,  // value = valve command for MANUAL, V
+  kController,   // controller = the law to use from the next cycle on
+  kTuning,       // tuning = new parameters for all three laws
+  kReset,        // clears a latched fault: FAULT -> STOP
+  kHeartbeat,    // heartbeat = the supervising client's counter
+  kRecord,       // value = seconds of history to write as a run file
+};
+
+struct Command {
+  CommandKind kind = CommandKind::kReset;
+  double value = 0.0;
+  Mode mode = Mode::kStop;
+  control::ControllerKind controller = control::ControllerKind::kPpFfidz;
+  std::uint32_t heartbeat = 0;
+  Tuning tuning;
+};
+
+inline Command setpoint_command(double mm) { Command c; c.kind = CommandKind::kSetpoint; c.value = mm; return c; }
+inline Command mode_command(Mode m) { Command c; c.kind = CommandKind::kMode; c.mode = m; return c; }
+inline Command manual_valve_command(double v) { Command c; c.kind = CommandKind::kManualValve; c.value = v; return c; }
+inline Command controller_command(control::ControllerKind k) { Command c; c.kind = CommandKind::kController; c.controller = k; return c; }
+inline Command tuning_command(const Tuning& t) { Command c; c.kind = CommandKind::kTuning; c.tuning = t; return c; }
+inline Command reset_command() { Command c; c.kind = CommandKind::kReset; return c; }
+inline Command heartbeat_command(std::uint32_t n) { Command c; c.kind = CommandKind::kHeartbeat; c.heartbeat = n; return c; }
+inline Command record_command(double seconds) { Command c; c.kind = CommandKind::kRecord; c.value = seconds; return c; }
+
+}  // namespace epa::runtime

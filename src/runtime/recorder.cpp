@@ -1,0 +1,99 @@
+#include "runtime/recorder.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "core/run_file.hpp"
+
+namespace epa::runtime {
+
+namespace {
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+}  // namespace
+
+Recorder::Recorder(RecorderConfig config, LoopChannels& channels, Log log)
+    : config_(std::move(config)), ch_(channels), log_(std::move(log)) {}
+
+Recorder::~Recorder() { stop(); }
+
+void Recorder::start() {
+  thread_ = std::thread([this] {
+    while (!stop_.load()) {
+      process_pending();
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+}
+
+void Recorder::stop() {
+  if (thread_.joinable()) {
+    stop_ = true;
+    thread_.join();
+  }
+  process_pending();
+}
+
+std::size_t Recorder::process_pending() {
+  std::size_t n = 0;
+  RecordRequest r;
+  while (ch_.record_requests.try_pop(r)) {
+    if (r.reason == RecordRequest::Reason::kMove && !config_.per_move) continue;
+    write(r);
+    ++n;
+  }
+  return n;
+}
+
+std::string Recorder::last_file() const {
+  std::lock_guard lock(last_file_mutex_);
+  return last_file_;
+}
+
+void Recorder::write(const RecordRequest& request) {
+  core::Run run;
+  run.Ts = config_.Ts;
+  run.set_meta("controller", std::string(control::to_string(request.controller)));
+  run.set_meta("source", config_.source);
+  const auto first = ch_.samples.copy_out(request.first, request.end, run);
+  if (run.size() == 0) {
+    if (log_) log_("recorder: no samples left to write (the ring was overwritten)");
+    return;
+  }
+  // Times restart at 0 so the file is a step response from its first sample.
+  const double t0 = run.t_s.front();
+  for (double& t : run.t_s) t = std::round((t - t0) / config_.Ts) * config_.Ts;
+
+  char name[160];
+  if (request.reason == RecordRequest::Reason::kMove) {
+    const auto& m = request.move;
+    run.set_meta("move", std::to_string(m.number));
+    run.set_meta("from_mm", num(m.from_mm));
+    run.set_meta("step_mm", num(m.to_mm - m.from_mm));
+    std::snprintf(name, sizeof name, "move-%04u-%s-%gto%gmm.csv", m.number,
+                  std::string(control::to_string(request.controller)).c_str(), m.from_mm, m.to_mm);
+  } else {
+    std::snprintf(name, sizeof name, "record-%04llu-sample%llu.csv", static_cast<unsigned long long>(++request_count_),
+                  static_cast<unsigned long long>(first));
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(config_.directory, ec);
+  const std::string path = (std::filesystem::path(config_.directory) / name).string();
+  if (auto s = core::write_run_file(path, run); !s) {
+    if (log_) log_("recorder: " + s.error().message);
+    return;
+  }
+  {
+    std::lock_guard lock(last_file_mutex_);
+    last_file_ = path;
+  }
+  ++files_written_;
+  if (log_) log_("recorder: wrote " + path + " (" + std::to_string(run.size()) + " samples)");
+}
+
+}  // namespace epa::runtime

@@ -1,0 +1,55 @@
+#pragma once
+// The run recorder's writer: a thread that takes RecordRequests from the loop and writes the
+// requested samples from the SampleRing as epa-run/1 files, off the real-time thread, so a rig's
+// runs feed `epa identify` and `epa diagnose` directly. One file per move (if enabled) and one
+// per explicit request.
+#include <atomic>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "runtime/scan_cycle.hpp"
+
+namespace epa::runtime {
+
+struct RecorderConfig {
+  std::string directory = "runs";
+  bool per_move = true;
+  double Ts = 0.005;
+  std::string source = "appliance";  // run-file metadata: sim backend or which rig
+};
+
+class Recorder {
+ public:
+  using Log = std::function<void(const std::string&)>;
+  Recorder(RecorderConfig config, LoopChannels& channels, Log log = {});
+  ~Recorder();
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+
+  void start();  // the writer thread polls every 20 ms
+  void stop();   // writes what is pending, then joins
+
+  // Writes every pending request now (the thread calls this; tests may call it directly).
+  // Returns the number of files written.
+  std::size_t process_pending();
+
+  std::uint64_t files_written() const { return files_written_.load(); }
+  std::string last_file() const;
+
+ private:
+  void write(const RecordRequest& request);
+
+  RecorderConfig config_;
+  LoopChannels& ch_;
+  Log log_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+  std::atomic<std::uint64_t> files_written_{0};
+  std::uint64_t request_count_ = 0;
+  mutable std::mutex last_file_mutex_;
+  std::string last_file_;
+};
+
+}  // namespace epa::runtime

@@ -1,0 +1,49 @@
+#include "runtime/runtime_config.hpp"
+
+#include <cmath>
+#include <string>
+
+namespace epa::runtime {
+
+namespace {
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+}  // namespace
+
+core::Status validate(const RuntimeConfig& c) {
+  const struct { const char* name; double value; bool positive; } checks[] = {
+      {"period_s", c.period_s, true},           {"mm_per_volt", c.mm_per_volt, true},
+      {"sensor_gain", c.sensor_gain, true},     {"sensor_offset_v", c.sensor_offset_v, false},
+      {"manual_valve_limit_v", c.manual_valve_limit_v, true},
+      {"following_error_mm", c.following_error_mm, true},
+      {"move_window_s", c.move_window_s, true}, {"record_buffer_s", c.record_buffer_s, true},
+  };
+  for (const auto& ch : checks) {
+    if (!std::isfinite(ch.value)) return core::invalid_argument(std::string(ch.name) + " must be a finite number");
+    if (ch.positive && !(ch.value > 0.0)) return core::invalid_argument(std::string(ch.name) + " must be > 0, got " + num(ch.value));
+  }
+  if (c.period_s < 0.0002 || c.period_s > 1.0) return core::invalid_argument("period_s must be within [0.0002, 1] s, got " + num(c.period_s));
+  if (!(c.sensor_min_v < c.sensor_max_v)) return core::invalid_argument("sensor_min_v must be below sensor_max_v");
+  if (!(c.soft_min_mm < c.soft_max_mm)) return core::invalid_argument("soft_min_mm must be below soft_max_mm");
+  if (!(c.setpoint_min_mm <= c.setpoint_max_mm)) return core::invalid_argument("setpoint_min_mm must not exceed setpoint_max_mm");
+  if (c.setpoint_min_mm < c.soft_min_mm || c.setpoint_max_mm > c.soft_max_mm)
+    return core::invalid_argument("the setpoint range [" + num(c.setpoint_min_mm) + ", " + num(c.setpoint_max_mm) +
+                                  "] mm must lie inside the soft limits [" + num(c.soft_min_mm) + ", " + num(c.soft_max_mm) + "] mm");
+  if (!std::isfinite(c.safe_valve_v) || std::abs(c.safe_valve_v) > 10.0)  // the valve accepts +-10 V
+    return core::invalid_argument("safe_valve_v must be a valve command within +-10 V, got " + num(c.safe_valve_v));
+  if (!(c.following_error_time_s >= 0.0)) return core::invalid_argument("following_error_time_s must be >= 0 (0: off)");
+  if (!(c.heartbeat_timeout_s >= 0.0)) return core::invalid_argument("heartbeat_timeout_s must be >= 0 (0: off)");
+  if (c.max_consecutive_io_errors < 1) return core::invalid_argument("max_consecutive_io_errors must be >= 1");
+  if (c.max_consecutive_overruns < 1) return core::invalid_argument("max_consecutive_overruns must be >= 1");
+  if (c.start_mode == Mode::kFault || c.start_mode == Mode::kManual)
+    return core::invalid_argument("start mode must be stop or run");
+  if (c.start_setpoint_mm < c.setpoint_min_mm || c.start_setpoint_mm > c.setpoint_max_mm)
+    return core::invalid_argument("start setpoint " + num(c.start_setpoint_mm) + " mm lies outside the setpoint range");
+  if (c.move_window_s > c.record_buffer_s) return core::invalid_argument("move_window_s must not exceed record_buffer_s");
+  return core::ok();
+}
+
+}  // namespace epa::runtime

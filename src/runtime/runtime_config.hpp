@@ -1,0 +1,37 @@
+#pragma once
+// Everything the scan cycle needs to know besides the controller parameters, with the defaults
+// of config/epa.toml. Validated once at start-up; the messages name the setting.
+#include "control/controller_kind.hpp"
+#include "core/result.hpp"
+#include "runtime/mode.hpp"
+
+namespace epa::runtime {
+
+struct RuntimeConfig {
+  double period_s = 0.005;          // Ts, must equal the model's sample time
+  double mm_per_volt = 50.0;        // model units: position_mm = y * mm_per_volt
+  double sensor_offset_v = 0.0;     // calibration: y = (sensor_v - offset) * gain
+  double sensor_gain = 1.0;
+
+  double sensor_min_v = -0.2, sensor_max_v = 10.2;  // outside: broken wire or wrong scaling
+  double soft_min_mm = -2.0, soft_max_mm = 502.0;   // fault when the piston leaves them in RUN/MANUAL
+  double setpoint_min_mm = 0.0, setpoint_max_mm = 500.0;
+  double manual_valve_limit_v = 3.0;
+  double safe_valve_v = 0.0;        // 5/3 valve centred
+  double following_error_mm = 50.0; // |r - y| above this ...
+  double following_error_time_s = 2.0;  // ... for longer than this faults (0: off)
+  int max_consecutive_io_errors = 3;
+  int max_consecutive_overruns = 10;
+  double heartbeat_timeout_s = 0.0;  // 0: no heartbeat supervision
+
+  control::ControllerKind controller = control::ControllerKind::kPpFfidz;
+  Mode start_mode = Mode::kStop;
+  double start_setpoint_mm = 0.0;
+
+  double move_window_s = 5.0;       // online metrics: each move is measured over this window
+  double record_buffer_s = 60.0;    // recorder ring: seconds of history kept in memory
+};
+
+core::Status validate(const RuntimeConfig& config);
+
+}  // namespace epa::runtime

@@ -1,0 +1,279 @@
+#include "runtime/scan_cycle.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace epa::runtime {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+double or_nan(const std::optional<double>& v) { return v ? *v : kNaN; }
+}  // namespace
+
+ScanCycle::ScanCycle(const RuntimeConfig& config, const Tuning& tuning, hal::Daq& daq, Clock& clock, LoopChannels& ch)
+    : config_(config),
+      tuning_(tuning),
+      daq_(daq),
+      clock_(clock),
+      ch_(ch),
+      period_ns_(static_cast<std::int64_t>(std::llround(config.period_s * 1e9))),
+      controller_(config.controller),
+      setpoint_mm_(config.start_setpoint_mm),
+      manual_valve_v_(config.safe_valve_v),
+      valve_v_(config.safe_valve_v),
+      moves_(config.move_window_s, config.period_s) {
+  if (config.start_mode == Mode::kRun) {
+    mode_ = Mode::kRun;
+    init_state_on_next_read_ = true;  // the position is known only after the first read
+  }
+  heartbeat_changed_ns_ = clock_.now_ns();
+  publish();
+}
+
+void ScanCycle::apply_commands(std::int64_t now_ns) noexcept {
+  Command c;
+  for (int i = 0; i < 16 && ch_.commands.try_pop(c); ++i) apply(c, now_ns);  // bounded work per cycle
+}
+
+void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
+  bool accepted = true;
+  switch (c.kind) {
+    case CommandKind::kSetpoint:
+      if (!(c.value >= config_.setpoint_min_mm && c.value <= config_.setpoint_max_mm)) {
+        accepted = false;
+      } else if (c.value != setpoint_mm_) {
+        setpoint_mm_ = c.value;
+        if (mode_ == Mode::kRun) start_move();
+      }
+      break;
+    case CommandKind::kMode:
+      if (mode_ == Mode::kFault || c.mode == Mode::kFault) {
+        accepted = false;  // a latched fault needs an explicit reset first
+      } else if (c.mode != mode_) {
+        if (moves_.active()) finish_move();
+        if (c.mode == Mode::kRun) enter_run(now_ns);
+        if (c.mode == Mode::kManual) {
+          manual_valve_v_ = config_.safe_valve_v;  // never resume a stale manual command
+          heartbeat_changed_ns_ = now_ns;
+        }
+        mode_ = c.mode;
+      }
+      break;
+    case CommandKind::kManualValve:
+      if (!(std::abs(c.value) <= config_.manual_valve_limit_v)) accepted = false;
+      else manual_valve_v_ = c.value;
+      break;
+    case CommandKind::kController:
+      controller_ = c.controller;  // bumpless: the RST history carries over
+      break;
+    case CommandKind::kTuning:
+      tuning_ = c.tuning;  // takes effect in this cycle's control step, whole
+      break;
+    case CommandKind::kReset:
+      if (mode_ == Mode::kFault) {
+        mode_ = Mode::kStop;
+        fault_ = FaultCode::kNone;
+        consecutive_read_errors_ = consecutive_write_errors_ = consecutive_overruns_ = 0;
+        following_error_since_ns_ = -1;
+      }
+      break;
+    case CommandKind::kHeartbeat:
+      if (c.heartbeat != heartbeat_) {
+        heartbeat_ = c.heartbeat;
+        heartbeat_changed_ns_ = now_ns;
+      }
+      break;
+    case CommandKind::kRecord: {
+      const auto end = ch_.samples.written();
+      const auto n = static_cast<std::uint64_t>(std::max(0.0, c.value) / config_.period_s);
+      accepted = ch_.record_requests.try_push({RecordRequest::Reason::kRequest, end > n ? end - n : 0, end, {}, controller_});
+      break;
+    }
+  }
+  (accepted ? applied_ : rejected_)++;
+}
+
+void ScanCycle::enter_run(std::int64_t now_ns) noexcept {
+  init_state_on_next_read_ = true;
+  heartbeat_changed_ns_ = now_ns;  // the client gets a full timeout from here
+  following_error_since_ns_ = -1;
+}
+
+void ScanCycle::start_move() noexcept {
+  if (moves_.active()) finish_move();
+  moves_.start(position_mm_, setpoint_mm_, ch_.samples.written());
+}
+
+void ScanCycle::finish_move() noexcept {
+  last_move_ = moves_.finish();
+  ch_.record_requests.try_push({RecordRequest::Reason::kMove, last_move_.first_sample, last_move_.end_sample, last_move_,
+                                controller_});  // a full queue drops the file, never the loop
+}
+
+FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
+  if (consecutive_read_errors_ >= config_.max_consecutive_io_errors ||
+      consecutive_write_errors_ >= config_.max_consecutive_io_errors)
+    return FaultCode::kIoErrors;
+  if (consecutive_overruns_ >= config_.max_consecutive_overruns) return FaultCode::kOverruns;
+  if (read_ok) {
+    if (!std::isfinite(sensor_v_)) return FaultCode::kSensorNotFinite;
+    if (sensor_v_ < config_.sensor_min_v || sensor_v_ > config_.sensor_max_v) return FaultCode::kSensorOutOfRange;
+  }
+  const bool moving = mode_ == Mode::kRun || mode_ == Mode::kManual;
+  if (!moving) return FaultCode::kNone;
+  if (read_ok && (position_mm_ < config_.soft_min_mm || position_mm_ > config_.soft_max_mm)) return FaultCode::kSoftLimit;
+  if (config_.heartbeat_timeout_s > 0.0 &&
+      static_cast<double>(now_ns - heartbeat_changed_ns_) > config_.heartbeat_timeout_s * 1e9)
+    return FaultCode::kHeartbeatLost;
+  if (mode_ == Mode::kRun && read_ok && config_.following_error_time_s > 0.0) {
+    if (std::abs(setpoint_mm_ - position_mm_) > config_.following_error_mm) {
+      if (following_error_since_ns_ < 0) following_error_since_ns_ = now_ns;
+      if (static_cast<double>(now_ns - following_error_since_ns_) > config_.following_error_time_s * 1e9)
+        return FaultCode::kFollowingError;
+    } else {
+      following_error_since_ns_ = -1;
+    }
+  }
+  return FaultCode::kNone;
+}
+
+void ScanCycle::enter_fault(FaultCode code) noexcept {
+  if (moves_.active()) finish_move();
+  mode_ = Mode::kFault;
+  fault_ = code;
+  ++faults_;
+}
+
+void ScanCycle::cycle(std::int64_t now_ns) noexcept {
+  apply_commands(now_ns);
+
+  const hal::SensorReading reading = daq_.read_sensor();
+  const bool read_ok = reading.status == hal::IoStatus::kOk;
+  if (read_ok) {
+    sensor_v_ = reading.sensor_v;
+    position_mm_ = (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain * config_.mm_per_volt;
+    consecutive_read_errors_ = 0;
+  } else {
+    ++consecutive_read_errors_;  // counted before the fault check: the N-th failure faults this cycle
+    ++io_errors_;
+  }
+  if (mode_ != Mode::kFault) {
+    if (const FaultCode f = detect_fault(read_ok, now_ns); f != FaultCode::kNone) enter_fault(f);
+  }
+
+  const double y_v = (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain;
+  const double r_v = setpoint_mm_ / config_.mm_per_volt;
+  saturated_ = false;
+  switch (mode_) {
+    case Mode::kRun:
+      if (!read_ok) break;  // hold the last command for a missed sample (counted below)
+      if (init_state_on_next_read_) {
+        // At rest at the current position: no error history, no controller output history.
+        state_ = {};
+        state_.rst.y_past.fill(y_v);
+        state_.rst.r_past.fill(y_v);
+        init_state_on_next_read_ = false;
+        if (setpoint_mm_ != position_mm_) start_move();
+      }
+      {
+        const auto out = control::controller_step(tuning_.for_kind(controller_), state_, r_v, y_v);
+        if (out.fault) {
+          enter_fault(FaultCode::kControllerFault);
+          valve_v_ = config_.safe_valve_v;
+        } else {
+          valve_v_ = out.valve_v;
+          controller_v_ = out.controller_v;
+          saturated_ = out.saturated;
+        }
+      }
+      break;
+    case Mode::kManual: valve_v_ = manual_valve_v_; controller_v_ = 0.0; break;
+    case Mode::kStop:
+    case Mode::kFault: valve_v_ = config_.safe_valve_v; controller_v_ = 0.0; break;
+  }
+
+  const bool write_ok = daq_.write_valve(valve_v_) == hal::IoStatus::kOk;
+  io_ok_ = read_ok && write_ok;
+  if (write_ok) {
+    consecutive_write_errors_ = 0;
+  } else {
+    ++consecutive_write_errors_;  // a valve that cannot be written faults at the next cycle's check
+    ++io_errors_;
+  }
+
+  ch_.samples.push({static_cast<double>(cycle_) * config_.period_s, setpoint_mm_, position_mm_, valve_v_, controller_v_});
+  if (mode_ == Mode::kRun && moves_.active() && moves_.add(position_mm_)) finish_move();
+  ++cycle_;
+  publish();
+}
+
+void ScanCycle::publish() noexcept {
+  Snapshot& s = snap_;
+  s.cycle = cycle_;
+  s.time_s = static_cast<double>(cycle_) * config_.period_s;
+  s.Ts = config_.period_s;
+  s.mode = mode_;
+  s.fault = fault_;
+  s.controller = controller_;
+  s.saturated = saturated_;
+  s.io_ok = io_ok_;
+  s.setpoint_mm = setpoint_mm_;
+  s.position_mm = position_mm_;
+  s.sensor_v = sensor_v_;
+  s.error_mm = setpoint_mm_ - position_mm_;
+  s.valve_v = valve_v_;
+  s.controller_v = controller_v_;
+  s.manual_valve_v = manual_valve_v_;
+  s.heartbeat = heartbeat_;
+  s.moves = last_move_.number;
+  s.faults = faults_;
+  s.io_errors = io_errors_;
+  s.commands_applied = applied_;
+  s.commands_rejected = rejected_;
+  const auto& m = last_move_.metrics;
+  s.last_move = {last_move_.number, last_move_.from_mm, last_move_.to_mm, or_nan(m.rise_s), or_nan(m.settling_s),
+                 last_move_.number ? m.ess_mm : kNaN, or_nan(m.overshoot_pct)};
+  if (cycle_ % 200 == 0) s.loop = stats_.view();  // percentiles scan the bins: a few times a second
+  s.loop.overruns = stats_.overruns;
+  const auto& p = tuning_.for_kind(controller_);
+  const auto& rst = p.rst();
+  s.tuning = {rst.F, rst.G, rst.H, static_cast<std::uint8_t>(rst.nF), static_cast<std::uint8_t>(rst.nG),
+              static_cast<std::uint8_t>(rst.nH), p.dead_zone().m_r, p.dead_zone().m_l, p.dead_zone().b_r,
+              p.dead_zone().b_l, p.lc_v() * config_.mm_per_volt, p.valve_limit_v()};
+  ch_.snapshot.publish(s);
+}
+
+void ScanCycle::run(const std::atomic<bool>& stop) noexcept {
+  std::int64_t deadline = clock_.now_ns() + period_ns_;
+  std::int64_t previous_wake = -1;
+  while (!stop.load(std::memory_order_relaxed)) {
+    clock_.sleep_until(deadline);
+    const std::int64_t wake = clock_.now_ns();
+    stats_.wake.add(wake - deadline);
+    if (previous_wake >= 0) stats_.jitter.add(std::abs((wake - previous_wake) - period_ns_));
+    previous_wake = wake;
+    cycle(wake);
+    const std::int64_t done = clock_.now_ns();
+    stats_.compute.add(done - wake);
+    deadline += period_ns_;
+    if (done > deadline) {  // missed the next deadline: skip the lost periods, count an overrun
+      ++stats_.overruns;
+      ++consecutive_overruns_;
+      while (deadline < done) deadline += period_ns_;
+    } else {
+      consecutive_overruns_ = 0;
+    }
+  }
+  shut_down();
+}
+
+void ScanCycle::shut_down() noexcept {
+  if (moves_.active()) finish_move();
+  valve_v_ = config_.safe_valve_v;
+  daq_.write_valve(valve_v_);
+  if (mode_ != Mode::kFault) mode_ = Mode::kStop;
+  publish();
+}
+
+}  // namespace epa::runtime

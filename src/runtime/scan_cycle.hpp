@@ -1,0 +1,100 @@
+#pragma once
+// The PLC-style scan cycle: every period Ts it applies queued commands, reads the sensor through
+// the DAQ, checks for faults, steps the active controller (or holds the valve safe / manual),
+// writes the valve, records the sample and publishes a snapshot. One cycle never allocates,
+// blocks on other threads, or does I/O other than the DAQ's.
+//
+// Timing (the same as sim::simulate_step): at cycle k the sensor is read, u(k) is computed and
+// written at once, and held until k+1. Against the sim backend, which steps its plant on each
+// write, a run through the scan cycle reproduces `epa simulate` sample for sample.
+#include <atomic>
+#include <cstdint>
+
+#include "control/controller.hpp"
+#include "hal/daq.hpp"
+#include "runtime/clock.hpp"
+#include "runtime/command.hpp"
+#include "runtime/command_queue.hpp"
+#include "runtime/loop_stats.hpp"
+#include "runtime/move_tracker.hpp"
+#include "runtime/runtime_config.hpp"
+#include "runtime/sample_ring.hpp"
+#include "runtime/seqlock.hpp"
+#include "runtime/snapshot.hpp"
+#include "runtime/spsc_ring.hpp"
+#include "runtime/tuning.hpp"
+
+namespace epa::runtime {
+
+// Asks the recorder thread to write samples [first, end) as a run file.
+struct RecordRequest {
+  enum class Reason : std::uint8_t { kMove, kRequest } reason = Reason::kRequest;
+  std::uint64_t first = 0, end = 0;
+  MoveResult move;  // for kMove
+  control::ControllerKind controller = control::ControllerKind::kPpFfidz;
+};
+
+// The two channels other threads meet the loop through, plus the recorder's.
+struct LoopChannels {
+  explicit LoopChannels(std::size_t record_capacity) : samples(record_capacity) {}
+  CommandQueue<Command, 64> commands;
+  SeqlockCell<Snapshot> snapshot;
+  SampleRing samples;
+  SpscRing<RecordRequest, 16> record_requests;
+};
+
+class ScanCycle {
+ public:
+  // Allocates all buffers here. `config` must be valid (validate()) and period_s must equal Ts.
+  ScanCycle(const RuntimeConfig& config, const Tuning& tuning, hal::Daq& daq, Clock& clock, LoopChannels& channels);
+
+  // One cycle at wake time `now_ns`. noexcept and allocation-free.
+  void cycle(std::int64_t now_ns) noexcept;
+
+  // Sleeps to absolute deadlines and runs cycles until `stop` is set, measuring wake-up latency,
+  // period jitter, compute time and overruns; then writes the safe valve command.
+  void run(const std::atomic<bool>& stop) noexcept;
+
+  // The last act of a shutdown or of the loop thread: valve to its safe command, mode STOP.
+  void shut_down() noexcept;
+
+  const Snapshot& last_snapshot() const noexcept { return snap_; }
+
+ private:
+  void apply_commands(std::int64_t now_ns) noexcept;
+  void apply(const Command& c, std::int64_t now_ns) noexcept;
+  void enter_run(std::int64_t now_ns) noexcept;
+  void start_move() noexcept;
+  void finish_move() noexcept;
+  FaultCode detect_fault(bool read_ok, std::int64_t now_ns) noexcept;
+  void enter_fault(FaultCode code) noexcept;
+  void publish() noexcept;
+
+  RuntimeConfig config_;
+  Tuning tuning_;
+  hal::Daq& daq_;
+  Clock& clock_;
+  LoopChannels& ch_;
+  std::int64_t period_ns_;
+
+  Mode mode_ = Mode::kStop;
+  FaultCode fault_ = FaultCode::kNone;
+  control::ControllerKind controller_;
+  control::ControllerState state_;
+  bool init_state_on_next_read_ = false;
+  double setpoint_mm_ = 0.0, manual_valve_v_ = 0.0;
+  double sensor_v_ = 0.0, position_mm_ = 0.0, valve_v_ = 0.0, controller_v_ = 0.0;
+  bool saturated_ = false, io_ok_ = true;
+  int consecutive_read_errors_ = 0, consecutive_write_errors_ = 0, consecutive_overruns_ = 0;
+  std::int64_t following_error_since_ns_ = -1;
+  std::uint32_t heartbeat_ = 0;
+  std::int64_t heartbeat_changed_ns_ = 0;
+  std::uint64_t cycle_ = 0, faults_ = 0, io_errors_ = 0, applied_ = 0, rejected_ = 0;
+
+  MoveTracker moves_;
+  MoveResult last_move_;
+  LoopStats stats_;
+  Snapshot snap_;
+};
+
+}  // namespace epa::runtime

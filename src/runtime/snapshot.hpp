@@ -1,0 +1,44 @@
+#pragma once
+// Snapshot out: everything the other threads may know of the loop, published once per cycle
+// through a SeqlockCell. Trivially copyable: plain numbers, NaN for "never" / "no value".
+#include <array>
+#include <cstdint>
+
+#include "control/controller_kind.hpp"
+#include "control/rst_law.hpp"
+#include "runtime/loop_stats.hpp"
+#include "runtime/mode.hpp"
+
+namespace epa::runtime {
+
+struct MoveMetricsView {
+  std::uint32_t number = 0;  // 0: no move finished yet
+  double from_mm = 0, to_mm = 0;
+  double rise_s = 0, settling_s = 0, ess_mm = 0, overshoot_pct = 0;  // NaN: never reached / never moved
+};
+
+struct TuningView {
+  std::array<double, control::kMaxLawOrder + 1> F{}, G{}, H{};
+  std::uint8_t nF = 0, nG = 0, nH = 0;
+  double m_r = 0, m_l = 0, b_r = 0, b_l = 0, lc_mm = 0, valve_limit_v = 0;
+};
+
+struct Snapshot {
+  std::uint64_t cycle = 0;
+  double time_s = 0;  // since start, cycle * Ts
+  double Ts = 0;
+  Mode mode = Mode::kStop;
+  FaultCode fault = FaultCode::kNone;  // the latched fault (kNone unless mode is kFault)
+  control::ControllerKind controller = control::ControllerKind::kPpFfidz;
+  bool saturated = false;
+  bool io_ok = true;  // the last read and write both succeeded
+  double setpoint_mm = 0, position_mm = 0, sensor_v = 0, error_mm = 0;
+  double valve_v = 0, controller_v = 0, manual_valve_v = 0;
+  std::uint32_t heartbeat = 0;
+  std::uint64_t moves = 0, faults = 0, io_errors = 0, commands_applied = 0, commands_rejected = 0;
+  MoveMetricsView last_move;
+  LoopStatsView loop;
+  TuningView tuning;
+};
+
+}  // namespace epa::runtime

@@ -1,0 +1,187 @@
+// Every fault drives the valve to its safe command within one cycle, and stays latched until an
+// explicit reset; a reset with the cause gone returns to STOP.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "control/paper_controller.hpp"
+#include "fake_daq.hpp"
+#include "runtime/scan_cycle.hpp"
+
+namespace epa::runtime {
+namespace {
+
+constexpr std::int64_t kPeriodNs = 5'000'000;
+constexpr double kSafeV = 0.0;
+
+class Faults : public ::testing::Test {
+ protected:
+  void start(RuntimeConfig c = {}) {
+    c.start_mode = Mode::kRun;
+    c.start_setpoint_mm = c.start_setpoint_mm == 0.0 ? 300.0 : c.start_setpoint_mm;
+    config_ = c;
+    daq_.sensor_v = 2.0;  // 100 mm
+    loop_ = std::make_unique<ScanCycle>(c, *make_tuning(control::paper_controller_config(control::ControllerKind::kPpFfidz)),
+                                        daq_, clock_, ch_);
+    cycles(3);
+    ASSERT_EQ(snap().mode, Mode::kRun);
+    ASSERT_NE(daq_.last_written_v, kSafeV);  // moving: the valve is open
+  }
+  void cycles(int n) {
+    for (int k = 0; k < n; ++k) {
+      loop_->cycle(clock_.now_ns());
+      clock_.advance(kPeriodNs);
+    }
+  }
+  // The fault is caused, then exactly one cycle runs: it must already have written the safe command.
+  void expect_safe_after_one_cycle(FaultCode expected) {
+    cycles(1);
+    EXPECT_EQ(daq_.last_written_v, kSafeV);
+    EXPECT_EQ(snap().mode, Mode::kFault);
+    EXPECT_EQ(snap().fault, expected) << to_string(snap().fault);
+  }
+  const Snapshot& snap() const { return loop_->last_snapshot(); }
+
+  testing::FakeDaq daq_;
+  VirtualClock clock_;
+  LoopChannels ch_{4000};
+  RuntimeConfig config_;
+  std::unique_ptr<ScanCycle> loop_;
+};
+
+TEST_F(Faults, SensorNotFinite) {
+  start();
+  daq_.sensor_v = std::numeric_limits<double>::quiet_NaN();
+  expect_safe_after_one_cycle(FaultCode::kSensorNotFinite);
+}
+
+TEST_F(Faults, SensorOutOfRange) {
+  start();
+  daq_.sensor_v = 11.0;
+  expect_safe_after_one_cycle(FaultCode::kSensorOutOfRange);
+}
+
+TEST_F(Faults, PositionOutsideSoftLimits) {
+  RuntimeConfig c;
+  c.soft_min_mm = 50.0;
+  c.soft_max_mm = 450.0;
+  c.setpoint_min_mm = 50.0;
+  c.setpoint_max_mm = 450.0;
+  start(c);
+  daq_.sensor_v = 0.9;  // 45 mm
+  expect_safe_after_one_cycle(FaultCode::kSoftLimit);
+}
+
+TEST_F(Faults, ConsecutiveReadErrorsFaultOnTheNthFailure) {
+  start();  // max_consecutive_io_errors = 3
+  daq_.read_status = hal::IoStatus::kTimeout;
+  const double held = daq_.last_written_v;
+  cycles(2);
+  EXPECT_EQ(snap().mode, Mode::kRun);
+  EXPECT_EQ(daq_.last_written_v, held);  // a missed sample holds the last command
+  expect_safe_after_one_cycle(FaultCode::kIoErrors);
+}
+
+TEST_F(Faults, OneMissedReadDoesNotFault) {
+  start();
+  daq_.read_status = hal::IoStatus::kError;
+  cycles(2);
+  daq_.read_status = hal::IoStatus::kOk;
+  cycles(5);
+  EXPECT_EQ(snap().mode, Mode::kRun);
+  EXPECT_EQ(snap().io_errors, 2u);
+}
+
+TEST_F(Faults, RepeatedOverruns) {
+  RuntimeConfig c;
+  c.max_consecutive_overruns = 3;
+  start(c);
+  daq_.clock = &clock_;
+  daq_.read_takes_ns = 2 * kPeriodNs;  // every cycle now misses its deadline
+  std::atomic<bool> stop{false};
+  struct Stopper final : hal::Daq {
+    testing::FakeDaq& d; std::atomic<bool>& stop; const Snapshot* snap;
+    Stopper(testing::FakeDaq& dd, std::atomic<bool>& s) : d(dd), stop(s), snap(nullptr) {}
+    std::string describe() const override { return ""; }
+    core::Status open() override { return core::ok(); }
+    hal::SensorReading read_sensor() noexcept override { return d.read_sensor(); }
+    hal::IoStatus write_valve(double v) noexcept override {
+      if (d.writes > 20) stop = true;
+      return d.write_valve(v);
+    }
+    void close() noexcept override {}
+  } stopper(daq_, stop);
+  ScanCycle loop(c, *make_tuning(control::paper_controller_config(control::ControllerKind::kPpFfidz)), stopper, clock_, ch_);
+  loop.run(stop);
+  EXPECT_EQ(loop.last_snapshot().mode, Mode::kFault);
+  EXPECT_EQ(loop.last_snapshot().fault, FaultCode::kOverruns);
+  EXPECT_GE(loop.last_snapshot().loop.overruns, 3u);
+  EXPECT_EQ(daq_.last_written_v, kSafeV);
+}
+
+TEST_F(Faults, FollowingErrorTooLargeForTooLong) {
+  RuntimeConfig c;
+  c.following_error_mm = 20.0;
+  c.following_error_time_s = 0.5;
+  start(c);    // cycles at 0, 5, 10 ms; the error (|300 - 100| mm) is there from t = 0
+  cycles(98);  // up to t = 500 ms: exactly the allowed time, not more
+  EXPECT_EQ(snap().mode, Mode::kRun);
+  cycles(1);   // t = 505 ms
+  EXPECT_EQ(snap().mode, Mode::kFault);
+  EXPECT_EQ(snap().fault, FaultCode::kFollowingError);
+  EXPECT_EQ(daq_.last_written_v, kSafeV);
+}
+
+TEST_F(Faults, HeartbeatLostWhenTheClientStopsCounting) {
+  RuntimeConfig c;
+  c.heartbeat_timeout_s = 0.1;
+  start(c);
+  for (std::uint32_t beat = 1; beat <= 10; ++beat) {  // 10 beats, every 50 ms: no fault
+    ASSERT_TRUE(ch_.commands.try_push(heartbeat_command(beat)));
+    cycles(10);
+  }
+  EXPECT_EQ(snap().mode, Mode::kRun);
+  ASSERT_TRUE(ch_.commands.try_push(heartbeat_command(11)));
+  cycles(1);   // the last change, at time T
+  cycles(20);  // up to T + 100 ms: exactly the timeout, not more
+  EXPECT_EQ(snap().mode, Mode::kRun);
+  cycles(1);   // T + 105 ms
+  EXPECT_EQ(snap().mode, Mode::kFault);
+  EXPECT_EQ(snap().fault, FaultCode::kHeartbeatLost);
+  EXPECT_EQ(daq_.last_written_v, kSafeV);
+}
+
+TEST_F(Faults, FaultStaysLatchedUntilResetThenStop) {
+  start();
+  daq_.sensor_v = 11.0;
+  cycles(1);
+  ASSERT_EQ(snap().mode, Mode::kFault);
+  daq_.sensor_v = 2.0;  // the cause is gone, but the fault stays
+  ASSERT_TRUE(ch_.commands.try_push(mode_command(Mode::kRun)));
+  cycles(5);
+  EXPECT_EQ(snap().mode, Mode::kFault);
+  EXPECT_EQ(snap().commands_rejected, 1u);
+  EXPECT_EQ(daq_.last_written_v, kSafeV);
+
+  ASSERT_TRUE(ch_.commands.try_push(reset_command()));
+  cycles(1);
+  EXPECT_EQ(snap().mode, Mode::kStop);
+  EXPECT_EQ(snap().fault, FaultCode::kNone);
+  ASSERT_TRUE(ch_.commands.try_push(mode_command(Mode::kRun)));
+  cycles(1);
+  EXPECT_EQ(snap().mode, Mode::kRun);
+  EXPECT_EQ(snap().faults, 1u);
+}
+
+TEST_F(Faults, ResetWithTheCausePresentFaultsAgain) {
+  start();
+  daq_.sensor_v = 11.0;
+  cycles(1);
+  ASSERT_TRUE(ch_.commands.try_push(reset_command()));
+  cycles(1);
+  EXPECT_EQ(snap().mode, Mode::kFault);  // still out of range: faulted again in the same cycle
+  EXPECT_EQ(snap().faults, 2u);
+}
+
+}  // namespace
+}  // namespace epa::runtime

@@ -1,0 +1,258 @@
+// The scan cycle on the virtual clock: the same code path as `epa simulate`, modes, bumpless
+// switching at cycle boundaries, online metrics and the recorder.
+#include "runtime/scan_cycle.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "control/paper_controller.hpp"
+#include "core/paper_reference.hpp"
+#include "core/run_file.hpp"
+#include "fake_daq.hpp"
+#include "hal/sim_daq.hpp"
+#include "runtime/recorder.hpp"
+#include "sim/closed_loop.hpp"
+
+namespace epa::runtime {
+namespace {
+
+using control::ControllerKind;
+constexpr std::int64_t kPeriodNs = 5'000'000;
+
+Tuning paper_tuning() { return *make_tuning(control::paper_controller_config(ControllerKind::kPpFfidz)); }
+
+// Runs `n` cycles at virtual times k * Ts.
+void run_cycles(ScanCycle& loop, VirtualClock& clock, int n) {
+  for (int k = 0; k < n; ++k) {
+    loop.cycle(clock.now_ns());
+    clock.advance(kPeriodNs);
+  }
+}
+
+core::Run recorded(LoopChannels& ch) {
+  core::Run run;
+  ch.samples.copy_out(0, ch.samples.written(), run);
+  return run;
+}
+
+TEST(ScanCycle, ReproducesSimulateExactlyForEachController) {
+  for (ControllerKind kind : control::kAllControllerKinds) {
+    const auto model = core::paper::model();
+    auto daq = *hal::SimDaq::make(model, {.noise_std_mm = 0.1, .seed = 5});
+    VirtualClock clock;
+    RuntimeConfig config;
+    config.controller = kind;
+    config.start_mode = Mode::kRun;
+    config.start_setpoint_mm = 50.0;
+    LoopChannels ch(8000);
+    ScanCycle loop(config, paper_tuning(), daq, clock, ch);
+    run_cycles(loop, clock, 4000);
+
+    auto params = *control::ControllerParams::make(control::paper_controller_config(kind));
+    const auto sim = *sim::simulate_step(model, params, {.step_mm = 50.0, .duration_s = 20.0, .noise_std_mm = 0.1, .seed = 5});
+    const core::Run run = recorded(ch);
+    ASSERT_EQ(run.size(), sim.run.size());
+    EXPECT_EQ(run.y_mm, sim.run.y_mm) << control::to_string(kind);
+    EXPECT_EQ(run.u_V, sim.run.u_V) << control::to_string(kind);
+    EXPECT_EQ(run.uc_V, sim.run.uc_V) << control::to_string(kind);
+    EXPECT_EQ(loop.last_snapshot().mode, Mode::kRun);
+  }
+}
+
+TEST(ScanCycle, OnlineMoveMetricsAreSimulateMetricsOverTheMoveWindow) {
+  const auto model = core::paper::model();
+  auto daq = *hal::SimDaq::make(model, {});
+  VirtualClock clock;
+  RuntimeConfig config;
+  config.start_mode = Mode::kRun;
+  config.start_setpoint_mm = 100.0;
+  config.move_window_s = 5.0;
+  LoopChannels ch(8000);
+  ScanCycle loop(config, paper_tuning(), daq, clock, ch);
+  run_cycles(loop, clock, 1001);  // the 5 s window is 1000 samples
+
+  auto params = *control::ControllerParams::make(control::paper_controller_config(ControllerKind::kPpFfidz));
+  const auto sim = *sim::simulate_step(model, params, {.step_mm = 100.0, .duration_s = 5.0});
+  const auto expected = core::step_metrics(sim.run.y_mm, 100.0, {.Ts = 0.005, .ess_window_s = 2.0});
+  const auto& m = loop.last_snapshot().last_move;
+  EXPECT_EQ(m.number, 1u);
+  EXPECT_EQ(m.from_mm, 0.0);
+  EXPECT_EQ(m.to_mm, 100.0);
+  EXPECT_EQ(m.rise_s, *expected.rise_s);
+  EXPECT_EQ(m.settling_s, *expected.settling_s);
+  EXPECT_EQ(m.ess_mm, expected.ess_mm);
+  EXPECT_EQ(m.overshoot_pct, *expected.overshoot_pct);
+  EXPECT_EQ(loop.last_snapshot().moves, 1u);
+}
+
+struct Rig {
+  testing::FakeDaq daq;
+  VirtualClock clock;
+  LoopChannels ch{4000};
+  RuntimeConfig config;
+  std::unique_ptr<ScanCycle> loop;
+
+  explicit Rig(RuntimeConfig c = {}) : config(c) { loop = std::make_unique<ScanCycle>(config, paper_tuning(), daq, clock, ch); }
+  void push(Command c) { ASSERT_TRUE(ch.commands.try_push(c)); }
+  void cycles(int n) { run_cycles(*loop, clock, n); }
+  const Snapshot& snap() const { return loop->last_snapshot(); }
+};
+
+
+TEST(ScanCycle, StopHoldsTheValveSafeAndRunMovesIt) {
+  Rig rig;
+  rig.cycles(3);
+  EXPECT_EQ(rig.daq.last_written_v, 0.0);
+  EXPECT_EQ(rig.snap().mode, Mode::kStop);
+  rig.push(setpoint_command(150.0));  // 2 V sensor = 100 mm now
+  rig.push(mode_command(Mode::kRun));
+  rig.cycles(1);
+  EXPECT_EQ(rig.snap().mode, Mode::kRun);
+  EXPECT_NE(rig.daq.last_written_v, 0.0);
+  rig.push(mode_command(Mode::kStop));
+  rig.cycles(1);
+  EXPECT_EQ(rig.daq.last_written_v, 0.0);  // within one cycle
+}
+
+TEST(ScanCycle, ManualAppliesTheCommandWithinItsLimitAndStartsFromSafe) {
+  Rig rig;
+  rig.push(manual_valve_command(2.0));
+  rig.push(mode_command(Mode::kManual));
+  rig.cycles(1);
+  EXPECT_EQ(rig.daq.last_written_v, 0.0);  // entering MANUAL never resumes an old command
+  rig.push(manual_valve_command(2.0));
+  rig.cycles(1);
+  EXPECT_EQ(rig.daq.last_written_v, 2.0);
+  const auto rejected = rig.snap().commands_rejected;
+  rig.push(manual_valve_command(4.0));  // above the 3 V manual limit
+  rig.cycles(1);
+  EXPECT_EQ(rig.daq.last_written_v, 2.0);
+  EXPECT_EQ(rig.snap().commands_rejected, rejected + 1);
+}
+
+TEST(ScanCycle, SetpointOutsideTheRangeIsRejectedWhole) {
+  Rig rig;
+  rig.push(setpoint_command(600.0));
+  rig.cycles(1);
+  EXPECT_EQ(rig.snap().setpoint_mm, 0.0);
+  EXPECT_EQ(rig.snap().commands_rejected, 1u);
+}
+
+// Reference: the same law stepped by hand with the state the loop had, so "takes effect at the
+// boundary" means: the first cycle after the command uses the new parameters, whole.
+TEST(ScanCycle, TuningSwappedMidRunTakesEffectAtTheNextCycleWithTheStateCarriedOver) {
+  RuntimeConfig config;
+  config.start_mode = Mode::kRun;
+  config.start_setpoint_mm = 150.0;
+  Rig rig(config);
+  rig.daq.sensor_v = 2.0;
+  rig.cycles(10);
+
+  auto cfg = control::paper_controller_config(ControllerKind::kPpFfidz);
+  cfg.G = {-0.2, 0.6, -0.39};
+  Tuning swapped = *make_tuning(cfg);
+
+  // Replay the first 10 cycles by hand to get the state, then one with the new tuning.
+  control::ControllerState state;
+  state.rst.y_past.fill(2.0);
+  state.rst.r_past.fill(2.0);
+  const auto old_params = paper_tuning().ffidz;
+  for (int k = 0; k < 10; ++k) control::controller_step(old_params, state, 3.0, 2.0);
+  const auto expected = control::controller_step(swapped.ffidz, state, 3.0, 2.0);
+
+  rig.push(tuning_command(swapped));
+  rig.cycles(1);
+  EXPECT_DOUBLE_EQ(rig.snap().controller_v, expected.controller_v);
+  EXPECT_DOUBLE_EQ(rig.daq.last_written_v, expected.valve_v);
+  EXPECT_EQ(rig.snap().tuning.G[0], -0.2);
+}
+
+TEST(ScanCycle, ControllerSwitchIsBumplessTheHistoryCarriesOver) {
+  RuntimeConfig config;
+  config.start_mode = Mode::kRun;
+  config.start_setpoint_mm = 150.0;
+  Rig rig(config);
+  rig.cycles(20);
+  control::ControllerState state;
+  state.rst.y_past.fill(2.0);
+  state.rst.r_past.fill(2.0);
+  const auto t = paper_tuning();
+  for (int k = 0; k < 20; ++k) control::controller_step(t.ffidz, state, 3.0, 2.0);
+  const auto expected = control::controller_step(t.ngidz, state, 3.0, 2.0);
+  rig.push(controller_command(ControllerKind::kPpNgidz));
+  rig.cycles(1);
+  EXPECT_EQ(rig.snap().controller, ControllerKind::kPpNgidz);
+  EXPECT_DOUBLE_EQ(rig.snap().controller_v, expected.controller_v);  // not restarted from zero
+}
+
+TEST(ScanCycle, ShutDownPutsTheValveSafe) {
+  RuntimeConfig config;
+  config.start_mode = Mode::kRun;
+  config.start_setpoint_mm = 300.0;
+  Rig rig(config);
+  rig.cycles(5);
+  ASSERT_NE(rig.daq.last_written_v, 0.0);
+  rig.loop->shut_down();
+  EXPECT_EQ(rig.daq.last_written_v, 0.0);
+  EXPECT_EQ(rig.snap().mode, Mode::kStop);
+}
+
+TEST(ScanCycle, RunStopsWhenAskedAndLeavesTheValveSafe) {
+  RuntimeConfig config;
+  config.start_mode = Mode::kRun;
+  config.start_setpoint_mm = 300.0;
+  testing::FakeDaq daq;
+  VirtualClock clock;
+  LoopChannels ch(4000);
+  std::atomic<bool> stop{false};
+  struct StopAfter final : hal::Daq {  // stops the loop from inside after 100 reads
+    testing::FakeDaq& inner; std::atomic<bool>& stop; int reads = 0;
+    StopAfter(testing::FakeDaq& d, std::atomic<bool>& s) : inner(d), stop(s) {}
+    std::string describe() const override { return "stop-after"; }
+    core::Status open() override { return core::ok(); }
+    hal::SensorReading read_sensor() noexcept override { if (++reads == 100) stop = true; return inner.read_sensor(); }
+    hal::IoStatus write_valve(double v) noexcept override { return inner.write_valve(v); }
+    void close() noexcept override {}
+  } stopper(daq, stop);
+  ScanCycle loop2(config, paper_tuning(), stopper, clock, ch);
+  loop2.run(stop);
+  EXPECT_EQ(stopper.reads, 100);
+  EXPECT_EQ(daq.last_written_v, 0.0);
+  EXPECT_EQ(clock.now_ns(), 100 * kPeriodNs);  // absolute deadlines: exactly one period apart
+  EXPECT_EQ(loop2.last_snapshot().loop.overruns, 0u);
+}
+
+TEST(Recorder, WritesEachMoveAsAValidRunFile) {
+  const auto dir = std::filesystem::temp_directory_path() / ("epa_recorder_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  auto daq = *hal::SimDaq::make(core::paper::model(), {});
+  VirtualClock clock;
+  RuntimeConfig config;
+  config.start_mode = Mode::kRun;
+  config.start_setpoint_mm = 50.0;
+  config.move_window_s = 2.0;
+  LoopChannels ch(4000);
+  ScanCycle loop(config, paper_tuning(), daq, clock, ch);
+  Recorder recorder({.directory = dir.string(), .per_move = true, .Ts = 0.005, .source = "test"}, ch);
+  run_cycles(loop, clock, 450);
+  ASSERT_EQ(recorder.process_pending(), 1u);
+  auto run = core::read_run_file(recorder.last_file(), 0.005);
+  ASSERT_TRUE(run.has_value()) << run.error().message;
+  EXPECT_EQ(run->size(), 400u);  // the 2 s window
+  EXPECT_EQ(run->meta("controller"), "pp-ffidz");
+  EXPECT_EQ(run->meta("step_mm"), "50");
+  EXPECT_EQ(run->t_s.front(), 0.0);
+  EXPECT_EQ(run->r_mm.front(), 50.0);
+
+  ASSERT_TRUE(ch.commands.try_push(record_command(1.0)));
+  run_cycles(loop, clock, 1);
+  ASSERT_EQ(recorder.process_pending(), 1u);
+  auto requested = core::read_run_file(recorder.last_file(), 0.005);
+  ASSERT_TRUE(requested.has_value());
+  EXPECT_EQ(requested->size(), 200u);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace epa::runtime
