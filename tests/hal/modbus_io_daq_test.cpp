@@ -1,1 +1,511 @@
-// placeholder: being written
+// The modbus-io backend against a real RemoteIoSimulator over 127.0.0.1 (free ports, bounded
+// polling loops only), plus the register layout it shares with the simulator.
+#include "hal/modbus_io_daq.hpp"
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <modbus/modbus.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <thread>
+
+#include "core/paper_reference.hpp"
+#include "hal/remote_io_simulator.hpp"
+
+// Counts every operator new of this test binary (forwarding to malloc, so other tests are
+// unaffected) to prove that the cycle calls allocate nothing.
+namespace {
+std::atomic<std::size_t> g_allocations{0};
+}
+void* operator new(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace epa::hal {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
+constexpr double kCountV = kDefaultVoltsPerCount;  // one int16 count, V
+
+double elapsed_ms(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// Bounded polling: true as soon as done() holds, false after max_wait.
+template <typename F>
+bool poll_until(F done, std::chrono::milliseconds max_wait = 2000ms) {
+  const auto deadline = Clock::now() + max_wait;
+  while (Clock::now() < deadline) {
+    if (done()) return true;
+    std::this_thread::sleep_for(1ms);
+  }
+  return done();
+}
+
+RemoteIoSimulatorConfig sim_config(int port = 0, RemoteIoLayout layout = default_remote_io_layout()) {
+  RemoteIoSimulatorConfig c;
+  c.port = port;
+  c.layout = layout;
+  c.model = core::paper::model();
+  c.plant.initial_position_mm = 100.0;  // 2.0 V
+  return c;
+}
+
+std::unique_ptr<RemoteIoSimulator> start_sim(const RemoteIoSimulatorConfig& c) {
+  auto sim = RemoteIoSimulator::start(c);
+  EXPECT_TRUE(sim.has_value()) << sim.error().message;
+  return sim ? std::move(*sim) : nullptr;
+}
+
+ModbusIoConfig daq_config(int port, RemoteIoLayout layout = default_remote_io_layout()) {
+  ModbusIoConfig c;
+  c.port = port;
+  c.layout = layout;
+  c.response_timeout_ms = 250;  // functional tests: generous for a loaded CI machine; bound tests set their own
+  return c;
+}
+
+// ---- layout --------------------------------------------------------------------------------
+
+TEST(RemoteIoLayout, Int16RoundTripsWithinHalfACount) {
+  const AnalogPoint p = default_remote_io_layout().sensor;
+  for (double v : {-9.99, -2.0, 0.0, 1.234, 2.0, 5.0, 9.99}) {
+    const auto back = decode_volts(p, encode_volts(p, v));
+    ASSERT_TRUE(back.has_value());
+    EXPECT_NEAR(*back, v, kCountV / 2 + 1e-12) << v;
+  }
+}
+
+TEST(RemoteIoLayout, Int16RoundsToTheNearestCountAndAppliesTheOffset) {
+  AnalogPoint p{.volts_per_count = 0.5, .offset_v = 0.0};
+  EXPECT_EQ(encode_volts(p, 0.74)[0], 1);       // 1.48 counts
+  EXPECT_EQ(encode_volts(p, 0.76)[0], 2);       // 1.52 counts
+  EXPECT_EQ(encode_volts(p, -0.76)[0], 0xFFFE); // -2 counts, two's complement
+  p.offset_v = 1.0;
+  EXPECT_EQ(encode_volts(p, 2.0)[0], 2);        // (2 - 1) / 0.5
+  EXPECT_DOUBLE_EQ(*decode_volts(p, {0xFFFE, 0}), 0.0);  // -2 * 0.5 + 1
+}
+
+TEST(RemoteIoLayout, Int16ClampsAtFullScaleAndNeverWritesMinus32768) {
+  const AnalogPoint p = default_remote_io_layout().valve;
+  EXPECT_EQ(encode_volts(p, 10.0)[0], 0x7FFF);   // exactly full scale
+  EXPECT_EQ(encode_volts(p, 12.5)[0], 0x7FFF);   // clamped
+  EXPECT_EQ(encode_volts(p, -10.0)[0], 0x8001);  // -32767
+  EXPECT_EQ(encode_volts(p, -99.0)[0], 0x8001);  // clamped to -32767, not -32768
+  EXPECT_EQ(encode_volts(p, std::nan(""))[0], 0);  // non-finite: the centred valve
+  EXPECT_DOUBLE_EQ(*decode_volts(p, {0x7FFF, 0}), 10.0);
+  EXPECT_NEAR(*decode_volts(p, {0x8000, 0}), -32768 * kCountV, 1e-12);  // read as it comes
+}
+
+TEST(RemoteIoLayout, Float32FollowsTheWordOrderTestVectors) {
+  AnalogPoint p{.table = RegisterTable::kHolding, .encoding = AnalogEncoding::kFloat32};
+  p.word_order = core::WordOrder::kABCD;
+  EXPECT_EQ(encode_volts(p, 123456.0), (PointWords{0x47F1, 0x2000}));
+  EXPECT_DOUBLE_EQ(*decode_volts(p, {0x47F1, 0x2000}), 123456.0);
+  p.word_order = core::WordOrder::kCDAB;
+  EXPECT_EQ(encode_volts(p, 123456.0), (PointWords{0x2000, 0x47F1}));
+  EXPECT_DOUBLE_EQ(*decode_volts(p, {0x2000, 0x47F1}), 123456.0);
+  EXPECT_DOUBLE_EQ(*decode_volts(p, encode_volts(p, 2.5)), 2.5);
+  EXPECT_NEAR(*decode_volts(p, encode_volts(p, 1.234)), 1.234, 1e-6);  // float precision
+}
+
+TEST(RemoteIoLayout, DecodingANonFiniteFloatIsAnError) {
+  const AnalogPoint p{.encoding = AnalogEncoding::kFloat32, .word_order = core::WordOrder::kABCD};
+  EXPECT_FALSE(decode_volts(p, {0x7FC0, 0x0000}).has_value());  // NaN
+  EXPECT_FALSE(decode_volts(p, {0x7F80, 0x0000}).has_value());  // +inf
+  EXPECT_FALSE(decode_volts(p, {0xFF80, 0x0000}).has_value());  // -inf
+  EXPECT_EQ(encode_volts(p, std::nan("")), (PointWords{0, 0}));  // never NaN on the wire
+}
+
+TEST(RemoteIoLayout, DefaultIsValidInputAndHoldingRegisterZero) {
+  const RemoteIoLayout l = default_remote_io_layout();
+  EXPECT_TRUE(validate(l).has_value());
+  EXPECT_EQ(l.sensor.table, RegisterTable::kInput);
+  EXPECT_EQ(l.valve.table, RegisterTable::kHolding);
+  EXPECT_EQ(l.sensor.address, 0);
+  EXPECT_EQ(l.valve.address, 0);
+  EXPECT_DOUBLE_EQ(l.sensor.volts_per_count, 10.0 / 32767);
+}
+
+TEST(RemoteIoLayout, ValidateNamesTheField) {
+  struct Case {
+    const char* field;
+    void (*spoil)(RemoteIoLayout&);
+  };
+  const Case cases[] = {
+      {"sensor.address", [](RemoteIoLayout& l) { l.sensor.address = -1; }},
+      {"valve.address", [](RemoteIoLayout& l) { l.valve.address = 65536; }},
+      {"valve.address", [](RemoteIoLayout& l) { l.valve.encoding = AnalogEncoding::kFloat32, l.valve.address = 65535; }},
+      {"sensor.volts_per_count", [](RemoteIoLayout& l) { l.sensor.volts_per_count = 0.0; }},
+      {"valve.volts_per_count", [](RemoteIoLayout& l) { l.valve.volts_per_count = std::nan(""); }},
+      {"sensor.offset_v", [](RemoteIoLayout& l) { l.sensor.offset_v = INFINITY; }},
+      {"valve.table", [](RemoteIoLayout& l) { l.valve.table = RegisterTable::kInput, l.sensor.address = 5; }},
+      {"overlap", [](RemoteIoLayout& l) {  // float32 sensor in holding 0-1, valve in holding 1
+         l.sensor.table = RegisterTable::kHolding, l.sensor.encoding = AnalogEncoding::kFloat32, l.valve.address = 1;
+       }},
+  };
+  for (const Case& c : cases) {
+    RemoteIoLayout l = default_remote_io_layout();
+    c.spoil(l);
+    const auto s = validate(l);
+    ASSERT_FALSE(s.has_value()) << "expected an error naming " << c.field;
+    EXPECT_NE(s.error().message.find(c.field), std::string::npos) << s.error().message;
+  }
+  RemoteIoLayout adjacent = default_remote_io_layout();  // holding 0-1 and 2: no overlap
+  adjacent.sensor.table = RegisterTable::kHolding, adjacent.sensor.encoding = AnalogEncoding::kFloat32;
+  adjacent.valve.address = 2;
+  EXPECT_TRUE(validate(adjacent).has_value());
+}
+
+TEST(ModbusIoConfig, ValidateNamesTheField) {
+  struct Case {
+    const char* expected;
+    void (*spoil)(ModbusIoConfig&);
+  };
+  const Case cases[] = {
+      {"port 0", [](ModbusIoConfig& c) { c.port = 0; }},
+      {"unit id 248", [](ModbusIoConfig& c) { c.unit_id = 248; }},
+      {"response timeout 0 ms", [](ModbusIoConfig& c) { c.response_timeout_ms = 0; }},
+      {"host 'io-module.local'", [](ModbusIoConfig& c) { c.host = "io-module.local"; }},
+      {"valve.table", [](ModbusIoConfig& c) { c.layout.valve.table = RegisterTable::kInput, c.layout.valve.address = 4; }},
+  };
+  EXPECT_TRUE(validate(ModbusIoConfig{}).has_value());
+  for (const Case& c : cases) {
+    ModbusIoConfig config;
+    c.spoil(config);
+    const auto s = validate(config);
+    ASSERT_FALSE(s.has_value()) << "expected " << c.expected;
+    EXPECT_NE(s.error().message.find(c.expected), std::string::npos) << s.error().message;
+  }
+}
+
+// ---- the client against the simulator ----------------------------------------------------------
+
+TEST(ModbusIoDaq, OpenToAClosedPortFailsNamingHostAndPort) {
+  int port = 0;
+  {
+    auto sim = start_sim(sim_config());
+    ASSERT_NE(sim, nullptr);
+    port = sim->port();
+  }  // stopped: nothing listens there any more
+  ModbusIoDaq daq(daq_config(port));
+  const auto s = daq.open();
+  ASSERT_FALSE(s.has_value());
+  EXPECT_NE(s.error().message.find("127.0.0.1:" + std::to_string(port)), std::string::npos) << s.error().message;
+  EXPECT_NE(s.error().message.find("Connection refused"), std::string::npos) << s.error().message;
+  EXPECT_FALSE(daq.connected());
+  EXPECT_EQ(daq.read_sensor().status, IoStatus::kError);  // never opened: an error, not a crash
+}
+
+// libmodbus 3.1.6 connects on a non-blocking socket and waits for the handshake at most the
+// response timeout. A listener whose accept queue is full drops our SYN, so the handshake never
+// completes; open() must still come back within a few timeouts.
+TEST(ModbusIoDaq, OpenGivesUpWithinTheResponseTimeoutWhenNobodyCompletesTheHandshake) {
+  const int listener = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(bind(listener, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  ASSERT_EQ(listen(listener, 0), 0);
+  socklen_t len = sizeof addr;
+  ASSERT_EQ(getsockname(listener, reinterpret_cast<sockaddr*>(&addr), &len), 0);
+  std::vector<int> fillers;  // fill the accept queue until a connect stays pending
+  for (int i = 0; i < 8; ++i) {
+    const int fd = socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK, 0);
+    fillers.push_back(fd);
+    connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
+    pollfd p{fd, POLLOUT, 0};
+    if (poll(&p, 1, 20) == 0) break;  // this one is stuck: the queue is full
+  }
+  ModbusIoConfig c = daq_config(ntohs(addr.sin_port));
+  c.response_timeout_ms = 2;
+  ModbusIoDaq daq(c);
+  const auto t0 = Clock::now();
+  const auto s = daq.open();
+  const double took_ms = elapsed_ms(t0);
+  for (int fd : fillers) close(fd);
+  close(listener);
+  ASSERT_FALSE(s.has_value());
+  EXPECT_LT(took_ms, 100.0);
+  EXPECT_NE(s.error().message.find("no answer within 2 ms"), std::string::npos) << s.error().message;
+  RecordProperty("open_ms", std::to_string(took_ms));
+}
+
+TEST(ModbusIoDaq, ReadsTheSimulatedPositionInSensorVolts) {
+  auto sim = start_sim(sim_config());
+  ASSERT_NE(sim, nullptr);
+  ModbusIoDaq daq(daq_config(sim->port()));
+  ASSERT_TRUE(daq.open().has_value());
+  EXPECT_NE(daq.describe().find("127.0.0.1:" + std::to_string(sim->port())), std::string::npos) << daq.describe();
+  for (int k = 0; k < 10; ++k) {
+    const SensorReading r = daq.read_sensor();
+    ASSERT_EQ(r.status, IoStatus::kOk);
+    EXPECT_NEAR(r.sensor_v, 2.0, kCountV);  // 100 mm at 50 mm/V, within one count
+  }
+  EXPECT_EQ(daq.failed_requests(), 0u);
+}
+
+TEST(ModbusIoDaq, WritingThreeVoltsMovesTheSimulatedPistonUp) {
+  auto sim = start_sim(sim_config());
+  ASSERT_NE(sim, nullptr);
+  ModbusIoDaq daq(daq_config(sim->port()));
+  ASSERT_TRUE(daq.open().has_value());
+  ASSERT_EQ(daq.write_valve(3.0), IoStatus::kOk);
+  EXPECT_TRUE(poll_until([&] { return sim->position_mm() > 110.0; })) << sim->position_mm();
+  EXPECT_TRUE(poll_until([&] { auto r = daq.read_sensor(); return r.status == IoStatus::kOk && r.sensor_v > 2.2; }));
+
+  modbus_t* raw = modbus_new_tcp("127.0.0.1", sim->port());  // the register holds the scaled command
+  ASSERT_NE(raw, nullptr);
+  ASSERT_EQ(modbus_connect(raw), 0);
+  std::uint16_t reg = 0;
+  ASSERT_EQ(modbus_read_registers(raw, 0, 1, &reg), 1);
+  EXPECT_EQ(reg, static_cast<std::uint16_t>(std::lround(3.0 / kCountV)));
+  EXPECT_EQ(daq.write_valve(std::nan("")), IoStatus::kError);  // written as 0 V, reported
+  ASSERT_EQ(modbus_read_registers(raw, 0, 1, &reg), 1);
+  EXPECT_EQ(reg, 0);
+  modbus_close(raw);
+  modbus_free(raw);
+}
+
+TEST(ModbusIoDaq, FailsFastWhenTheModuleGoesAwayAndReconnectsWithinTheInterval) {
+  auto sim = start_sim(sim_config());
+  ASSERT_NE(sim, nullptr);
+  const int port = sim->port();
+  ModbusIoDaq daq(daq_config(port));
+  const int interval = daq.config().reconnect_interval_cycles;
+  ASSERT_EQ(interval, 200);
+  ASSERT_TRUE(daq.open().has_value());
+  ASSERT_EQ(daq.read_sensor().status, IoStatus::kOk);
+
+  sim->stop();
+  auto t0 = Clock::now();
+  const SensorReading lost = daq.read_sensor();
+  EXPECT_LT(elapsed_ms(t0), 100.0);
+  EXPECT_NE(lost.status, IoStatus::kOk);
+  EXPECT_EQ(daq.failed_requests(), 1u);
+  EXPECT_FALSE(daq.connected());
+  EXPECT_EQ(daq.write_valve(1.0), IoStatus::kError);  // no request while disconnected
+
+  t0 = Clock::now();  // three intervals of a dead module: one connect attempt per interval
+  for (int k = 0; k < 3 * interval; ++k) ASSERT_EQ(daq.read_sensor().status, IoStatus::kError);
+  EXPECT_EQ(daq.connect_attempts(), 3u);
+  EXPECT_LT(elapsed_ms(t0), 100.0);
+
+  sim = start_sim(sim_config(port));  // the module comes back on the same port
+  ASSERT_NE(sim, nullptr);
+  int calls = 0;
+  bool ok = false;
+  while (!ok && calls < 3 * interval) {
+    ++calls;
+    ok = daq.read_sensor().status == IoStatus::kOk;
+  }
+  EXPECT_TRUE(ok);
+  EXPECT_LE(calls, interval + 1);  // the reconnecting call itself does not read
+  EXPECT_EQ(daq.reconnects(), 1u);
+  EXPECT_EQ(daq.write_valve(0.0), IoStatus::kOk);
+}
+
+TEST(ModbusIoDaq, CycleCallsAllocateNothingConnectedLostOrReconnecting) {
+  auto sim = start_sim(sim_config());
+  ASSERT_NE(sim, nullptr);
+  const int port = sim->port();
+  ModbusIoConfig c = daq_config(port);
+  c.reconnect_interval_cycles = 10;
+  ModbusIoDaq daq(c);
+  ASSERT_TRUE(daq.open().has_value());
+  int ok = 0;
+  std::size_t before = g_allocations.load();
+  for (int k = 0; k < 100; ++k) {
+    ok += daq.read_sensor().status == IoStatus::kOk;
+    ok += daq.write_valve(0.5 * std::sin(0.1 * k)) == IoStatus::kOk;
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0u) << "connected";
+  EXPECT_EQ(ok, 200);
+  sim->stop();
+  before = g_allocations.load();
+  for (int k = 0; k < 50; ++k) {  // the loss, then a connect attempt every 10 calls to a closed port
+    daq.read_sensor();
+    daq.write_valve(0.0);
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0u) << "disconnected";
+  EXPECT_EQ(daq.connect_attempts(), 4u);  // calls 11, 21, 31, 41 after the loss
+  sim = start_sim(sim_config(port));
+  ASSERT_NE(sim, nullptr);
+  before = g_allocations.load();
+  ok = 0;
+  for (int k = 0; k < 20; ++k) ok += daq.read_sensor().status == IoStatus::kOk;
+  EXPECT_EQ(g_allocations.load() - before, 0u) << "reconnecting";
+  EXPECT_GE(ok, 9);  // reconnected within the interval of 10 cycles
+}
+
+// A module that answers open()'s first request and then stays silent: the next read must give
+// kTimeout after about the response timeout, not block.
+TEST(ModbusIoDaq, ReadReportsTimeoutWithinTheResponseTimeoutWhenTheModuleFallsSilent) {
+  modbus_t* server = modbus_new_tcp("127.0.0.1", 0);
+  ASSERT_NE(server, nullptr);
+  int listener = modbus_tcp_listen(server, 1);
+  ASSERT_GE(listener, 0);
+  sockaddr_in addr{};
+  socklen_t len = sizeof addr;
+  ASSERT_EQ(getsockname(listener, reinterpret_cast<sockaddr*>(&addr), &len), 0);
+  modbus_mapping_t* mapping = modbus_mapping_new(0, 0, 1, 1);
+  std::atomic<bool> stop{false};
+  std::thread silent([&] {
+    for (pollfd p{listener, POLLIN, 0}; poll(&p, 1, 20) <= 0;)
+      if (stop.load()) return;
+    if (modbus_tcp_accept(server, &listener) < 0) return;
+    std::uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
+    for (int answered = 0; !stop.load();) {
+      pollfd p{modbus_get_socket(server), POLLIN, 0};
+      if (poll(&p, 1, 20) <= 0) continue;
+      const int n = modbus_receive(server, query);
+      if (n < 0) break;
+      if (answered++ == 0) modbus_reply(server, query, n, mapping);
+    }
+  });
+  ModbusIoConfig c = daq_config(ntohs(addr.sin_port));
+  c.response_timeout_ms = 50;  // not 2 ms: open()'s first answer needs this test's thread to wake up
+  ModbusIoDaq daq(c);
+  const auto opened = daq.open();
+  const auto t0 = Clock::now();
+  const SensorReading r = opened ? daq.read_sensor() : SensorReading{};
+  const double took_ms = elapsed_ms(t0);
+  stop.store(true);
+  silent.join();
+  modbus_close(server);
+  close(listener);
+  modbus_mapping_free(mapping);
+  modbus_free(server);
+  ASSERT_TRUE(opened.has_value()) << opened.error().message;
+  EXPECT_EQ(r.status, IoStatus::kTimeout);
+  EXPECT_GE(took_ms, 49.0);
+  EXPECT_LT(took_ms, 150.0);
+  EXPECT_EQ(daq.failed_requests(), 1u);
+  RecordProperty("timeout_read_ms", std::to_string(took_ms));
+}
+
+TEST(ModbusIoDaq, ASecondClientIsServedAtTheSameTime) {
+  auto sim = start_sim(sim_config());
+  ASSERT_NE(sim, nullptr);
+  ModbusIoDaq first(daq_config(sim->port())), second(daq_config(sim->port()));
+  ASSERT_TRUE(first.open().has_value());
+  ASSERT_TRUE(second.open().has_value());
+  EXPECT_EQ(sim->clients(), 2);
+  for (int k = 0; k < 20; ++k) {
+    EXPECT_EQ(first.read_sensor().status, IoStatus::kOk);
+    const SensorReading r = second.read_sensor();
+    EXPECT_EQ(r.status, IoStatus::kOk);
+    EXPECT_NEAR(r.sensor_v, 2.0, kCountV);
+  }
+}
+
+TEST(ModbusIoDaq, AnotherUnitIdGetsGatewayTargetException) {
+  auto sim = start_sim(sim_config());
+  ASSERT_NE(sim, nullptr);
+  modbus_t* raw = modbus_new_tcp("127.0.0.1", sim->port());
+  ASSERT_NE(raw, nullptr);
+  ASSERT_EQ(modbus_connect(raw), 0);
+  modbus_set_response_timeout(raw, 0, 500'000);
+  std::uint16_t reg = 0;
+  EXPECT_EQ(modbus_read_input_registers(raw, 0, 1, &reg), 1);  // libmodbus' default unit 0xFF: served
+  modbus_set_slave(raw, 7);
+  EXPECT_EQ(modbus_read_input_registers(raw, 0, 1, &reg), -1);
+  EXPECT_EQ(errno, EMBXGTAR);
+  modbus_set_slave(raw, 1);  // same connection, right unit: answered
+  EXPECT_EQ(modbus_read_input_registers(raw, 0, 1, &reg), 1);
+  EXPECT_EQ(reg, static_cast<std::uint16_t>(std::lround(2.0 / kCountV)));
+  modbus_close(raw);
+  modbus_free(raw);
+
+  ModbusIoConfig c = daq_config(sim->port());
+  c.unit_id = 7;
+  ModbusIoDaq daq(c);
+  const auto s = daq.open();  // open() reads once, so the wrong unit id shows here
+  ASSERT_FALSE(s.has_value());
+  EXPECT_NE(s.error().message.find("(unit 7)"), std::string::npos) << s.error().message;
+  EXPECT_NE(s.error().message.find("Target device failed to respond"), std::string::npos) << s.error().message;
+}
+
+TEST(ModbusIoDaq, OpenNamesAnAddressTheModuleDoesNotHave) {
+  auto sim = start_sim(sim_config());
+  ASSERT_NE(sim, nullptr);
+  RemoteIoLayout wrong = default_remote_io_layout();
+  wrong.sensor.address = 8;
+  ModbusIoDaq daq(daq_config(sim->port(), wrong));
+  const auto s = daq.open();
+  ASSERT_FALSE(s.has_value());
+  EXPECT_NE(s.error().message.find("input register 8"), std::string::npos) << s.error().message;
+  EXPECT_NE(s.error().message.find("Illegal data address"), std::string::npos) << s.error().message;
+}
+
+TEST(ModbusIoDaq, Float32LayoutWorksEndToEnd) {
+  RemoteIoLayout layout;
+  layout.sensor = {.table = RegisterTable::kInput, .address = 10, .encoding = AnalogEncoding::kFloat32,
+                   .word_order = core::WordOrder::kCDAB};
+  layout.valve = {.table = RegisterTable::kHolding, .address = 20, .encoding = AnalogEncoding::kFloat32,
+                  .word_order = core::WordOrder::kCDAB};
+  auto sim = start_sim(sim_config(0, layout));
+  ASSERT_NE(sim, nullptr);
+  ModbusIoDaq daq(daq_config(sim->port(), layout));
+  ASSERT_TRUE(daq.open().has_value());
+  const SensorReading r = daq.read_sensor();
+  ASSERT_EQ(r.status, IoStatus::kOk);
+  EXPECT_NEAR(r.sensor_v, 2.0, 1e-6);
+  ASSERT_EQ(daq.write_valve(-3.0), IoStatus::kOk);
+  EXPECT_TRUE(poll_until([&] { return sim->position_mm() < 90.0; })) << sim->position_mm();
+}
+
+TEST(RemoteIoSimulator, SurvivesAGarbageClientAndRefusesABusyPort) {
+  auto sim = start_sim(sim_config());
+  ASSERT_NE(sim, nullptr);
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(sim->port()));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  const char garbage[] = "GET / HTTP/1.0\r\n\r\n\xff\xff\xff\xff\xff\xff\xff\xff";
+  ASSERT_GT(send(fd, garbage, sizeof garbage, MSG_NOSIGNAL), 0);
+  close(fd);
+  EXPECT_TRUE(poll_until([&] { return sim->clients() == 0; }));
+  ModbusIoDaq daq(daq_config(sim->port()));
+  ASSERT_TRUE(daq.open().has_value());
+  EXPECT_EQ(daq.read_sensor().status, IoStatus::kOk);
+
+  auto second = RemoteIoSimulator::start(sim_config(sim->port()));
+  ASSERT_FALSE(second.has_value());
+  const std::string& message = second.error().message;
+  EXPECT_NE(message.find(":" + std::to_string(sim->port())), std::string::npos) << message;
+  EXPECT_NE(message.find("in use"), std::string::npos) << message;
+}
+
+TEST(RemoteIoSimulator, StepsInRealTimeAndStopsPromptly) {
+  auto sim = start_sim(sim_config());
+  ASSERT_NE(sim, nullptr);
+  const auto t0 = Clock::now();
+  ASSERT_TRUE(poll_until([&] { return sim->steps() >= 40; }));
+  const double took_ms = elapsed_ms(t0);
+  EXPECT_GE(took_ms, 40 * 5.0 - 5.0);  // not faster than Ts = 5 ms per step
+  const auto t1 = Clock::now();
+  sim->stop();
+  EXPECT_LT(elapsed_ms(t1), 200.0);
+  const auto steps = sim->steps();
+  sim->stop();  // idempotent
+  EXPECT_EQ(sim->steps(), steps);
+  EXPECT_DOUBLE_EQ(sim->position_mm(), 100.0);  // valve at 0 V: at rest
+}
+
+}  // namespace
+}  // namespace epa::hal

@@ -1,0 +1,262 @@
+#include "app/appliance_config.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+namespace epa::app {
+
+namespace {
+
+// Reads one TOML table: typed getters that remember which keys were used, and a final check
+// that refuses keys nobody asked for. The first error wins; later calls are no-ops.
+class TableReader {
+ public:
+  TableReader(const toml::table* table, std::string name, const std::string& file, std::optional<core::Error>& error)
+      : table_(table), name_(std::move(name)), file_(file), error_(error) {}
+
+  void number(const char* key, double& out, std::function<bool(double)> ok = {}, const char* expected = "") {
+    const toml::node* n = find(key);
+    if (!n) return;
+    const auto v = n->value<double>();
+    if (!v || !std::isfinite(*v)) return fail(*n, key, "must be a number");
+    if (ok && !ok(*v)) return fail(*n, key, std::string("must be ") + expected);
+    out = *v;
+  }
+  void integer(const char* key, int& out, long lo, long hi) {
+    const toml::node* n = find(key);
+    if (!n) return;
+    const auto v = n->value<std::int64_t>();
+    if (!v || !n->is_integer()) return fail(*n, key, "must be a whole number");
+    if (*v < lo || *v > hi) return fail(*n, key, "must be within " + std::to_string(lo) + ".." + std::to_string(hi));
+    out = static_cast<int>(*v);
+  }
+  void boolean(const char* key, bool& out) {
+    const toml::node* n = find(key);
+    if (!n) return;
+    if (!n->is_boolean()) return fail(*n, key, "must be true or false");
+    out = *n->value<bool>();
+  }
+  void text(const char* key, std::string& out) {
+    const toml::node* n = find(key);
+    if (!n) return;
+    if (!n->is_string()) return fail(*n, key, "must be a string");
+    out = *n->value<std::string>();
+  }
+  // A string that must parse into T; the parser's message says what was expected.
+  template <typename T>
+  void choice(const char* key, T& out, std::function<core::Result<T>(std::string_view)> parse) {
+    const toml::node* n = find(key);
+    if (!n) return;
+    if (!n->is_string()) return fail(*n, key, "must be a string");
+    auto r = parse(*n->value<std::string>());
+    if (!r) return fail(*n, key, r.error().message);
+    out = *r;
+  }
+  const toml::table* subtable(const char* key) {
+    used_.insert(key);
+    return table_ ? (*table_)[key].as_table() : nullptr;
+  }
+  void refuse_unknown_keys() {
+    if (!table_ || error_) return;
+    for (const auto& [k, node] : *table_) {
+      if (!used_.count(std::string(k.str())))
+        return fail(node, std::string(k.str()).c_str(), "is not a known setting (check the spelling against config/epa.toml)");
+    }
+  }
+  std::string key_path(const char* key) const { return name_.empty() ? key : name_ + "." + key; }
+
+ private:
+  const toml::node* find(const char* key) {
+    used_.insert(key);
+    if (error_ || !table_) return nullptr;
+    return table_->get(key);
+  }
+  void fail(const toml::node& n, const char* key, const std::string& why) {
+    if (error_) return;
+    error_ = core::parse_error(file_ + ":" + std::to_string(n.source().begin.line) + ": " + key_path(key) + " " + why);
+  }
+
+  const toml::table* table_;
+  std::string name_;
+  const std::string& file_;
+  std::optional<core::Error>& error_;
+  std::set<std::string> used_;
+};
+
+const auto kPositive = [](double v) { return v > 0.0; };
+const auto kNonNegative = [](double v) { return v >= 0.0; };
+
+core::Result<HalBackend> parse_backend(std::string_view s) {
+  if (s == "sim") return HalBackend::kSim;
+  if (s == "modbus-io") return HalBackend::kModbusIo;
+  if (s == "comedi") return HalBackend::kComedi;
+  return core::invalid_argument("'" + std::string(s) + "' is not one of sim, modbus-io, comedi");
+}
+
+core::Result<hal::RegisterTable> parse_table(std::string_view s) {
+  if (s == "input") return hal::RegisterTable::kInput;
+  if (s == "holding") return hal::RegisterTable::kHolding;
+  return core::invalid_argument("'" + std::string(s) + "' is not one of input, holding");
+}
+
+core::Result<hal::AnalogEncoding> parse_encoding(std::string_view s) {
+  if (s == "int16") return hal::AnalogEncoding::kInt16;
+  if (s == "float32") return hal::AnalogEncoding::kFloat32;
+  return core::invalid_argument("'" + std::string(s) + "' is not one of int16, float32");
+}
+
+core::Result<hal::AnalogReference> parse_aref(std::string_view s) {
+  if (s == "ground") return hal::AnalogReference::kGround;
+  if (s == "common") return hal::AnalogReference::kCommon;
+  if (s == "diff") return hal::AnalogReference::kDiff;
+  if (s == "other") return hal::AnalogReference::kOther;
+  return core::invalid_argument("'" + std::string(s) + "' is not one of ground, common, diff, other");
+}
+
+void read_analog_point(TableReader& parent, const char* key, hal::AnalogPoint& p, const std::string& file,
+                       std::optional<core::Error>& error) {
+  TableReader t(parent.subtable(key), parent.key_path(key), file, error);
+  t.choice<hal::RegisterTable>("table", p.table, parse_table);
+  t.integer("address", p.address, 0, hal::kMaxRegisterAddress);
+  t.choice<hal::AnalogEncoding>("encoding", p.encoding, parse_encoding);
+  t.choice<core::WordOrder>("word_order", p.word_order, core::parse_word_order);
+  double full_scale_v = p.volts_per_count * hal::kInt16FullScaleCounts;
+  t.number("full_scale_v", full_scale_v, kPositive, "> 0 V");
+  p.volts_per_count = full_scale_v / hal::kInt16FullScaleCounts;
+  t.number("offset_v", p.offset_v);
+  t.refuse_unknown_keys();
+}
+
+void read_comedi_channel(TableReader& parent, const char* key, hal::ComediChannel& c, const std::string& file,
+                         std::optional<core::Error>& error) {
+  TableReader t(parent.subtable(key), parent.key_path(key), file, error);
+  t.integer("subdevice", c.subdevice, -1, 255);
+  t.integer("channel", c.channel, 0, 4095);
+  t.number("range_min_v", c.range_min_v);
+  t.number("range_max_v", c.range_max_v);
+  t.choice<hal::AnalogReference>("aref", c.aref, parse_aref);
+  t.refuse_unknown_keys();
+}
+
+}  // namespace
+
+const char* to_string(HalBackend b) {
+  switch (b) {
+    case HalBackend::kSim: return "sim";
+    case HalBackend::kModbusIo: return "modbus-io";
+    case HalBackend::kComedi: return "comedi";
+  }
+  return "?";
+}
+
+core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, const std::string& file) {
+  toml::table root;
+  try {
+    root = toml::parse(text, file);
+  } catch (const toml::parse_error& e) {
+    return core::parse_error(file + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()));
+  }
+  ApplianceConfig c;
+  auto& r = c.runtime;
+  std::optional<core::Error> error;
+  TableReader top(&root, "", file, error);
+
+  TableReader loop(top.subtable("loop"), "loop", file, error);
+  loop.number("period_s", r.period_s, kPositive, "> 0 s");
+  loop.integer("realtime_priority", c.realtime_priority, 0, 99);
+  loop.boolean("lock_memory", c.lock_memory);
+  loop.integer("max_consecutive_overruns", r.max_consecutive_overruns, 1, 1000000);
+  loop.refuse_unknown_keys();
+
+  TableReader ctl(top.subtable("controller"), "controller", file, error);
+  ctl.choice<control::ControllerKind>("kind", r.controller, control::parse_controller_kind);
+  ctl.text("model", c.model_path);
+  ctl.text("design", c.design_path);
+  ctl.number("lc_mm", c.lc_mm, kNonNegative, ">= 0 mm");
+  ctl.number("valve_limit_v", c.valve_limit_v, [](double v) { return v > 0.0 && v <= 10.0; }, "within (0, 10] V");
+  ctl.refuse_unknown_keys();
+
+  TableReader lim(top.subtable("limits"), "limits", file, error);
+  lim.number("sensor_min_v", r.sensor_min_v);
+  lim.number("sensor_max_v", r.sensor_max_v);
+  lim.number("soft_min_mm", r.soft_min_mm);
+  lim.number("soft_max_mm", r.soft_max_mm);
+  lim.number("setpoint_min_mm", r.setpoint_min_mm);
+  lim.number("setpoint_max_mm", r.setpoint_max_mm);
+  lim.number("manual_valve_limit_v", r.manual_valve_limit_v, kPositive, "> 0 V");
+  lim.number("safe_valve_v", r.safe_valve_v);
+  lim.number("following_error_mm", r.following_error_mm, kPositive, "> 0 mm");
+  lim.number("following_error_time_s", r.following_error_time_s, kNonNegative, ">= 0 s (0: off)");
+  lim.integer("max_consecutive_io_errors", r.max_consecutive_io_errors, 1, 1000000);
+  lim.number("heartbeat_timeout_s", r.heartbeat_timeout_s, kNonNegative, ">= 0 s (0: off)");
+  lim.refuse_unknown_keys();
+
+  TableReader cal(top.subtable("calibration"), "calibration", file, error);
+  cal.number("sensor_offset_v", r.sensor_offset_v);
+  cal.number("sensor_gain", r.sensor_gain, kPositive, "> 0");
+  cal.refuse_unknown_keys();
+
+  TableReader start(top.subtable("startup"), "startup", file, error);
+  start.choice<runtime::Mode>("mode", r.start_mode, runtime::parse_mode);
+  start.number("setpoint_mm", r.start_setpoint_mm);
+  start.refuse_unknown_keys();
+
+  TableReader rec(top.subtable("recorder"), "recorder", file, error);
+  rec.text("directory", c.record_directory);
+  rec.boolean("per_move", c.record_per_move);
+  rec.number("buffer_s", r.record_buffer_s, kPositive, "> 0 s");
+  rec.number("move_window_s", r.move_window_s, kPositive, "> 0 s");
+  rec.refuse_unknown_keys();
+
+  TableReader log(top.subtable("log"), "log", file, error);
+  log.number("status_interval_s", c.status_interval_s, kNonNegative, ">= 0 s (0: off)");
+  log.refuse_unknown_keys();
+
+  TableReader hal_table(top.subtable("hal"), "hal", file, error);
+  hal_table.choice<HalBackend>("backend", c.backend, parse_backend);
+  TableReader sim(hal_table.subtable("sim"), "hal.sim", file, error);
+  sim.number("initial_position_mm", c.sim.initial_position_mm);
+  sim.number("noise_mm", c.sim.noise_std_mm, kNonNegative, ">= 0 mm");
+  int seed = static_cast<int>(c.sim.seed);
+  sim.integer("seed", seed, 0, 2147483647);
+  c.sim.seed = static_cast<std::uint64_t>(seed);
+  sim.refuse_unknown_keys();
+  TableReader mb(hal_table.subtable("modbus_io"), "hal.modbus_io", file, error);
+  mb.text("host", c.modbus_io.host);
+  mb.integer("port", c.modbus_io.port, 1, 65535);
+  mb.integer("unit_id", c.modbus_io.unit_id, 0, 247);
+  mb.integer("response_timeout_ms", c.modbus_io.response_timeout_ms, 1, 1000);
+  read_analog_point(mb, "sensor", c.modbus_io.layout.sensor, file, error);
+  read_analog_point(mb, "valve", c.modbus_io.layout.valve, file, error);
+  mb.refuse_unknown_keys();
+  TableReader cm(hal_table.subtable("comedi"), "hal.comedi", file, error);
+  cm.text("device", c.comedi.device);
+  read_comedi_channel(cm, "sensor", c.comedi.sensor, file, error);
+  read_comedi_channel(cm, "valve", c.comedi.valve, file, error);
+  cm.refuse_unknown_keys();
+  hal_table.refuse_unknown_keys();
+  top.refuse_unknown_keys();
+  if (error) return *error;
+
+  // Cross-field rules, in the runtime's and backends' own validators.
+  if (auto s = runtime::validate(r); !s) return core::invalid_argument(file + ": " + s.error().message);
+  if (c.backend == HalBackend::kModbusIo)
+    if (auto s = hal::validate(c.modbus_io); !s) return core::invalid_argument(file + ": [hal.modbus_io] " + s.error().message);
+  if (c.backend == HalBackend::kComedi)
+    if (auto s = hal::validate(c.comedi); !s) return core::invalid_argument(file + ": [hal.comedi] " + s.error().message);
+  return c;
+}
+
+core::Result<ApplianceConfig> read_appliance_config(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return core::io_error(path + ": cannot open the configuration file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_appliance_config(ss.str(), path);
+}
+
+}  // namespace epa::app

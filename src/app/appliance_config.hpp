@@ -1,0 +1,42 @@
+#pragma once
+// config/epa.toml (epa-config/1): everything `epa serve` needs, read into the runtime's and the
+// backends' own config structs. Every key is optional (defaults as in config/epa.toml), every
+// value is type- and range-checked, and unknown keys are refused; messages name the file, the
+// line and the key.
+#include <string>
+
+#include "hal/comedi_daq.hpp"
+#include "hal/modbus_io_daq.hpp"
+#include "plant/hammerstein_plant.hpp"
+#include "runtime/recorder.hpp"
+#include "runtime/runtime_config.hpp"
+
+namespace epa::app {
+
+enum class HalBackend { kSim, kModbusIo, kComedi };
+
+struct ApplianceConfig {
+  runtime::RuntimeConfig runtime;
+  int realtime_priority = 80;
+  bool lock_memory = true;
+
+  std::string model_path;   // "": the paper's model
+  std::string design_path;  // "": the paper's F, G
+  double lc_mm = 5.0;
+  double valve_limit_v = 5.0;
+
+  std::string record_directory = "runs";
+  bool record_per_move = true;
+  double status_interval_s = 10.0;
+
+  HalBackend backend = HalBackend::kSim;
+  plant::PlantOptions sim;
+  hal::ModbusIoConfig modbus_io;
+  hal::ComediConfig comedi;
+};
+
+core::Result<ApplianceConfig> parse_appliance_config(const std::string& toml_text, const std::string& source_name);
+core::Result<ApplianceConfig> read_appliance_config(const std::string& path);
+const char* to_string(HalBackend backend);
+
+}  // namespace epa::app

@@ -1,0 +1,106 @@
+#include "app/plant_server_command.hpp"
+
+#include <pthread.h>
+#include <signal.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <ostream>
+
+#include "app/tuning_source.hpp"
+#include "hal/remote_io_simulator.hpp"
+
+namespace epa::app {
+
+void add_plant_server_command(CLI::App& app, PlantServerOptions& o) {
+  auto* cmd = app.add_subcommand(
+      "plant-server", "Run a plant model in real time behind a Modbus TCP server that looks like a remote analog I/O "
+                      "module (sensor: input register 0, valve: holding register 0, int16, +-10 V = +-32767)");
+  cmd->add_option("--address", o.address, "IPv4 address to listen on (0.0.0.0: all)")->capture_default_str();
+  cmd->add_option("--port", o.port, "TCP port (0: any free port)")->capture_default_str()->check(CLI::Range(0, 65535));
+  cmd->add_option("--unit-id", o.unit_id, "Modbus unit id served (0xFF is always accepted)")
+      ->capture_default_str()->check(CLI::Range(0, 247));
+  cmd->add_option("--model", o.model_path, "Model file (epa-model/1 TOML); default: the paper's eq 9-10")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--initial-position", o.initial_position_mm, "Piston position at start, mm")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--noise", o.noise_mm, "Sensor noise standard deviation, mm")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--seed", o.seed, "Seed of the sensor noise")->capture_default_str();
+  cmd->add_option("--Ts", o.Ts, "Real-time step period, s (default: the model's, 0.005 for the paper)")
+      ->check(CLI::PositiveNumber);
+}
+
+namespace {
+
+std::string format_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+// Blocks SIGINT and SIGTERM for as long as it lives, so that sigwait() receives them and the
+// threads started meanwhile inherit the block; restores the caller's mask afterwards.
+class BlockedStopSignals {
+ public:
+  BlockedStopSignals() {
+    sigemptyset(&set_);
+    sigaddset(&set_, SIGINT);
+    sigaddset(&set_, SIGTERM);
+    ok_ = pthread_sigmask(SIG_BLOCK, &set_, &old_) == 0;
+  }
+  ~BlockedStopSignals() {
+    if (ok_) pthread_sigmask(SIG_SETMASK, &old_, nullptr);
+  }
+  BlockedStopSignals(const BlockedStopSignals&) = delete;
+  BlockedStopSignals& operator=(const BlockedStopSignals&) = delete;
+
+  bool ok() const { return ok_; }
+  int wait() const {
+    int signal_number = 0;
+    while (sigwait(&set_, &signal_number) != 0) {
+    }
+    return signal_number;
+  }
+
+ private:
+  sigset_t set_{}, old_{};
+  bool ok_ = false;
+};
+
+}  // namespace
+
+int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostream& err) {
+  auto model_file = load_model(o.model_path);
+  if (!model_file) return err << "epa plant-server: " << model_file.error().message << "\n", 1;
+  hal::RemoteIoSimulatorConfig config;
+  config.address = o.address;
+  config.port = o.port;
+  config.unit_id = o.unit_id;
+  config.model = model_file->model;
+  if (o.Ts > 0.0) config.model.Ts = o.Ts;
+  config.plant.initial_position_mm = o.initial_position_mm;
+  config.plant.noise_std_mm = o.noise_mm;
+  config.plant.seed = o.seed;
+
+  BlockedStopSignals signals;  // before start(): the simulator's threads must not take the signals
+  if (!signals.ok()) return err << "epa plant-server: cannot block SIGINT/SIGTERM: " << std::strerror(errno) << "\n", 1;
+  auto sim = hal::RemoteIoSimulator::start(config);
+  if (!sim) return err << "epa plant-server: " << sim.error().message << "\n", 1;
+
+  out << "plant-server listening on " << o.address << ":" << (*sim)->port() << " (unit " << o.unit_id << ", Ts "
+      << format_number(config.model.Ts) << " s)" << std::endl;
+  out << "model: " << (o.model_path.empty() ? std::string("paper eq 9-10") : o.model_path) << "; initial position "
+      << format_number(o.initial_position_mm) << " mm; sensor noise " << format_number(o.noise_mm)
+      << " mm; stop with SIGINT or SIGTERM" << std::endl;
+
+  const int signal_number = signals.wait();
+  (*sim)->stop();
+  out << "plant-server stopped by " << (signal_number == SIGINT ? "SIGINT" : "SIGTERM") << " after "
+      << (*sim)->steps() << " steps (" << (*sim)->requests() << " requests, " << (*sim)->overruns()
+      << " overruns); final position " << format_number((*sim)->position_mm()) << " mm" << std::endl;
+  return 0;
+}
+
+}  // namespace epa::app

@@ -1,0 +1,34 @@
+#pragma once
+// `epa plant-server`: the paper's plant (or any epa-model/1 model) stepped in real time behind a
+// Modbus TCP server that looks like a remote analog I/O module (hal::RemoteIoSimulator, default
+// register layout: sensor in input register 0, valve in holding register 0, int16, ±10 V =
+// ±32767). For hardware-in-the-loop tests of `epa serve` with the modbus-io backend. Runs until
+// SIGINT or SIGTERM.
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+namespace epa::app {
+
+struct PlantServerOptions {
+  std::string address = "127.0.0.1";
+  int port = 1502;               // 0: a free port, printed in the "listening" line
+  int unit_id = 1;
+  std::string model_path;        // empty: the paper's model
+  double initial_position_mm = 0.0;
+  double noise_mm = 0.0;
+  std::uint64_t seed = 1;
+  double Ts = 0.0;               // 0: the model's own
+};
+
+void add_plant_server_command(CLI::App& app, PlantServerOptions& options);
+
+// Blocks SIGINT and SIGTERM in the calling thread (and so in the simulator's threads) and waits
+// for one of them; restores the signal mask before returning. Prints
+// "plant-server listening on ADDRESS:PORT (unit N, Ts T s)" on `out` once clients can connect,
+// and the final position on exit. Returns 0 after a signal, 1 on bad input or when the port
+// cannot be bound (said on `err`).
+int run_plant_server(const PlantServerOptions& options, std::ostream& out, std::ostream& err);
+
+}  // namespace epa::app

@@ -1,0 +1,70 @@
+#pragma once
+// A stand-in for a remote analog I/O module with the plant behind it: a Modbus TCP server
+// (libmodbus) whose registers follow a RemoteIoLayout, and a plant thread that steps the paper's
+// Hammerstein plant in real time. `epa plant-server` runs it in its own process; the modbus-io
+// tests run it in-process on a free port.
+//
+// Plant thread, every Ts (absolute deadlines, clock_nanosleep TIMER_ABSTIME on CLOCK_MONOTONIC):
+// decode the valve register(s) (an undecodable value counts as 0 V, the centred valve), step the
+// plant, encode its measured sensor volts into the sensor register(s). When it falls more than
+// 10 periods behind (a suspended process) it starts a fresh schedule instead of catching up in a
+// burst, and counts an overrun.
+//
+// Server thread: select() over the listening socket and up to kMaxClients clients, waking at
+// least every 50 ms so that stop() returns promptly; libmodbus' modbus_receive/modbus_reply do the
+// protocol (modbus_reply also answers illegal addresses and functions with exceptions). Requests
+// for the configured unit id or for 0xFF (Modbus TCP's "no unit id") are served; any other unit
+// id gets exception 0x0B (gateway target device failed to respond) rather than silence, so that
+// a misconfigured client gets a clear error at once instead of a timeout. A client that
+// disconnects, sends garbage or stalls mid-frame for more than 100 ms is dropped; the server
+// carries on. The register mapping is shared under a std::mutex: this is a test tool, not the
+// real-time loop.
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "core/hammerstein_model.hpp"
+#include "core/result.hpp"
+#include "hal/remote_io_layout.hpp"
+#include "plant/hammerstein_plant.hpp"
+
+namespace epa::hal {
+
+struct RemoteIoSimulatorConfig {
+  std::string address = "127.0.0.1";  // IPv4 address to listen on; "0.0.0.0" for all
+  int port = 1502;                    // 0: pick a free port (see RemoteIoSimulator::port())
+  int unit_id = 1;                    // 0..247; others (except 0xFF) get exception 0x0B
+  RemoteIoLayout layout = default_remote_io_layout();
+  core::HammersteinModel model;       // its Ts is the real-time step period
+  plant::PlantOptions plant;
+};
+
+class RemoteIoSimulator {
+ public:
+  static constexpr int kMaxClients = 16;
+
+  // Validates, binds and listens, then starts the server and plant threads. Errors name the
+  // field, or the address:port and the system's reason when binding fails (e.g. in use).
+  static core::Result<std::unique_ptr<RemoteIoSimulator>> start(const RemoteIoSimulatorConfig& config);
+  ~RemoteIoSimulator();  // stop()
+  RemoteIoSimulator(const RemoteIoSimulator&) = delete;
+  RemoteIoSimulator& operator=(const RemoteIoSimulator&) = delete;
+
+  int port() const;               // the bound port (the real one when configured as 0)
+  double position_mm() const;     // true piston position, for tests and logs
+  std::uint64_t steps() const;    // plant steps done
+  std::uint64_t overruns() const; // times the plant thread gave up catching up (see above)
+  std::uint64_t requests() const; // Modbus requests answered (including exceptions)
+  int clients() const;            // clients connected now
+
+  // Stops both threads and closes every socket; idempotent. Returns within 50 ms + Ts, or 150 ms
+  // + Ts while a client stalls mid-frame.
+  void stop();
+
+ private:
+  struct Impl;
+  explicit RemoteIoSimulator(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace epa::hal

@@ -1,0 +1,72 @@
+#include "app/appliance_config.hpp"
+
+#include <gtest/gtest.h>
+
+namespace epa::app {
+namespace {
+
+const std::string kShipped = std::string(EPA_SOURCE_DIR) + "/config/epa.toml";
+
+std::string error_of(const std::string& text) {
+  auto c = parse_appliance_config(text, "test.toml");
+  return c.has_value() ? "(accepted)" : c.error().message;
+}
+
+TEST(ApplianceConfig, ShippedFileParsesToTheDocumentedDefaults) {
+  auto c = read_appliance_config(kShipped);
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  const runtime::RuntimeConfig defaults;
+  EXPECT_EQ(c->runtime.period_s, defaults.period_s);
+  EXPECT_EQ(c->runtime.sensor_min_v, defaults.sensor_min_v);
+  EXPECT_EQ(c->runtime.soft_max_mm, defaults.soft_max_mm);
+  EXPECT_EQ(c->runtime.following_error_time_s, defaults.following_error_time_s);
+  EXPECT_EQ(c->runtime.move_window_s, defaults.move_window_s);
+  EXPECT_EQ(c->runtime.controller, control::ControllerKind::kPpFfidz);
+  EXPECT_EQ(c->runtime.start_mode, runtime::Mode::kStop);
+  EXPECT_EQ(c->backend, HalBackend::kSim);
+  EXPECT_EQ(c->modbus_io.port, 1502);
+  EXPECT_DOUBLE_EQ(c->modbus_io.layout.sensor.volts_per_count, hal::default_remote_io_layout().sensor.volts_per_count);
+  EXPECT_EQ(c->comedi.device, "/dev/comedi0");
+}
+
+TEST(ApplianceConfig, EmptyFileGivesTheDefaults) {
+  auto c = parse_appliance_config("", "empty.toml");
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->runtime.period_s, 0.005);
+}
+
+TEST(ApplianceConfig, UnknownKeyIsRefusedWithFileLineAndKey) {
+  const auto e = error_of("[loop]\nperiod_s = 0.005\nperoid_s = 0.001\n");
+  EXPECT_NE(e.find("test.toml:3:"), std::string::npos) << e;
+  EXPECT_NE(e.find("loop.peroid_s"), std::string::npos) << e;
+}
+
+TEST(ApplianceConfig, WrongTypeAndOutOfRangeNameTheKey) {
+  EXPECT_NE(error_of("[loop]\nperiod_s = \"fast\"\n").find("loop.period_s must be a number"), std::string::npos);
+  EXPECT_NE(error_of("[hal.modbus_io]\nport = 70000\n").find("hal.modbus_io.port must be within 1..65535"), std::string::npos);
+  EXPECT_NE(error_of("[controller]\nkind = \"pid\"\n").find("controller.kind"), std::string::npos);
+  EXPECT_NE(error_of("[hal]\nbackend = \"ni\"\n").find("not one of sim, modbus-io, comedi"), std::string::npos);
+  EXPECT_NE(error_of("[startup]\nmode = \"fault\"\n").find("startup.mode"), std::string::npos);
+}
+
+TEST(ApplianceConfig, SyntaxErrorNamesTheLine) {
+  EXPECT_NE(error_of("[loop]\nperiod_s = = 1\n").find("test.toml:2:"), std::string::npos);
+}
+
+TEST(ApplianceConfig, CrossFieldRulesAreChecked) {
+  EXPECT_NE(error_of("[limits]\nsoft_min_mm = 10.0\n").find("inside the soft limits"), std::string::npos);
+  const auto overlap = error_of(
+      "[hal]\nbackend = \"modbus-io\"\n[hal.modbus_io]\n"
+      "sensor = { table = \"holding\", address = 0 }\nvalve = { table = \"holding\", address = 0 }\n");
+  EXPECT_NE(overlap.find("[hal.modbus_io]"), std::string::npos) << overlap;
+  EXPECT_NE(error_of("[hal.modbus_io]\nsensor = { tabel = \"input\" }\n").find("hal.modbus_io.sensor.tabel"), std::string::npos);
+}
+
+TEST(ApplianceConfig, ScalingIsGivenAsFullScaleVolts) {
+  auto c = parse_appliance_config("[hal.modbus_io]\nsensor = { full_scale_v = 5.0 }\n", "t.toml");
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  EXPECT_DOUBLE_EQ(c->modbus_io.layout.sensor.volts_per_count, 5.0 / 32767);
+}
+
+}  // namespace
+}  // namespace epa::app
