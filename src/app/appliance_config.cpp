@@ -167,8 +167,9 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
 
   TableReader loop(top.subtable("loop"), "loop", file, error);
   loop.number("period_s", r.period_s, kPositive, "> 0 s");
-  loop.integer("realtime_priority", c.realtime_priority, 0, 99);
-  loop.boolean("lock_memory", c.lock_memory);
+  loop.integer("realtime_priority", c.realtime.fifo_priority, 0, 99);
+  loop.boolean("lock_memory", c.realtime.lock_memory);
+  loop.integer("cpu_dma_latency_us", c.realtime.cpu_dma_latency_us, -1, 100000);
   loop.integer("max_consecutive_overruns", r.max_consecutive_overruns, 1, 1000000);
   loop.refuse_unknown_keys();
 

@@ -8,6 +8,7 @@
 #include "hal/comedi_daq.hpp"
 #include "hal/modbus_io_daq.hpp"
 #include "plant/hammerstein_plant.hpp"
+#include "hal/realtime.hpp"
 #include "runtime/recorder.hpp"
 #include "runtime/runtime_config.hpp"
 
@@ -17,8 +18,7 @@ enum class HalBackend { kSim, kModbusIo, kComedi };
 
 struct ApplianceConfig {
   runtime::RuntimeConfig runtime;
-  int realtime_priority = 80;
-  bool lock_memory = true;
+  hal::RealtimeRequest realtime;
 
   std::string model_path;   // "": the paper's model
   std::string design_path;  // "": the paper's F, G

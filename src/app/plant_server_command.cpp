@@ -28,6 +28,10 @@ void add_plant_server_command(CLI::App& app, PlantServerOptions& o) {
   cmd->add_option("--noise", o.noise_mm, "Sensor noise standard deviation, mm")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_option("--seed", o.seed, "Seed of the sensor noise")->capture_default_str();
+  cmd->add_option("--realtime-priority", o.realtime_priority,
+                  "SCHED_FIFO priority of the simulator's threads, so it answers in bounded time like a module (0: normal)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 99));
   cmd->add_option("--Ts", o.Ts, "Real-time step period, s (default: the model's, 0.005 for the paper)")
       ->check(CLI::PositiveNumber);
 }
@@ -83,6 +87,7 @@ int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostrea
   config.plant.initial_position_mm = o.initial_position_mm;
   config.plant.noise_std_mm = o.noise_mm;
   config.plant.seed = o.seed;
+  config.realtime_priority = o.realtime_priority;
 
   BlockedStopSignals signals;  // before start(): the simulator's threads must not take the signals
   if (!signals.ok()) return err << "epa plant-server: cannot block SIGINT/SIGTERM: " << std::strerror(errno) << "\n", 1;

@@ -20,6 +20,7 @@ struct PlantServerOptions {
   double noise_mm = 0.0;
   std::uint64_t seed = 1;
   double Ts = 0.0;               // 0: the model's own
+  int realtime_priority = 0;     // SCHED_FIFO for the simulator's threads (0: normal priority)
 };
 
 void add_plant_server_command(CLI::App& app, PlantServerOptions& options);

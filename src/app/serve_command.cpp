@@ -10,7 +10,7 @@
 #include "app/daq_factory.hpp"
 #include "app/tuning_source.hpp"
 #include "runtime/clock.hpp"
-#include "runtime/realtime.hpp"
+#include "hal/realtime.hpp"
 #include "runtime/recorder.hpp"
 #include "runtime/scan_cycle.hpp"
 
@@ -113,7 +113,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
 
   std::atomic<bool> stop{false};
   std::thread loop_thread([&] {
-    for (const auto& warning : runtime::request_realtime(c.realtime_priority, c.lock_memory)) spdlog::warn("{}", warning);
+    for (const auto& warning : hal::request_realtime(c.realtime)) spdlog::warn("{}", warning);
     loop.run(stop);
   });
   sd_notify(0, "READY=1");

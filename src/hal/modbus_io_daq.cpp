@@ -1,5 +1,7 @@
 #include "hal/modbus_io_daq.hpp"
 
+#include <algorithm>
+
 #include <arpa/inet.h>
 #include <modbus.h>
 
@@ -78,7 +80,14 @@ core::Status ModbusIoDaq::open() {
   return core::ok();
 }
 
+void ModbusIoDaq::flush_if_needed() noexcept {
+  if (!flush_before_next_request_) return;
+  modbus_flush(ctx_);  // non-blocking: drops whatever answers arrived late
+  flush_before_next_request_ = false;
+}
+
 int ModbusIoDaq::read_point_words(const AnalogPoint& point) noexcept {
+  flush_if_needed();
   const int n = register_count(point);
   const int rc = point.table == RegisterTable::kInput
                      ? modbus_read_input_registers(ctx_, point.address, n, words_.data())
@@ -94,17 +103,27 @@ IoStatus ModbusIoDaq::fail_request(int saved_errno) noexcept {
   failed_requests_.fetch_add(1, std::memory_order_relaxed);
   // A Modbus exception is a complete, well-framed answer: the link stays usable.
   if (saved_errno > MODBUS_ENOBASE && saved_errno <= EMBXGTAR) return IoStatus::kError;
-  modbus_close(ctx_);
+  // Late, malformed or mismatched answers keep the link. The late answer may still be on its
+  // way, so flushing now would miss it and the next request would read it (a mismatch, then the
+  // same again): the socket is flushed when the next request starts instead.
+  if (saved_errno == ETIMEDOUT || saved_errno == EMBBADDATA || saved_errno == EMBMDATA || saved_errno == EMBBADCRC ||
+      saved_errno == EMBBADEXC || saved_errno == EMBBADSLAVE) {
+    flush_before_next_request_ = true;
+    return saved_errno == ETIMEDOUT ? IoStatus::kTimeout : IoStatus::kError;
+  }
+  modbus_close(ctx_);  // the link itself broke
   connected_.store(false, std::memory_order_relaxed);
   cycles_disconnected_ = 0;
-  return saved_errno == ETIMEDOUT ? IoStatus::kTimeout : IoStatus::kError;
+  reconnect_wait_ = 1;
+  return IoStatus::kError;
 }
 
 SensorReading ModbusIoDaq::read_sensor() noexcept {
   if (ctx_ == nullptr) return {IoStatus::kError, 0.0};  // not opened
   if (!connected()) {
-    if (++cycles_disconnected_ < config_.reconnect_interval_cycles) return {IoStatus::kError, 0.0};
+    if (++cycles_disconnected_ < reconnect_wait_) return {IoStatus::kError, 0.0};
     cycles_disconnected_ = 0;
+    reconnect_wait_ = std::min(2 * reconnect_wait_, config_.reconnect_interval_cycles);
     connect_attempts_.fetch_add(1, std::memory_order_relaxed);
     if (modbus_connect(ctx_) == -1) return {IoStatus::kError, 0.0};  // libmodbus closed the socket already
     connected_.store(true, std::memory_order_relaxed);
@@ -125,6 +144,7 @@ IoStatus ModbusIoDaq::write_valve(double valve_v) noexcept {
   if (ctx_ == nullptr || !connected()) return IoStatus::kError;
   const AnalogPoint& valve = config_.layout.valve;
   words_ = encode_volts(valve, valve_v);  // non-finite is encoded as 0 V
+  flush_if_needed();
   const int rc = register_count(valve) == 1 ? modbus_write_register(ctx_, valve.address, words_[0])
                                             : modbus_write_registers(ctx_, valve.address, 2, words_.data());
   if (rc == -1) return fail_request(errno);

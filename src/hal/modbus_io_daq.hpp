@@ -9,12 +9,16 @@
 // and write_valve() therefore makes at most one blocking network call bounded by
 // response_timeout_ms, plus system-call overhead.
 //
-// Failures: a request that times out or breaks the link closes the connection (a late answer
-// would otherwise be taken as the answer to the next request); a Modbus exception answer (e.g.
-// illegal address) is an error but keeps the connection. While disconnected, write_valve()
-// returns kError at once, and read_sensor() returns kError and counts cycles; every
-// reconnect_interval_cycles-th call makes one connect attempt (and, to stay within the bound,
-// does not also read in that call, so the first good reading comes one call later).
+// Failures: a timeout or a malformed or mismatched answer keeps the connection; the socket is
+// flushed before the next request (libmodbus checks the TCP transaction id, so a late answer is
+// never taken for another): one late answer costs a sample or two, which the scan cycle bridges,
+// instead of a reconnect.
+// A Modbus exception answer (e.g. illegal address) is an error and keeps the connection too.
+// A broken link (reset, refused, closed) closes it. While disconnected, write_valve() returns
+// kError at once, and read_sensor() returns kError and retries the connect after 1, 2, 4, ...
+// calls, at most reconnect_interval_cycles apart (a brief glitch heals within the scan cycle's
+// I/O-error tolerance; a dead module is not hammered). The reconnecting call does not also read,
+// to stay within the bound, so the first good reading comes one call later.
 // The cycle calls allocate nothing (libmodbus uses stack buffers; a test counts operator new).
 #include <array>
 #include <atomic>
@@ -34,7 +38,7 @@ struct ModbusIoConfig {
   int port = 1502;
   int unit_id = 1;                 // Modbus unit (slave) id, 0..247
   int response_timeout_ms = 2;     // bound on each request and on each connect attempt
-  int reconnect_interval_cycles = 200;  // read_sensor() calls between connect attempts (200 x 5 ms = 1 s)
+  int reconnect_interval_cycles = 200;  // longest wait between connect attempts, in read_sensor() calls (1 s)
   RemoteIoLayout layout = default_remote_io_layout();
 };
 
@@ -70,11 +74,14 @@ class ModbusIoDaq final : public Daq {
   _modbus* ctx_ = nullptr;
   std::array<std::uint16_t, 2> words_{};  // request buffer, reused: no allocation in the cycle
   int cycles_disconnected_ = 0;
+  int reconnect_wait_ = 1;  // calls until the next connect attempt: 1, 2, 4, ... up to the interval
+  bool flush_before_next_request_ = false;  // after a late or mismatched answer
   std::atomic<bool> connected_{false};
   std::atomic<std::uint64_t> failed_requests_{0}, connect_attempts_{0}, reconnects_{0};
 
+  void flush_if_needed() noexcept;
   int read_point_words(const AnalogPoint& point) noexcept;  // libmodbus rc; errno set on -1
-  IoStatus fail_request(int saved_errno) noexcept;          // counts, disconnects, classifies
+  IoStatus fail_request(int saved_errno) noexcept;          // counts, flushes or disconnects, classifies
   std::string where() const;                                // "127.0.0.1:1502 (unit 1)"
 };
 

@@ -1,5 +1,7 @@
 #include "hal/remote_io_simulator.hpp"
 
+#include "hal/realtime.hpp"
+
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <modbus.h>
@@ -253,8 +255,15 @@ core::Result<std::unique_ptr<RemoteIoSimulator>> RemoteIoSimulator::start(const 
   try {
     impl->client_fds.reserve(kMaxClients);  // push_back in the server loop stays within capacity
     Impl* self = impl.get();
-    impl->server_thread = std::thread([self] { self->serve(); });
-    impl->plant_thread = std::thread([self] { self->run_plant(); });
+    const RealtimeRequest rt{.fifo_priority = c.realtime_priority, .lock_memory = false, .cpu_dma_latency_us = -1};
+    impl->server_thread = std::thread([self, rt] {
+      if (rt.fifo_priority > 0) request_realtime(rt);
+      self->serve();
+    });
+    impl->plant_thread = std::thread([self, rt] {
+      if (rt.fifo_priority > 0) request_realtime(rt);
+      self->run_plant();
+    });
   } catch (const std::exception& e) {
     impl->stop();
     return core::io_error(std::string("remote I/O simulator: cannot start: ") + e.what());

@@ -37,6 +37,8 @@ struct RemoteIoSimulatorConfig {
   RemoteIoLayout layout = default_remote_io_layout();
   core::HammersteinModel model;       // its Ts is the real-time step period
   plant::PlantOptions plant;
+  int realtime_priority = 0;          // SCHED_FIFO for both threads, as a module's firmware answers in
+                                      // bounded time; 0: normal priority (refusal is not an error)
 };
 
 class RemoteIoSimulator {

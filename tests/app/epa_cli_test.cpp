@@ -132,4 +132,31 @@ TEST_F(EpaCli, SpecAndTTogetherAreRefused) {
   EXPECT_NE(o.output.find("either --T or a spec"), std::string::npos) << o.output;
 }
 
+TEST_F(EpaCli, ServeRefusesABadConfigurationNamingFileLineAndKey) {
+  std::ofstream(path("bad.toml")) << "[loop]\nperiod_s = 0.005\nperoid_s = 0.001\n";
+  const auto o = run_epa("serve --config " + path("bad.toml"));
+  EXPECT_EQ(o.exit_code, 1);
+  EXPECT_NE(o.output.find("bad.toml:3: loop.peroid_s is not a known setting"), std::string::npos) << o.output;
+}
+
+TEST_F(EpaCli, ServeOnTheSimPlantMovesRecordsAndStopsCleanly) {
+  // move_window_s 0.5 so that the move is measured and recorded within the 1.5 s run.
+  std::ofstream(path("fast.toml")) << "[recorder]\nmove_window_s = 0.5\n[log]\nstatus_interval_s = 0\n";
+  const auto o = run_epa("serve --config " + path("fast.toml") + " --mode run --setpoint 100 --duration 1.5 --record-dir " +
+                         path("runs"));
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  EXPECT_NE(o.output.find("DAQ sim"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("move 1 0.0 -> 100.0 mm"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("valve 0.000 V"), std::string::npos) << o.output;  // stopped with the valve safe
+  auto run = epa::core::read_run_file(path("runs/move-0001-pp-ffidz-0to100mm.csv"), 0.005);
+  ASSERT_TRUE(run.has_value()) << run.error().message;
+  EXPECT_EQ(run->size(), 100u);
+}
+
+TEST_F(EpaCli, ServeRefusesAModbusIoModuleThatIsNotThere) {
+  const auto o = run_epa("serve --config " + std::string(EPA_SOURCE_DIR) + "/config/epa.toml --hal modbus-io --modbus-io-port 9");
+  EXPECT_EQ(o.exit_code, 1);
+  EXPECT_NE(o.output.find("127.0.0.1:9"), std::string::npos) << o.output;
+}
+
 }  // namespace

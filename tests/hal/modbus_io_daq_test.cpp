@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <modbus/modbus.h>
 #include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -298,9 +299,11 @@ TEST(ModbusIoDaq, FailsFastWhenTheModuleGoesAwayAndReconnectsWithinTheInterval) 
   EXPECT_FALSE(daq.connected());
   EXPECT_EQ(daq.write_valve(1.0), IoStatus::kError);  // no request while disconnected
 
-  t0 = Clock::now();  // three intervals of a dead module: one connect attempt per interval
+  // 600 calls to a dead module. Attempts after waits of 1, 2, 4, ..., 128, 200 calls: at the
+  // cumulative calls 1, 3, 7, 15, 31, 63, 127, 255, 455 (the next, 655, is past the end): 9.
+  t0 = Clock::now();
   for (int k = 0; k < 3 * interval; ++k) ASSERT_EQ(daq.read_sensor().status, IoStatus::kError);
-  EXPECT_EQ(daq.connect_attempts(), 3u);
+  EXPECT_EQ(daq.connect_attempts(), 9u);
   EXPECT_LT(elapsed_ms(t0), 100.0);
 
   sim = start_sim(sim_config(port));  // the module comes back on the same port
@@ -340,7 +343,9 @@ TEST(ModbusIoDaq, CycleCallsAllocateNothingConnectedLostOrReconnecting) {
     daq.write_valve(0.0);
   }
   EXPECT_EQ(g_allocations.load() - before, 0u) << "disconnected";
-  EXPECT_EQ(daq.connect_attempts(), 4u);  // calls 11, 21, 31, 41 after the loss
+  // After the loss (call 1), waits of 1, 2, 4, 8, 10, 10, ...: attempts at the 1st, 3rd, 7th,
+  // 15th, 25th, 35th and 45th of the 49 calls that follow.
+  EXPECT_EQ(daq.connect_attempts(), 7u);
   sim = start_sim(sim_config(port));
   ASSERT_NE(sim, nullptr);
   before = g_allocations.load();
@@ -390,10 +395,71 @@ TEST(ModbusIoDaq, ReadReportsTimeoutWithinTheResponseTimeoutWhenTheModuleFallsSi
   modbus_free(server);
   ASSERT_TRUE(opened.has_value()) << opened.error().message;
   EXPECT_EQ(r.status, IoStatus::kTimeout);
+  EXPECT_TRUE(daq.connected());  // one late answer costs a sample, not the link
+  EXPECT_EQ(daq.connect_attempts(), 0u);
   EXPECT_GE(took_ms, 49.0);
   EXPECT_LT(took_ms, 150.0);
   EXPECT_EQ(daq.failed_requests(), 1u);
   RecordProperty("timeout_read_ms", std::to_string(took_ms));
+}
+
+// A module that answers one request late (after the DAQ gave up on it) and then normally: the
+// late answer must not cascade into the following requests. At most the late request and the
+// one after it fail; the link stays up; then every request succeeds again. (Flushing right at
+// the failure would miss the next answer, still 1 ms away, and every later request would read
+// its predecessor's answer.)
+TEST(ModbusIoDaq, OneLateAnswerCostsAtMostTwoRequestsAndKeepsTheLink) {
+  modbus_t* server = modbus_new_tcp("127.0.0.1", 0);
+  ASSERT_NE(server, nullptr);
+  int listener = modbus_tcp_listen(server, 1);
+  ASSERT_GE(listener, 0);
+  sockaddr_in addr{};
+  socklen_t len = sizeof addr;
+  ASSERT_EQ(getsockname(listener, reinterpret_cast<sockaddr*>(&addr), &len), 0);
+  modbus_mapping_t* mapping = modbus_mapping_new(0, 0, 1, 1);
+  mapping->tab_input_registers[0] = 6553;  // 2.0 V
+  std::atomic<bool> stop{false};
+  std::thread module([&] {
+    for (pollfd p{listener, POLLIN, 0}; poll(&p, 1, 20) <= 0;)
+      if (stop.load()) return;
+    if (modbus_tcp_accept(server, &listener) < 0) return;
+    // Like the simulator and real modules: answers leave at once. Without this, Nagle's algorithm
+    // holds each small answer until the previous one is acknowledged, and the lag never clears.
+    const int one = 1;
+    setsockopt(modbus_get_socket(server), IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    std::uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
+    for (int request = 0; !stop.load();) {
+      pollfd p{modbus_get_socket(server), POLLIN, 0};
+      if (poll(&p, 1, 20) <= 0) continue;
+      const int n = modbus_receive(server, query);
+      if (n < 0) break;
+      // 1 ms to answer, as a module's firmware takes; request 3 is answered late, past the timeout.
+      std::this_thread::sleep_for(std::chrono::milliseconds(++request == 3 ? 30 : 1));
+      modbus_reply(server, query, n, mapping);
+    }
+  });
+  ModbusIoConfig c = daq_config(ntohs(addr.sin_port));
+  c.response_timeout_ms = 20;
+  ModbusIoDaq daq(c);
+  const auto opened = daq.open();  // request 1
+  std::vector<IoStatus> statuses;
+  for (int k = 0; k < 12 && opened; ++k) {
+    statuses.push_back(daq.read_sensor().status);  // request 2, 3 (late), 4, ...
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));  // the scan period between requests
+  }
+  stop.store(true);
+  module.join();
+  modbus_close(server);
+  close(listener);
+  modbus_mapping_free(mapping);
+  modbus_free(server);
+  ASSERT_TRUE(opened.has_value()) << opened.error().message;
+  ASSERT_EQ(statuses.size(), 12u);
+  EXPECT_EQ(statuses[0], IoStatus::kOk);
+  EXPECT_EQ(statuses[1], IoStatus::kTimeout);
+  EXPECT_LE(daq.failed_requests(), 2u);
+  for (std::size_t k = 3; k < statuses.size(); ++k) EXPECT_EQ(statuses[k], IoStatus::kOk) << "request " << k + 2;
+  EXPECT_EQ(daq.connect_attempts(), 0u);
 }
 
 TEST(ModbusIoDaq, ASecondClientIsServedAtTheSameTime) {
