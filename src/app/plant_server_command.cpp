@@ -9,6 +9,7 @@
 #include <ostream>
 
 #include "app/tuning_source.hpp"
+#include "core/format.hpp"
 #include "hal/remote_io_simulator.hpp"
 
 namespace epa::app {
@@ -37,12 +38,6 @@ void add_plant_server_command(CLI::App& app, PlantServerOptions& o) {
 }
 
 namespace {
-
-std::string format_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
 
 // Blocks SIGINT and SIGTERM for as long as it lives, so that sigwait() receives them and the
 // threads started meanwhile inherit the block; restores the caller's mask afterwards.
@@ -95,16 +90,16 @@ int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostrea
   if (!sim) return err << "epa plant-server: " << sim.error().message << "\n", 1;
 
   out << "plant-server listening on " << o.address << ":" << (*sim)->port() << " (unit " << o.unit_id << ", Ts "
-      << format_number(config.model.Ts) << " s)" << std::endl;
+      << core::format_number(config.model.Ts) << " s)" << std::endl;
   out << "model: " << (o.model_path.empty() ? std::string("paper eq 9-10") : o.model_path) << "; initial position "
-      << format_number(o.initial_position_mm) << " mm; sensor noise " << format_number(o.noise_mm)
+      << core::format_number(o.initial_position_mm) << " mm; sensor noise " << core::format_number(o.noise_mm)
       << " mm; stop with SIGINT or SIGTERM" << std::endl;
 
   const int signal_number = signals.wait();
   (*sim)->stop();
   out << "plant-server stopped by " << (signal_number == SIGINT ? "SIGINT" : "SIGTERM") << " after "
       << (*sim)->steps() << " steps (" << (*sim)->requests() << " requests, " << (*sim)->overruns()
-      << " overruns); final position " << format_number((*sim)->position_mm()) << " mm" << std::endl;
+      << " overruns); final position " << core::format_number((*sim)->position_mm()) << " mm" << std::endl;
   return 0;
 }
 

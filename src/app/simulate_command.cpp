@@ -10,6 +10,7 @@
 #include "app/table1_report.hpp"
 #include "app/tuning_source.hpp"
 #include "control/controller.hpp"
+#include "core/format.hpp"
 #include "core/paper_reference.hpp"
 #include "core/run_file.hpp"
 
@@ -33,12 +34,6 @@ void add_simulate_command(CLI::App& app, SimulateOptions& o) {
 }
 
 namespace {
-
-std::string format_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
 
 nlohmann::json optional_json(std::optional<double> v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
 
@@ -79,7 +74,7 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
       auto run = sim::simulate_step(model, *params, {.step_mm = step, .initial_mm = 0.0, .duration_s = o.duration_s,
                                                      .noise_std_mm = o.noise_mm, .seed = o.seed});
       if (!run) return err << "epa simulate: step " << step << " mm: " << run.error().message << "\n", 1;
-      if (kind == control::ControllerKind::kPpFfidz) run->run.set_meta("lc_mm", format_number(o.lc_mm));
+      if (kind == control::ControllerKind::kPpFfidz) run->run.set_meta("lc_mm", core::format_number(o.lc_mm));
       cases.push_back({kind, step, std::move(*run)});
     }
   }
@@ -116,7 +111,7 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
   }
 
   if (!o.plot_path.empty()) {
-    const std::string title = "Closed-loop step responses (" + model_file->source + ", Ts = " + format_number(model.Ts) + " s)";
+    const std::string title = "Closed-loop step responses (" + model_file->source + ", Ts = " + core::format_number(model.Ts) + " s)";
     if (!write_text(o.plot_path, render_response_plot(cases, model.dead_zone, o.plot_window_s, title), err)) return 1;
     out << "picture written to " << o.plot_path << "\n";
   }

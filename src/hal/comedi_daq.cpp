@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "core/format.hpp"
 #include "core/paper_reference.hpp"
 
 #ifdef EPA_HAVE_COMEDI
@@ -13,14 +14,8 @@
 namespace epa::hal {
 namespace {
 
-std::string volts_text(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 std::string range_text(double min_v, double max_v) {
-  return "[" + volts_text(min_v) + ", " + volts_text(max_v) + "] V";
+  return "[" + core::format_number(min_v) + ", " + core::format_number(max_v) + "] V";
 }
 
 core::Status validate_channel(const ComediChannel& c, const std::string& name) {
@@ -35,8 +30,8 @@ core::Status validate_channel(const ComediChannel& c, const std::string& name) {
     return core::invalid_argument(name + ".range_min_v/" + name + ".range_max_v must be finite");
   }
   if (!(c.range_min_v < c.range_max_v)) {
-    return core::invalid_argument(name + ".range_min_v (" + volts_text(c.range_min_v) + ") must be below " + name +
-                                  ".range_max_v (" + volts_text(c.range_max_v) + ")");
+    return core::invalid_argument(name + ".range_min_v (" + core::format_number(c.range_min_v) + ") must be below " + name +
+                                  ".range_max_v (" + core::format_number(c.range_max_v) + ")");
   }
   return core::ok();
 }

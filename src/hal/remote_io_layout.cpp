@@ -6,6 +6,8 @@
 #include <limits>
 #include <string>
 
+#include "core/format.hpp"
+
 namespace epa::hal {
 
 const char* to_string(RegisterTable t) {
@@ -35,12 +37,6 @@ RemoteIoLayout default_remote_io_layout() {
 
 namespace {
 
-std::string format_double(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 core::Status validate_point(const AnalogPoint& p, const std::string& name) {
   const int last = p.address + register_count(p) - 1;
   if (p.address < 0 || last > kMaxRegisterAddress)
@@ -51,10 +47,10 @@ core::Status validate_point(const AnalogPoint& p, const std::string& name) {
   if (p.encoding == AnalogEncoding::kInt16) {
     if (!(p.volts_per_count > 0.0) || !std::isfinite(p.volts_per_count))
       return core::invalid_argument("remote I/O layout: " + name + ".volts_per_count must be > 0 and finite, got " +
-                                    format_double(p.volts_per_count));
+                                    core::format_number(p.volts_per_count));
     if (!std::isfinite(p.offset_v))
       return core::invalid_argument("remote I/O layout: " + name + ".offset_v must be finite, got " +
-                                    format_double(p.offset_v));
+                                    core::format_number(p.offset_v));
   }
   return core::ok();
 }

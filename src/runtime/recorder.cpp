@@ -5,17 +5,10 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "core/format.hpp"
 #include "core/run_file.hpp"
 
 namespace epa::runtime {
-
-namespace {
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-}  // namespace
 
 Recorder::Recorder(RecorderConfig config, LoopChannels& channels, Log log)
     : config_(std::move(config)), ch_(channels), log_(std::move(log)) {}
@@ -73,8 +66,8 @@ void Recorder::write(const RecordRequest& request) {
   if (request.reason == RecordRequest::Reason::kMove) {
     const auto& m = request.move;
     run.set_meta("move", std::to_string(m.number));
-    run.set_meta("from_mm", num(m.from_mm));
-    run.set_meta("step_mm", num(m.to_mm - m.from_mm));
+    run.set_meta("from_mm", core::format_number(m.from_mm));
+    run.set_meta("step_mm", core::format_number(m.to_mm - m.from_mm));
     std::snprintf(name, sizeof name, "move-%04u-%s-%gto%gmm.csv", m.number,
                   std::string(control::to_string(request.controller)).c_str(), m.from_mm, m.to_mm);
   } else {

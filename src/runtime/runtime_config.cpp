@@ -3,15 +3,9 @@
 #include <cmath>
 #include <string>
 
-namespace epa::runtime {
+#include "core/format.hpp"
 
-namespace {
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-}  // namespace
+namespace epa::runtime {
 
 core::Status validate(const RuntimeConfig& c) {
   const struct { const char* name; double value; bool positive; } checks[] = {
@@ -23,17 +17,17 @@ core::Status validate(const RuntimeConfig& c) {
   };
   for (const auto& ch : checks) {
     if (!std::isfinite(ch.value)) return core::invalid_argument(std::string(ch.name) + " must be a finite number");
-    if (ch.positive && !(ch.value > 0.0)) return core::invalid_argument(std::string(ch.name) + " must be > 0, got " + num(ch.value));
+    if (ch.positive && !(ch.value > 0.0)) return core::invalid_argument(std::string(ch.name) + " must be > 0, got " + core::format_number(ch.value));
   }
-  if (c.period_s < 0.0002 || c.period_s > 1.0) return core::invalid_argument("period_s must be within [0.0002, 1] s, got " + num(c.period_s));
+  if (c.period_s < 0.0002 || c.period_s > 1.0) return core::invalid_argument("period_s must be within [0.0002, 1] s, got " + core::format_number(c.period_s));
   if (!(c.sensor_min_v < c.sensor_max_v)) return core::invalid_argument("sensor_min_v must be below sensor_max_v");
   if (!(c.soft_min_mm < c.soft_max_mm)) return core::invalid_argument("soft_min_mm must be below soft_max_mm");
   if (!(c.setpoint_min_mm <= c.setpoint_max_mm)) return core::invalid_argument("setpoint_min_mm must not exceed setpoint_max_mm");
   if (c.setpoint_min_mm < c.soft_min_mm || c.setpoint_max_mm > c.soft_max_mm)
-    return core::invalid_argument("the setpoint range [" + num(c.setpoint_min_mm) + ", " + num(c.setpoint_max_mm) +
-                                  "] mm must lie inside the soft limits [" + num(c.soft_min_mm) + ", " + num(c.soft_max_mm) + "] mm");
+    return core::invalid_argument("the setpoint range [" + core::format_number(c.setpoint_min_mm) + ", " + core::format_number(c.setpoint_max_mm) +
+                                  "] mm must lie inside the soft limits [" + core::format_number(c.soft_min_mm) + ", " + core::format_number(c.soft_max_mm) + "] mm");
   if (!std::isfinite(c.safe_valve_v) || std::abs(c.safe_valve_v) > 10.0)  // the valve accepts +-10 V
-    return core::invalid_argument("safe_valve_v must be a valve command within +-10 V, got " + num(c.safe_valve_v));
+    return core::invalid_argument("safe_valve_v must be a valve command within +-10 V, got " + core::format_number(c.safe_valve_v));
   if (!(c.following_error_time_s >= 0.0)) return core::invalid_argument("following_error_time_s must be >= 0 (0: off)");
   if (!(c.heartbeat_timeout_s >= 0.0)) return core::invalid_argument("heartbeat_timeout_s must be >= 0 (0: off)");
   if (c.max_consecutive_io_errors < 1) return core::invalid_argument("max_consecutive_io_errors must be >= 1");
@@ -41,7 +35,7 @@ core::Status validate(const RuntimeConfig& c) {
   if (c.start_mode == Mode::kFault || c.start_mode == Mode::kManual)
     return core::invalid_argument("start mode must be stop or run");
   if (c.start_setpoint_mm < c.setpoint_min_mm || c.start_setpoint_mm > c.setpoint_max_mm)
-    return core::invalid_argument("start setpoint " + num(c.start_setpoint_mm) + " mm lies outside the setpoint range");
+    return core::invalid_argument("start setpoint " + core::format_number(c.start_setpoint_mm) + " mm lies outside the setpoint range");
   if (c.move_window_s > c.record_buffer_s) return core::invalid_argument("move_window_s must not exceed record_buffer_s");
   return core::ok();
 }

@@ -3,18 +3,11 @@
 #include <cmath>
 #include <string>
 
+#include "core/format.hpp"
 #include "core/units.hpp"
 #include "plant/hammerstein_plant.hpp"
 
 namespace epa::sim {
-
-namespace {
-std::string format_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-}  // namespace
 
 core::Result<StepRun> simulate_step(const core::HammersteinModel& model, const control::ControllerParams& params,
                                     const StepRunOptions& o) {
@@ -22,7 +15,7 @@ core::Result<StepRun> simulate_step(const core::HammersteinModel& model, const c
     return core::invalid_argument("duration must be > 0 s");
   const double target_mm = o.initial_mm + o.step_mm;
   if (!std::isfinite(target_mm) || target_mm < 0.0 || target_mm > core::kStrokeMm)
-    return core::invalid_argument("target " + format_number(target_mm) + " mm lies outside the stroke [0, 500] mm");
+    return core::invalid_argument("target " + core::format_number(target_mm) + " mm lies outside the stroke [0, 500] mm");
   auto plant = plant::HammersteinPlant::make(model, {.initial_position_mm = o.initial_mm,
                                                      .noise_std_mm = o.noise_std_mm,
                                                      .seed = o.seed,
@@ -35,8 +28,8 @@ core::Result<StepRun> simulate_step(const core::HammersteinModel& model, const c
   run.Ts = model.Ts;
   run.set_meta("controller", std::string(control::to_string(params.kind())));
   run.set_meta("source", "sim");
-  run.set_meta("step_mm", format_number(o.step_mm));
-  run.set_meta("noise_std_mm", format_number(o.noise_std_mm));
+  run.set_meta("step_mm", core::format_number(o.step_mm));
+  run.set_meta("noise_std_mm", core::format_number(o.noise_std_mm));
   run.set_meta("seed", std::to_string(o.seed));
   for (auto* column : {&run.t_s, &run.r_mm, &run.y_mm, &run.u_V, &run.uc_V}) column->reserve(n);
 

@@ -2,37 +2,21 @@
 // and counted while the loop runs (ARCHITECTURE.md: the cycle never allocates).
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
 
+#include "../support/counting_new.hpp"
 #include "control/controller.hpp"
 #include "control/paper_controller.hpp"
 #include "core/paper_reference.hpp"
 #include "plant/hammerstein_plant.hpp"
 
-namespace {
-std::atomic<long> g_allocations{0};
-}
-
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace epa::control {
 namespace {
 
 TEST(Allocation, CounterSeesAnAllocation) {  // guards against a counter that cannot count
-  const long before = g_allocations.load();
+  const long before = epa::testing::allocation_count();
   auto* p = new int(3);
-  EXPECT_GT(g_allocations.load(), before);
+  EXPECT_GT(epa::testing::allocation_count(), before);
   delete p;
 }
 
@@ -44,14 +28,14 @@ TEST(Allocation, TenThousandControllerStepsAllocateNothing) {
     ASSERT_TRUE(plant.has_value());
     ControllerState state;
     double sink = 0.0;
-    const long before = g_allocations.load();
+    const long before = epa::testing::allocation_count();
     for (int k = 0; k < 10000; ++k) {
       const double r_v = (k / 2000) % 2 == 0 ? 1.0 : 3.0;  // setpoint changes keep all branches busy
       const auto out = controller_step(*params, state, r_v, plant->measured_v());
       plant->step(out.valve_v);
       sink += out.valve_v;
     }
-    EXPECT_EQ(g_allocations.load() - before, 0) << to_string(kind);
+    EXPECT_EQ(epa::testing::allocation_count() - before, 0) << to_string(kind);
     EXPECT_TRUE(std::isfinite(sink));
   }
 }

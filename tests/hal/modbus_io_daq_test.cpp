@@ -22,18 +22,7 @@
 #include "core/paper_reference.hpp"
 #include "hal/remote_io_simulator.hpp"
 
-// Counts every operator new of this test binary (forwarding to malloc, so other tests are
-// unaffected) to prove that the cycle calls allocate nothing.
-namespace {
-std::atomic<std::size_t> g_allocations{0};
-}
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#include "../support/counting_new.hpp"  // the cycle calls must allocate nothing
 
 namespace epa::hal {
 namespace {
@@ -329,29 +318,29 @@ TEST(ModbusIoDaq, CycleCallsAllocateNothingConnectedLostOrReconnecting) {
   ModbusIoDaq daq(c);
   ASSERT_TRUE(daq.open().has_value());
   int ok = 0;
-  std::size_t before = g_allocations.load();
+  long before = epa::testing::allocation_count();
   for (int k = 0; k < 100; ++k) {
     ok += daq.read_sensor().status == IoStatus::kOk;
     ok += daq.write_valve(0.5 * std::sin(0.1 * k)) == IoStatus::kOk;
   }
-  EXPECT_EQ(g_allocations.load() - before, 0u) << "connected";
+  EXPECT_EQ(epa::testing::allocation_count() - before, 0) << "connected";
   EXPECT_EQ(ok, 200);
   sim->stop();
-  before = g_allocations.load();
+  before = epa::testing::allocation_count();
   for (int k = 0; k < 50; ++k) {  // the loss, then a connect attempt every 10 calls to a closed port
     daq.read_sensor();
     daq.write_valve(0.0);
   }
-  EXPECT_EQ(g_allocations.load() - before, 0u) << "disconnected";
+  EXPECT_EQ(epa::testing::allocation_count() - before, 0) << "disconnected";
   // After the loss (call 1), waits of 1, 2, 4, 8, 10, 10, ...: attempts at the 1st, 3rd, 7th,
   // 15th, 25th, 35th and 45th of the 49 calls that follow.
   EXPECT_EQ(daq.connect_attempts(), 7u);
   sim = start_sim(sim_config(port));
   ASSERT_NE(sim, nullptr);
-  before = g_allocations.load();
+  before = epa::testing::allocation_count();
   ok = 0;
   for (int k = 0; k < 20; ++k) ok += daq.read_sensor().status == IoStatus::kOk;
-  EXPECT_EQ(g_allocations.load() - before, 0u) << "reconnecting";
+  EXPECT_EQ(epa::testing::allocation_count() - before, 0) << "reconnecting";
   EXPECT_GE(ok, 9);  // reconnected within the interval of 10 cycles
 }
 

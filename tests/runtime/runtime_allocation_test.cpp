@@ -3,28 +3,13 @@
 // controller switch along the way.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
 
+#include "../support/counting_new.hpp"
 #include "control/paper_controller.hpp"
 #include "core/paper_reference.hpp"
 #include "hal/sim_daq.hpp"
 #include "runtime/scan_cycle.hpp"
 
-namespace {
-std::atomic<long> g_allocations{0};
-}
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace epa::runtime {
 namespace {
@@ -42,7 +27,7 @@ TEST(RuntimeAllocation, TenThousandScanCyclesAllocateNothing) {
                                controller_command(control::ControllerKind::kPpNgidz),
                                setpoint_command(60.0)};
 
-  const long before = g_allocations.load();
+  const long before = epa::testing::allocation_count();
   for (int k = 0; k < 10000; ++k) {
     if (k % 3000 == 1500) {
       ASSERT_TRUE(ch.commands.try_push(setpoints[(k / 3000) % 3]));
@@ -50,11 +35,11 @@ TEST(RuntimeAllocation, TenThousandScanCyclesAllocateNothing) {
     loop.cycle(clock.now_ns());
     clock.advance(5'000'000);
   }
-  const long during = g_allocations.load() - before;
+  const long during = epa::testing::allocation_count() - before;
   EXPECT_EQ(during, 0);
   EXPECT_GE(loop.last_snapshot().moves, 3u);  // the moves finished inside the counted span
   auto* probe = new int(1);                   // and the counter does count
-  EXPECT_GT(g_allocations.load() - before, during);
+  EXPECT_GT(epa::testing::allocation_count() - before, during);
   delete probe;
 }
 
