@@ -2,13 +2,13 @@
 // and counted while the loop runs (ARCHITECTURE.md: the cycle never allocates).
 #include <gtest/gtest.h>
 
+#include <cmath>
 
 #include "../support/counting_new.hpp"
 #include "control/controller.hpp"
 #include "control/paper_controller.hpp"
 #include "core/paper_reference.hpp"
 #include "plant/hammerstein_plant.hpp"
-
 
 namespace epa::control {
 namespace {

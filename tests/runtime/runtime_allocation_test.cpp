@@ -3,13 +3,11 @@
 // controller switch along the way.
 #include <gtest/gtest.h>
 
-
 #include "../support/counting_new.hpp"
 #include "control/paper_controller.hpp"
 #include "core/paper_reference.hpp"
 #include "hal/sim_daq.hpp"
 #include "runtime/scan_cycle.hpp"
-
 
 namespace epa::runtime {
 namespace {
