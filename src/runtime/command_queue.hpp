@@ -16,6 +16,11 @@ class CommandQueue {
     std::lock_guard lock(producer_mutex_);
     return ring_.try_push(item);
   }
+  // A group (e.g. the points of one Modbus block write) arrives whole, in one cycle, or not at all.
+  bool try_push_all(const T* items, std::size_t n) {
+    std::lock_guard lock(producer_mutex_);
+    return ring_.try_push_all(items, n);
+  }
   bool try_pop(T& out) noexcept { return ring_.try_pop(out); }
 
  private:

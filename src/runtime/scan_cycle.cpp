@@ -32,8 +32,10 @@ ScanCycle::ScanCycle(const RuntimeConfig& config, const Tuning& tuning, hal::Daq
 }
 
 void ScanCycle::apply_commands(std::int64_t now_ns) noexcept {
+  // Everything queued now, so a group pushed with try_push_all is never split across cycles;
+  // bounded by the queue's capacity.
   Command c;
-  for (int i = 0; i < 16 && ch_.commands.try_pop(c); ++i) apply(c, now_ns);  // bounded work per cycle
+  for (std::size_t i = 0; i < kCommandQueueCapacity && ch_.commands.try_pop(c); ++i) apply(c, now_ns);
 }
 
 void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {

@@ -34,10 +34,12 @@ struct RecordRequest {
   control::ControllerKind controller = control::ControllerKind::kPpFfidz;
 };
 
+inline constexpr std::size_t kCommandQueueCapacity = 64;
+
 // The two channels other threads meet the loop through, plus the recorder's.
 struct LoopChannels {
   explicit LoopChannels(std::size_t record_capacity) : samples(record_capacity) {}
-  CommandQueue<Command, 64> commands;
+  CommandQueue<Command, kCommandQueueCapacity> commands;
   SeqlockCell<Snapshot> snapshot;
   SampleRing samples;
   SpscRing<RecordRequest, 16> record_requests;

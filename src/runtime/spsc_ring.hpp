@@ -20,6 +20,15 @@ class SpscRing {
     return true;
   }
 
+  // All of `items` or none, published with one store: the consumer sees the whole group at once.
+  bool try_push_all(const T* items, std::size_t n) noexcept {
+    const auto tail = tail_.load(std::memory_order_relaxed);
+    if (Capacity - (tail - head_.load(std::memory_order_acquire)) < n) return false;
+    for (std::size_t i = 0; i < n; ++i) slots_[(tail + i) & (Capacity - 1)] = items[i];
+    tail_.store(tail + n, std::memory_order_release);
+    return true;
+  }
+
   bool try_pop(T& out) noexcept {
     const auto head = head_.load(std::memory_order_relaxed);
     if (head == tail_.load(std::memory_order_acquire)) return false;

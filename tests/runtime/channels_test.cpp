@@ -57,6 +57,40 @@ TEST(CommandQueue, DeliversInOrderAndRefusesWhenFull) {
   EXPECT_FALSE(q.try_pop(v));
 }
 
+TEST(CommandQueue, AGroupIsPushedWholeOrNotAtAll) {
+  CommandQueue<int, 8> q;
+  const int group[] = {1, 2, 3, 4, 5};
+  EXPECT_TRUE(q.try_push_all(group, 5));
+  EXPECT_FALSE(q.try_push_all(group, 5));  // 3 free slots: nothing of the group goes in
+  int v = 0, count = 0;
+  while (q.try_pop(v)) ++count;
+  EXPECT_EQ(count, 5);
+}
+
+TEST(CommandQueue, AConcurrentConsumerNeverSeesHalfAGroup) {
+  CommandQueue<int, 64> q;
+  std::atomic<bool> done{false};
+  std::thread producer([&] {
+    const int group[] = {1, 2, 3};
+    for (int i = 0; i < 20000;) i += q.try_push_all(group, 3) ? 1 : 0;
+    done = true;
+  });
+  int v = 0, expected = 1, received = 0;
+  for (;;) {
+    const bool finished = done.load();  // read before draining: after it, one drain gets the rest
+    // Drain what is visible now, as the scan cycle does: a group must never end mid-way.
+    while (q.try_pop(v)) {
+      ASSERT_EQ(v, expected);
+      expected = expected % 3 + 1;
+      ++received;
+    }
+    ASSERT_EQ(expected, 1) << "a drain ended inside a group";
+    if (finished) break;
+  }
+  producer.join();
+  EXPECT_EQ(received, 60000);
+}
+
 TEST(CommandQueue, ManyProducersOneConsumerLoseNothing) {
   CommandQueue<std::uint64_t, 64> q;
   constexpr int kProducers = 4, kEach = 20000;
