@@ -1,6 +1,7 @@
 #include "app/appliance_config.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <set>
@@ -55,6 +56,17 @@ class TableReader {
     auto r = parse(*n->value<std::string>());
     if (!r) return fail(*n, key, r.error().message);
     out = *r;
+  }
+  void text_list(const char* key, std::vector<std::string>& out) {
+    const toml::node* n = find(key);
+    if (!n) return;
+    const auto* arr = n->as_array();
+    if (!arr) return fail(*n, key, "must be an array of strings");
+    out.clear();
+    for (const auto& item : *arr) {
+      if (!item.is_string()) return fail(item, key, "must contain strings only");
+      out.push_back(*item.value<std::string>());
+    }
   }
   const toml::table* subtable(const char* key) {
     used_.insert(key);
@@ -217,6 +229,22 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   log.number("status_interval_s", c.status_interval_s, kNonNegative, ">= 0 s (0: off)");
   log.refuse_unknown_keys();
 
+  TableReader mbs(top.subtable("modbus"), "modbus", file, error);
+  mbs.boolean("enabled", c.modbus_enabled);
+  mbs.text("address", c.modbus.address);
+  mbs.integer("port", c.modbus.port, 0, 65535);
+  mbs.integer("unit_id", c.modbus.unit_id, 0, 247);
+  mbs.integer("max_clients", c.modbus.max_clients, 1, 1000);
+  mbs.number("idle_timeout_s", c.modbus.idle_timeout_s, kPositive, "> 0 s");
+  mbs.text("register_map", c.register_map_path);
+  mbs.boolean("read_only", c.modbus.policy.read_only);
+  int unlock_key = c.modbus.policy.unlock_key;
+  mbs.integer("unlock_key", unlock_key, 0, 65535);
+  c.modbus.policy.unlock_key = static_cast<std::uint16_t>(unlock_key);
+  mbs.number("unlock_timeout_s", c.modbus.policy.unlock_timeout_s, kPositive, "> 0 s");
+  mbs.text_list("write_clients", c.modbus.policy.write_clients);
+  mbs.refuse_unknown_keys();
+
   TableReader hal_table(top.subtable("hal"), "hal", file, error);
   hal_table.choice<HalBackend>("backend", c.backend, parse_backend);
   TableReader sim(hal_table.subtable("sim"), "hal.sim", file, error);
@@ -257,7 +285,13 @@ core::Result<ApplianceConfig> read_appliance_config(const std::string& path) {
   if (!in) return core::io_error(path + ": cannot open the configuration file");
   std::stringstream ss;
   ss << in.rdbuf();
-  return parse_appliance_config(ss.str(), path);
+  auto c = parse_appliance_config(ss.str(), path);
+  if (!c) return c;
+  // Files the configuration names are found next to it, wherever the appliance is started from.
+  const auto folder = std::filesystem::path(path).parent_path();
+  for (std::string* p : {&c->model_path, &c->design_path, &c->register_map_path})
+    if (!p->empty() && std::filesystem::path(*p).is_relative()) *p = (folder / *p).lexically_normal().string();
+  return c;
 }
 
 }  // namespace epa::app

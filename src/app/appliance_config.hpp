@@ -2,11 +2,14 @@
 // config/epa.toml (epa-config/1): everything `epa serve` needs, read into the runtime's and the
 // backends' own config structs. Every key is optional (defaults as in config/epa.toml), every
 // value is type- and range-checked, and unknown keys are refused; messages name the file, the
-// line and the key.
+// line and the key. Relative paths of files the configuration names (model, design, register map)
+// are resolved against the configuration file's folder; the recorder's directory against the
+// working directory (where the appliance keeps its data: /var/lib/epa under systemd).
 #include <string>
 
 #include "hal/comedi_daq.hpp"
 #include "hal/modbus_io_daq.hpp"
+#include "modbus/modbus_server.hpp"
 #include "plant/hammerstein_plant.hpp"
 #include "hal/realtime.hpp"
 #include "runtime/recorder.hpp"
@@ -28,6 +31,10 @@ struct ApplianceConfig {
   std::string record_directory = "runs";
   bool record_per_move = true;
   double status_interval_s = 10.0;
+
+  bool modbus_enabled = true;
+  modbus::ServerConfig modbus;
+  std::string register_map_path = "../registers/epa.csv";  // relative to the configuration file
 
   HalBackend backend = HalBackend::kSim;
   plant::PlantOptions sim;

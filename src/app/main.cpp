@@ -5,6 +5,7 @@
 
 #include "app/design_command.hpp"
 #include "app/plant_server_command.hpp"
+#include "app/registers_command.hpp"
 #include "app/serve_command.hpp"
 #include "app/simulate_command.hpp"
 
@@ -17,8 +18,10 @@ int main(int argc, char** argv) {
   epa::app::DesignOptions design;
   epa::app::ServeOptions serve;
   epa::app::PlantServerOptions plant_server;
+  epa::app::RegistersOptions registers;
   epa::app::add_serve_command(app, serve);
   epa::app::add_plant_server_command(app, plant_server);
+  epa::app::add_registers_command(app, registers);
   epa::app::add_simulate_command(app, simulate);
   epa::app::add_design_command(app, design);
   try {
@@ -30,6 +33,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("simulate")) return epa::app::run_simulate(simulate, std::cout, std::cerr);
     if (app.got_subcommand("design")) return epa::app::run_design(design, std::cout, std::cerr);
     if (app.got_subcommand("serve")) return epa::app::run_serve(serve, std::cerr);
+    if (app.got_subcommand("registers")) return epa::app::run_registers(registers, std::cout, std::cerr);
     if (app.got_subcommand("plant-server")) return epa::app::run_plant_server(plant_server, std::cout, std::cerr);
   } catch (const std::exception& e) {  // third-party code (CLI11, JSON, filesystem) at the edge
     std::cerr << "epa: " << e.what() << "\n";

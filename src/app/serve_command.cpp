@@ -4,10 +4,12 @@
 #include <systemd/sd-daemon.h>
 
 #include <csignal>
+#include <optional>
 #include <ctime>
 #include <thread>
 
 #include "app/daq_factory.hpp"
+#include "app/log_audit_sink.hpp"
 #include "app/tuning_source.hpp"
 #include "runtime/clock.hpp"
 #include "hal/realtime.hpp"
@@ -21,6 +23,7 @@ void add_serve_command(CLI::App& app, ServeOptions& o) {
   cmd->add_option("--config", o.config_path, "Configuration file (epa-config/1 TOML)")->capture_default_str();
   cmd->add_option("--hal", o.hal, "DAQ backend, overriding the configuration: sim, modbus-io, comedi");
   cmd->add_option("--modbus-io-port", o.modbus_io_port, "TCP port of the remote I/O module (modbus-io)");
+  cmd->add_option("--modbus-port", o.modbus_port, "TCP port of the Modbus server, overriding [modbus] port");
   cmd->add_option("--mode", o.mode, "Mode at start-up: stop or run");
   cmd->add_option("--setpoint", o.setpoint_mm, "Setpoint at start-up, mm");
   cmd->add_option("--record-dir", o.record_dir, "Directory for recorded run files");
@@ -38,6 +41,7 @@ core::Status apply_overrides(const ServeOptions& o, ApplianceConfig& c) {
     else return core::invalid_argument("--hal '" + o.hal + "' is not one of sim, modbus-io, comedi");
   }
   if (o.modbus_io_port > 0) c.modbus_io.port = o.modbus_io_port;
+  if (o.modbus_port >= 0) c.modbus.port = o.modbus_port;
   if (!o.mode.empty()) {
     auto m = runtime::parse_mode(o.mode);
     if (!m) return core::invalid_argument("--mode: " + m.error().message);
@@ -79,11 +83,18 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   c.runtime.mm_per_volt = model.mm_per_volt;
   auto polynomials = load_controller_polynomials(c.design_path);
   if (!polynomials) return err << "epa serve: " << polynomials.error().message << "\n", 1;
-  auto tuning = runtime::make_tuning({.kind = c.runtime.controller, .F = polynomials->F, .G = polynomials->G,
-                                      .H = polynomials->H, .dead_zone = model.dead_zone,
-                                      .lc_v = c.lc_mm / model.mm_per_volt, .valve_limit_v = c.valve_limit_v,
-                                      .safe_valve_v = c.runtime.safe_valve_v});
+  const control::ControllerConfig tuning_base{.kind = c.runtime.controller, .F = polynomials->F, .G = polynomials->G,
+                                              .H = polynomials->H, .dead_zone = model.dead_zone,
+                                              .lc_v = c.lc_mm / model.mm_per_volt, .valve_limit_v = c.valve_limit_v,
+                                              .safe_valve_v = c.runtime.safe_valve_v};
+  auto tuning = runtime::make_tuning(tuning_base);
   if (!tuning) return err << "epa serve: " << tuning.error().message << "\n", 1;
+  std::optional<modbus::RegisterMap> register_map;
+  if (c.modbus_enabled) {
+    auto map = modbus::RegisterMap::load(c.register_map_path);
+    if (!map) return err << "epa serve: " << map.error().message << "\n", 1;
+    register_map = std::move(*map);
+  }
 
   auto daq = make_daq(c, model);
   if (!daq) return err << "epa serve: " << daq.error().message << "\n", 1;
@@ -110,6 +121,22 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
                               .source = std::string("appliance/") + to_string(c.backend)},
                              channels, [](const std::string& line) { spdlog::info("{}", line); });
   recorder.start();
+  LogAuditSink audit;
+  std::unique_ptr<modbus::ModbusServer> modbus_server;
+  if (register_map) {
+    auto server = modbus::ModbusServer::start(c.modbus, *register_map, tuning_base, model.mm_per_volt, channels, &audit,
+                                              [](const std::string& line) { spdlog::info("{}", line); });
+    if (!server) {
+      spdlog::error("{}", server.error().message);
+      recorder.stop();
+      (*daq)->close();
+      return 1;
+    }
+    modbus_server = std::move(*server);
+    spdlog::info("modbus: listening on {}:{} (unit {}, map {}, {} points, {})", c.modbus.address, modbus_server->port(),
+                 c.modbus.unit_id, c.register_map_path, register_map->entries().size(),
+                 c.modbus.policy.read_only ? "read-only" : c.modbus.policy.unlock_key ? "tuning locked until unlocked" : "tuning locked (no unlock key)");
+  }
 
   std::atomic<bool> stop{false};
   std::thread loop_thread([&] {
@@ -160,6 +187,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
     }
   }
   sd_notify(0, "STOPPING=1");
+  if (modbus_server) modbus_server->stop();  // no more commands; then the loop's last cycle
   stop = true;
   loop_thread.join();  // the loop's last act: valve to its safe command
   recorder.stop();

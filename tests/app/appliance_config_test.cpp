@@ -27,6 +27,10 @@ TEST(ApplianceConfig, ShippedFileParsesToTheDocumentedDefaults) {
   EXPECT_EQ(c->modbus_io.port, 1502);
   EXPECT_DOUBLE_EQ(c->modbus_io.layout.sensor.volts_per_count, hal::default_remote_io_layout().sensor.volts_per_count);
   EXPECT_EQ(c->comedi.device, "/dev/comedi0");
+  EXPECT_EQ(c->register_map_path, std::string(EPA_SOURCE_DIR) + "/registers/epa.csv");  // next to the config
+  EXPECT_TRUE(c->modbus_enabled);
+  EXPECT_EQ(c->modbus.port, 502);
+  EXPECT_EQ(c->modbus.policy.unlock_key, 0);  // no default key: tuning stays locked until one is set
 }
 
 TEST(ApplianceConfig, EmptyFileGivesTheDefaults) {

@@ -1,0 +1,57 @@
+#pragma once
+// The Modbus TCP server: one thread, poll() over non-blocking sockets, our own framing per client
+// (so a client that sends one byte a second, or nothing, never blocks the others), libmodbus to
+// build every answer and exception (modbus_reply / modbus_reply_exception), and the
+// RequestHandler for what the answer says. A cap on clients (the one over the cap is accepted
+// and closed at once) and an idle timeout keep a crowd of dead connections from starving it.
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "modbus/request_handler.hpp"
+
+namespace epa::modbus {
+
+struct ServerConfig {
+  std::string address = "0.0.0.0";  // IPv4 address to listen on
+  int port = 502;                    // 0: any free port (see port())
+  int unit_id = 1;
+  int max_clients = 16;
+  double idle_timeout_s = 60.0;      // a client silent this long is disconnected
+  WritePolicy policy;
+};
+
+class ModbusServer {
+ public:
+  using Log = std::function<void(const std::string&)>;
+  // Binds, then serves on its own thread. The map, channels and sink must outlive the server.
+  static core::Result<std::unique_ptr<ModbusServer>> start(const ServerConfig& config, const RegisterMap& map,
+                                                           control::ControllerConfig tuning_base, double mm_per_volt,
+                                                           runtime::LoopChannels& channels, core::AuditSink* audit,
+                                                           Log log = {});
+  ~ModbusServer();
+  ModbusServer(const ModbusServer&) = delete;
+  ModbusServer& operator=(const ModbusServer&) = delete;
+
+  int port() const { return port_; }
+  int clients() const { return clients_.load(); }
+  std::uint64_t requests() const { return requests_.load(); }
+  std::uint64_t exceptions() const { return exceptions_.load(); }
+  void stop();
+
+ private:
+  struct Impl;
+  explicit ModbusServer(std::unique_ptr<Impl> impl);
+  void serve();
+
+  std::unique_ptr<Impl> impl_;
+  int port_ = 0;
+  std::atomic<bool> stop_{false};
+  std::atomic<int> clients_{0};
+  std::atomic<std::uint64_t> requests_{0}, exceptions_{0};
+  std::thread thread_;
+};
+
+}  // namespace epa::modbus

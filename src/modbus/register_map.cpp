@@ -1,0 +1,249 @@
+#include "modbus/register_map.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "core/format.hpp"
+
+namespace epa::modbus {
+
+namespace {
+
+constexpr std::pair<Table, std::string_view> kTables[] = {
+    {Table::kCoil, "coil"}, {Table::kDiscreteInput, "discrete"}, {Table::kInputRegister, "input"}, {Table::kHoldingRegister, "holding"}};
+constexpr std::pair<DataType, std::string_view> kTypes[] = {{DataType::kBool, "bool"},   {DataType::kUint16, "uint16"},
+                                                             {DataType::kInt16, "int16"}, {DataType::kUint32, "uint32"},
+                                                             {DataType::kInt32, "int32"}, {DataType::kFloat32, "float32"}};
+
+std::string trim(std::string s) {
+  const auto b = s.find_first_not_of(" \t\r");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
+}
+
+// CSV fields; double quotes protect commas ("" is a quote inside them).
+std::vector<std::string> split_csv(const std::string& line) {
+  std::vector<std::string> fields(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') fields.back() += '"', ++i;
+      else if (c == '"') quoted = false;
+      else fields.back() += c;
+    } else if (c == '"') quoted = true;
+    else if (c == ',') fields.emplace_back();
+    else fields.back() += c;
+  }
+  for (auto& f : fields) f = trim(f);
+  return fields;
+}
+
+std::optional<double> number(const std::string& s) {
+  double v = 0;
+  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || p != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+// What a write to a register of this type can carry, in engineering units after scaling (the
+// sentinels only stand for "no value" when a NaN is read).
+std::pair<double, double> representable(DataType t, double scale) {
+  switch (t) {
+    case DataType::kBool: return {0, 1};
+    case DataType::kUint16: return {0, 65535 / scale};
+    case DataType::kInt16: return {-32768 / scale, 32767 / scale};
+    case DataType::kUint32: return {0, 4294967295.0 / scale};
+    case DataType::kInt32: return {-2147483648.0 / scale, 2147483647.0 / scale};
+    case DataType::kFloat32: return {-3.4e38, 3.4e38};
+  }
+  return {0, 0};
+}
+
+}  // namespace
+
+std::string_view to_string(Table t) {
+  for (const auto& [v, n] : kTables) if (v == t) return n;
+  return "?";
+}
+std::string_view to_string(DataType t) {
+  for (const auto& [v, n] : kTypes) if (v == t) return n;
+  return "?";
+}
+bool is_bit_table(Table t) { return t == Table::kCoil || t == Table::kDiscreteInput; }
+
+core::Result<RegisterMap> RegisterMap::load(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return core::io_error(path + ": cannot open the register map");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse(ss.str(), path);
+}
+
+core::Result<RegisterMap> RegisterMap::parse(const std::string& text, const std::string& src) {
+  RegisterMap map;
+  map.source_ = src;
+  std::istringstream in(text);
+  std::string raw;
+  int line_no = 0;
+  std::map<std::string, int> column;  // header name -> index
+  auto fail = [&](const std::string& why) { return core::parse_error(src + ":" + std::to_string(line_no) + ": " + why); };
+
+  while (std::getline(in, raw)) {
+    ++line_no;
+    const std::string line = trim(raw);
+    if (line.empty() || line[0] == '#') continue;
+    const auto f = split_csv(line);
+    if (column.empty()) {
+      for (std::size_t i = 0; i < f.size(); ++i) column[f[i]] = static_cast<int>(i);
+      for (const char* required : {"name", "table", "address", "type"})
+        if (!column.count(required)) return fail(std::string("header: missing column '") + required + "'");
+      static const std::vector<std::string> kKnown = {"name", "table", "address", "type", "word_order", "scale", "unit",
+                                                      "access", "min", "max", "default", "persisted", "description"};
+      for (const auto& [name, i] : column)
+        if (std::find(kKnown.begin(), kKnown.end(), name) == kKnown.end()) return fail("header: unknown column '" + name + "'");
+      continue;
+    }
+    if (f.size() != column.size())
+      return fail("expected " + std::to_string(column.size()) + " fields as in the header, got " + std::to_string(f.size()));
+    auto get = [&](const char* c) { const auto it = column.find(c); return it == column.end() ? std::string() : f[static_cast<std::size_t>(it->second)]; };
+
+    RegisterEntry e;
+    e.line = line_no;
+    e.point = find_point(get("name"));
+    if (!e.point) return fail("unknown point '" + get("name") + "' (epa registers --points lists the points)");
+    const auto table = std::find_if(std::begin(kTables), std::end(kTables), [&](auto& t) { return t.second == get("table"); });
+    if (table == std::end(kTables)) return fail("table '" + get("table") + "' is not one of coil, discrete, input, holding");
+    e.table = table->first;
+    const auto address = number(get("address"));
+    if (!address || *address != std::floor(*address) || *address < 0 || *address > 65535)
+      return fail("address '" + get("address") + "' is not a whole number within 0..65535");
+    e.address = static_cast<int>(*address);
+    const auto type = std::find_if(std::begin(kTypes), std::end(kTypes), [&](auto& t) { return t.second == get("type"); });
+    if (type == std::end(kTypes)) return fail("type '" + get("type") + "' is not one of bool, uint16, int16, uint32, int32, float32");
+    e.type = type->first;
+    if (is_bit_table(e.table) != (e.type == DataType::kBool))
+      return fail(std::string("type ") + std::string(to_string(e.type)) + " does not fit the " + std::string(to_string(e.table)) +
+                  " table (bool goes in coils and discrete inputs, numbers in input and holding registers)");
+    if (e.address + e.width() > 65536) return fail("a " + std::string(to_string(e.type)) + " at address " + std::to_string(e.address) + " runs past 65535");
+    if (const auto wo = get("word_order"); !wo.empty()) {
+      auto order = core::parse_word_order(wo);
+      if (!order) return fail(order.error().message);
+      if (e.width() != 2) return fail("word_order applies to 32-bit types only");
+      e.word_order = *order;
+    }
+    if (const auto sc = get("scale"); !sc.empty()) {
+      const auto v = number(sc);
+      if (!v || *v <= 0) return fail("scale '" + sc + "' must be a number > 0");
+      if (e.type == DataType::kFloat32 || e.type == DataType::kBool) { if (*v != 1) return fail("scale applies to integer types only"); }
+      e.scale = *v;
+    }
+    const auto access = get("access");
+    if (access != "" && access != "r" && access != "rw") return fail("access '" + access + "' is not r or rw");
+    e.writable = access == "rw";
+    if (e.writable && (e.table == Table::kInputRegister || e.table == Table::kDiscreteInput))
+      return fail("access rw in the " + std::string(to_string(e.table)) + " table: Modbus cannot write it (use holding or coil)");
+    if (e.writable && !e.point->writable()) return fail("point '" + std::string(e.point->name) + "' is read-only: access must be r");
+    e.unit = column.count("unit") && !get("unit").empty() ? get("unit") : std::string(e.point->unit);
+    e.description = column.count("description") && !get("description").empty() ? get("description") : std::string(e.point->description);
+    // Range: the point's own, narrowed by the map's; it must be representable by the type.
+    const auto [type_lo, type_hi] = representable(e.type, e.scale);
+    e.min = e.point->writable() ? e.point->min : type_lo;
+    e.max = e.point->writable() ? e.point->max : type_hi;
+    for (const char* c : {"min", "max"}) {
+      const auto s = get(c);
+      if (s.empty()) continue;
+      const auto v = number(s);
+      if (!v) return fail(std::string(c) + " '" + s + "' is not a number");
+      (c[1] == 'i' ? e.min : e.max) = *v;
+    }
+    if (e.min > e.max) return fail("min " + core::format_number(e.min) + " exceeds max " + core::format_number(e.max));
+    if (e.writable && (e.min < type_lo || e.max > type_hi))
+      return fail("range [" + core::format_number(e.min) + ", " + core::format_number(e.max) + "] does not fit a " +
+                  std::string(to_string(e.type)) + " with scale " + core::format_number(e.scale) + " ([" +
+                  core::format_number(type_lo) + ", " + core::format_number(type_hi) + "])");
+    if (e.writable && (e.min < e.point->min || e.max > e.point->max))
+      return fail("range [" + core::format_number(e.min) + ", " + core::format_number(e.max) + "] goes beyond what '" +
+                  std::string(e.point->name) + "' accepts ([" + core::format_number(e.point->min) + ", " + core::format_number(e.point->max) + "])");
+    if (const auto d = get("default"); !d.empty()) {
+      const auto v = number(d);
+      if (!v) return fail("default '" + d + "' is not a number");
+      if (*v < e.min || *v > e.max)
+        return fail("default " + d + " lies outside [" + core::format_number(e.min) + ", " + core::format_number(e.max) + "]");
+      e.default_value = *v;
+    }
+    const auto persisted = get("persisted");
+    if (persisted != "" && persisted != "yes" && persisted != "no") return fail("persisted '" + persisted + "' is not yes or no");
+    e.persisted = persisted == "yes";
+    if (e.persisted && !e.writable) return fail("only writable (rw) points can be persisted");
+
+    auto& index = map.index_[static_cast<int>(e.table)];
+    if (static_cast<int>(index.size()) < e.address + e.width()) index.resize(static_cast<std::size_t>(e.address + e.width()), -1);
+    for (int a = e.address; a < e.address + e.width(); ++a) {
+      if (const auto other = index[static_cast<std::size_t>(a)]; other >= 0)
+        return fail(std::string(to_string(e.table)) + " address " + std::to_string(a) + " overlaps '" +
+                    std::string(map.entries_[static_cast<std::size_t>(other)].point->name) + "' of line " +
+                    std::to_string(map.entries_[static_cast<std::size_t>(other)].line));
+      index[static_cast<std::size_t>(a)] = static_cast<std::int32_t>(map.entries_.size());
+    }
+    map.entries_.push_back(std::move(e));
+  }
+  if (column.empty()) return core::parse_error(src + ": empty register map, expected a header row (name,table,address,type,...)");
+  if (map.entries_.empty()) return core::parse_error(src + ": the register map maps no points");
+  return map;
+}
+
+RegisterMap::Hit RegisterMap::find(Table table, int address) const noexcept {
+  const auto& index = index_[static_cast<int>(table)];
+  if (address < 0 || address >= static_cast<int>(index.size())) return {};
+  const auto i = index[static_cast<std::size_t>(address)];
+  if (i < 0) return {};
+  const RegisterEntry& e = entries_[static_cast<std::size_t>(i)];
+  return {&e, address - e.address};
+}
+
+void encode_value(const RegisterEntry& e, double v, std::uint16_t* w) noexcept {
+  auto scaled = [&](double lo, double hi, double sentinel) {
+    if (std::isnan(v)) return sentinel;
+    return std::clamp(std::round(v * e.scale), lo, hi);
+  };
+  switch (e.type) {
+    case DataType::kBool: w[0] = v != 0.0 && !std::isnan(v) ? 1 : 0; break;
+    case DataType::kUint16: w[0] = static_cast<std::uint16_t>(scaled(0, 65534, 65535)); break;
+    case DataType::kInt16: w[0] = static_cast<std::uint16_t>(static_cast<std::int16_t>(scaled(-32767, 32767, -32768))); break;
+    case DataType::kUint32: {
+      const auto r = core::encode_u32(static_cast<std::uint32_t>(scaled(0, 4294967294.0, 4294967295.0)), e.word_order);
+      w[0] = r[0], w[1] = r[1];
+      break;
+    }
+    case DataType::kInt32: {
+      const auto r = core::encode_i32(static_cast<std::int32_t>(scaled(-2147483647.0, 2147483647.0, -2147483648.0)), e.word_order);
+      w[0] = r[0], w[1] = r[1];
+      break;
+    }
+    case DataType::kFloat32: {
+      const auto r = core::encode_f32(static_cast<float>(v), e.word_order);
+      w[0] = r[0], w[1] = r[1];
+      break;
+    }
+  }
+}
+
+double decode_value(const RegisterEntry& e, const std::uint16_t* w) noexcept {
+  switch (e.type) {
+    case DataType::kBool: return w[0] ? 1.0 : 0.0;
+    case DataType::kUint16: return w[0] / e.scale;
+    case DataType::kInt16: return static_cast<std::int16_t>(w[0]) / e.scale;
+    case DataType::kUint32: return core::decode_u32({w[0], w[1]}, e.word_order) / e.scale;
+    case DataType::kInt32: return core::decode_i32({w[0], w[1]}, e.word_order) / e.scale;
+    case DataType::kFloat32: return core::decode_f32({w[0], w[1]}, e.word_order);
+  }
+  return 0.0;
+}
+
+}  // namespace epa::modbus

@@ -1,0 +1,227 @@
+#include "modbus/request_handler.hpp"
+
+#include <modbus.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace epa::modbus {
+
+namespace {
+
+constexpr std::uint8_t kIllegalFunction = MODBUS_EXCEPTION_ILLEGAL_FUNCTION;          // 01
+constexpr std::uint8_t kIllegalAddress = MODBUS_EXCEPTION_ILLEGAL_DATA_ADDRESS;       // 02
+constexpr std::uint8_t kIllegalValue = MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE;           // 03
+constexpr std::uint8_t kCannotApply = MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE;       // 04
+constexpr std::uint8_t kBusy = MODBUS_EXCEPTION_SLAVE_OR_SERVER_BUSY;                 // 06
+constexpr std::uint8_t kOtherUnit = MODBUS_EXCEPTION_GATEWAY_TARGET;                  // 0B
+constexpr int kHeader = 7;  // MBAP: transaction, protocol, length, unit
+
+int be16(const std::uint8_t* p) { return (p[0] << 8) | p[1]; }
+
+std::int64_t unix_time_ms() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+std::uint16_t* table_words(_modbus_mapping_t* m, Table t) {
+  return t == Table::kHoldingRegister ? m->tab_registers : m->tab_input_registers;
+}
+std::uint8_t* table_bits(_modbus_mapping_t* m, Table t) { return t == Table::kCoil ? m->tab_bits : m->tab_input_bits; }
+
+}  // namespace
+
+RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, int unit_id, control::ControllerConfig tuning_base,
+                               double mm_per_volt, runtime::LoopChannels& channels, core::AuditSink* audit)
+    : map_(map), policy_(std::move(policy)), unit_id_(unit_id), tuning_base_(std::move(tuning_base)),
+      mm_per_volt_(mm_per_volt), channels_(channels), audit_(audit) {}
+
+ServerStatus RequestHandler::status(std::int64_t now_ns) const {
+  return {change_counter_, requests_, clients_, now_ns >= unlocked_until_ns_};
+}
+
+std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, const std::string& client, std::int64_t now_ns,
+                                    _modbus_mapping_t* image) {
+  ++requests_;
+  if (length < kHeader + 1) return kIllegalFunction;
+  const int unit = req[6];
+  if (unit != unit_id_ && unit != 0xFF) return kOtherUnit;  // 0xFF: "the server itself" on TCP
+  const int fc = req[kHeader];
+  const std::uint8_t* d = req + kHeader + 1;
+  const int data_length = length - kHeader - 1;
+  const runtime::Snapshot snap = channels_.snapshot.read();
+  std::vector<Write> writes;
+
+  switch (fc) {
+    case MODBUS_FC_READ_COILS:
+    case MODBUS_FC_READ_DISCRETE_INPUTS:
+    case MODBUS_FC_READ_HOLDING_REGISTERS:
+    case MODBUS_FC_READ_INPUT_REGISTERS: {
+      if (data_length < 4) return kIllegalValue;
+      const Table t = fc == 1 ? Table::kCoil : fc == 2 ? Table::kDiscreteInput : fc == 3 ? Table::kHoldingRegister : Table::kInputRegister;
+      return read_into(t, be16(d), be16(d + 2), snap, now_ns, image);
+    }
+    case MODBUS_FC_WRITE_SINGLE_COIL: {
+      if (data_length < 4) return kIllegalValue;
+      const int v = be16(d + 2);
+      if (v != 0xFF00 && v != 0x0000) return kIllegalValue;
+      const std::uint8_t bit[1] = {static_cast<std::uint8_t>(v == 0xFF00 ? 1 : 0)};
+      if (auto e = collect_coil_writes(be16(d), 1, bit, writes)) return e;
+      return apply_writes(writes, client, snap, now_ns);
+    }
+    case MODBUS_FC_WRITE_SINGLE_REGISTER: {
+      if (data_length < 4) return kIllegalValue;
+      if (auto e = collect_register_writes(be16(d), 1, d + 2, writes)) return e;
+      return apply_writes(writes, client, snap, now_ns);
+    }
+    case MODBUS_FC_WRITE_MULTIPLE_COILS: {
+      if (data_length < 5) return kIllegalValue;
+      const int quantity = be16(d + 2);
+      if (quantity < 1 || quantity > MODBUS_MAX_WRITE_BITS || d[4] != (quantity + 7) / 8 || data_length < 5 + d[4]) return kIllegalValue;
+      std::vector<std::uint8_t> bits(static_cast<std::size_t>(quantity));
+      for (int i = 0; i < quantity; ++i) bits[static_cast<std::size_t>(i)] = (d[5 + i / 8] >> (i % 8)) & 1;
+      if (auto e = collect_coil_writes(be16(d), quantity, bits.data(), writes)) return e;
+      return apply_writes(writes, client, snap, now_ns);
+    }
+    case MODBUS_FC_WRITE_MULTIPLE_REGISTERS: {
+      if (data_length < 5) return kIllegalValue;
+      const int quantity = be16(d + 2);
+      if (quantity < 1 || quantity > MODBUS_MAX_WRITE_REGISTERS || d[4] != quantity * 2 || data_length < 5 + d[4]) return kIllegalValue;
+      if (auto e = collect_register_writes(be16(d), quantity, d + 5, writes)) return e;
+      return apply_writes(writes, client, snap, now_ns);
+    }
+    case MODBUS_FC_WRITE_AND_READ_REGISTERS: {
+      if (data_length < 9) return kIllegalValue;
+      const int read_quantity = be16(d + 2), write_quantity = be16(d + 6);
+      if (read_quantity < 1 || read_quantity > MODBUS_MAX_WR_READ_REGISTERS || write_quantity < 1 ||
+          write_quantity > MODBUS_MAX_WR_WRITE_REGISTERS || d[8] != write_quantity * 2 || data_length < 9 + d[8])
+        return kIllegalValue;
+      if (auto e = collect_register_writes(be16(d + 4), write_quantity, d + 9, writes)) return e;
+      // The read part must be valid too before anything is applied.
+      for (int a = be16(d); a < be16(d) + read_quantity; ++a)
+        if (!map_.find(Table::kHoldingRegister, a).entry) return kIllegalAddress;
+      if (auto e = apply_writes(writes, client, snap, now_ns)) return e;
+      // modbus_reply writes first, then reads: the answer shows the written values.
+      return read_into(Table::kHoldingRegister, be16(d), read_quantity, snap, now_ns, image);
+    }
+    default: return kIllegalFunction;
+  }
+}
+
+std::uint8_t RequestHandler::read_into(Table t, int address, int quantity, const runtime::Snapshot& snap, std::int64_t now_ns,
+                                       _modbus_mapping_t* image) {
+  const int max = is_bit_table(t) ? MODBUS_MAX_READ_BITS : MODBUS_MAX_READ_REGISTERS;
+  if (quantity < 1 || quantity > max) return kIllegalValue;
+  if (address + quantity > 65536) return kIllegalAddress;
+  const ServerStatus server = status(now_ns);
+  const PointContext ctx{snap, server};
+  for (int a = address; a < address + quantity;) {
+    const auto hit = map_.find(t, a);
+    if (!hit.entry) return kIllegalAddress;
+    const RegisterEntry& e = *hit.entry;
+    const double value = e.point->read(ctx, e.point->index);
+    if (is_bit_table(t)) {
+      table_bits(image, t)[e.address] = value != 0.0 ? 1 : 0;
+    } else {
+      encode_value(e, value, table_words(image, t) + e.address);  // the whole value, even if half is asked
+    }
+    a = e.address + e.width();
+  }
+  return 0;
+}
+
+std::uint8_t RequestHandler::collect_register_writes(int address, int quantity, const std::uint8_t* bytes,
+                                                     std::vector<Write>& out) const {
+  if (address + quantity > 65536) return kIllegalAddress;
+  for (int a = address; a < address + quantity;) {
+    const auto hit = map_.find(Table::kHoldingRegister, a);
+    if (!hit.entry || !hit.entry->writable) return kIllegalAddress;
+    const RegisterEntry& e = *hit.entry;
+    if (hit.offset != 0 || e.address + e.width() > address + quantity) return kIllegalValue;  // half a 32-bit value
+    std::uint16_t words[2] = {};
+    for (int i = 0; i < e.width(); ++i) words[i] = static_cast<std::uint16_t>(be16(bytes + 2 * (a - address + i)));
+    out.push_back({&e, decode_value(e, words)});
+    a += e.width();
+  }
+  return 0;
+}
+
+std::uint8_t RequestHandler::collect_coil_writes(int address, int quantity, const std::uint8_t* bits, std::vector<Write>& out) const {
+  if (address + quantity > 65536) return kIllegalAddress;
+  for (int i = 0; i < quantity; ++i) {
+    const auto hit = map_.find(Table::kCoil, address + i);
+    if (!hit.entry || !hit.entry->writable) return kIllegalAddress;
+    out.push_back({hit.entry, bits[i] ? 1.0 : 0.0});
+  }
+  return 0;
+}
+
+std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, const std::string& client,
+                                          const runtime::Snapshot& snap, std::int64_t now_ns) {
+  // 1. Values: within range, whole numbers where the point is an enumeration, counter or key.
+  for (const auto& w : writes) {
+    if (!(w.value >= w.entry->min && w.value <= w.entry->max)) return kIllegalValue;
+    if (w.entry->point->integer && w.value != std::floor(w.value)) return kIllegalValue;
+  }
+  // 2. Policy: read-only server, clients allowed to write, tuning lock, mode.
+  if (policy_.read_only) return kCannotApply;
+  if (!policy_.write_clients.empty() &&
+      std::find(policy_.write_clients.begin(), policy_.write_clients.end(), client) == policy_.write_clients.end())
+    return kCannotApply;
+  const bool unlocked = now_ns < unlocked_until_ns_;
+  for (const auto& w : writes) {
+    if (w.entry->point->tuning() && !unlocked) return kCannotApply;
+    if (w.entry->point->write == WriteEffect::kManualValve && snap.mode != runtime::Mode::kManual) return kCannotApply;
+    if (w.entry->point->write == WriteEffect::kMode && snap.mode == runtime::Mode::kFault) return kCannotApply;
+  }
+  // 3. Commands, all of them or none.
+  std::vector<runtime::Command> commands;
+  control::ControllerConfig tuning = tuning_base_;
+  bool tuning_changed = false;
+  std::int64_t unlock_until = unlocked_until_ns_;
+  for (const auto& w : writes) {
+    switch (w.entry->point->write) {
+      case WriteEffect::kSetpoint: commands.push_back(runtime::setpoint_command(w.value)); break;
+      case WriteEffect::kMode: commands.push_back(runtime::mode_command(static_cast<runtime::Mode>(static_cast<int>(w.value)))); break;
+      case WriteEffect::kController:
+        commands.push_back(runtime::controller_command(static_cast<control::ControllerKind>(static_cast<int>(w.value))));
+        break;
+      case WriteEffect::kManualValve: commands.push_back(runtime::manual_valve_command(w.value)); break;
+      case WriteEffect::kReset: commands.push_back(runtime::reset_command()); break;
+      case WriteEffect::kHeartbeat: commands.push_back(runtime::heartbeat_command(static_cast<std::uint32_t>(w.value))); break;
+      case WriteEffect::kRecord: commands.push_back(runtime::record_command(w.value)); break;
+      case WriteEffect::kUnlock:
+        if (policy_.unlock_key == 0 || w.value != policy_.unlock_key) return kIllegalValue;
+        unlock_until = now_ns + static_cast<std::int64_t>(policy_.unlock_timeout_s * 1e9);
+        break;
+      case WriteEffect::kDeadZoneMr: tuning.dead_zone.m_r = w.value, tuning_changed = true; break;
+      case WriteEffect::kDeadZoneMl: tuning.dead_zone.m_l = w.value, tuning_changed = true; break;
+      case WriteEffect::kDeadZoneBr: tuning.dead_zone.b_r = w.value, tuning_changed = true; break;
+      case WriteEffect::kDeadZoneBl: tuning.dead_zone.b_l = w.value, tuning_changed = true; break;
+      case WriteEffect::kLc: tuning.lc_v = w.value / mm_per_volt_, tuning_changed = true; break;
+      case WriteEffect::kNone: return kIllegalAddress;
+    }
+  }
+  if (tuning_changed) {
+    auto t = runtime::make_tuning(tuning);  // e.g. b_l > b_r after this write: refused whole
+    if (!t) return kIllegalValue;
+    commands.push_back(runtime::tuning_command(*t));
+  }
+  if (!commands.empty() && !channels_.commands.try_push_all(commands.data(), commands.size())) return kBusy;
+  // 4. Accepted: the lock, the tuning base, the counter and the audit trail follow.
+  unlocked_until_ns_ = unlock_until;
+  if (tuning_changed) tuning_base_ = tuning;
+  ++change_counter_;
+  if (audit_) {
+    const ServerStatus server = status(now_ns);
+    const PointContext ctx{snap, server};
+    for (const auto& w : writes) {
+      if (w.entry->point->write == WriteEffect::kUnlock) continue;  // never log the key
+      audit_->record({unix_time_ms(), "modbus " + client, std::string(w.entry->point->name),
+                      w.entry->point->read(ctx, w.entry->point->index), w.value});
+    }
+  }
+  return 0;
+}
+
+}  // namespace epa::modbus

@@ -1,0 +1,73 @@
+#pragma once
+// The Modbus application layer, without sockets: one request ADU in, an exception code or a
+// filled register image out (libmodbus' modbus_reply then builds the answer). Reads encode the
+// published snapshot; writes are validated whole (mapped, writable, whole 32-bit values, ranges,
+// write protection, mode) and sent to the scan cycle as one command group that is applied in one
+// cycle or not at all.
+//
+// Exceptions: 01 unsupported function; 02 unmapped address or write to a read-only register;
+// 03 bad quantity, a value outside min/max, a write that covers only part of a 32-bit value, a
+// wrong unlock key, or tuning values that do not validate together; 04 the write cannot be
+// applied (server read-only, client not allowed to write, tuning locked, wrong mode);
+// 06 the command queue is full (busy); 0B a request for another unit id.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "control/controller.hpp"
+#include "core/audit.hpp"
+#include "modbus/register_map.hpp"
+#include "runtime/scan_cycle.hpp"
+
+struct _modbus_mapping_t;  // libmodbus' register image (modbus_mapping_t)
+
+namespace epa::modbus {
+
+struct WritePolicy {
+  bool read_only = false;                  // refuse every write (exception 04)
+  std::uint16_t unlock_key = 0;            // 0: tuning registers can never be unlocked
+  double unlock_timeout_s = 60.0;          // tuning stays writable this long after the key
+  std::vector<std::string> write_clients;  // IPv4 addresses allowed to write; empty: any
+};
+
+class RequestHandler {
+ public:
+  // `tuning_base` is the configuration the running tuning was made from (tuning writes edit it).
+  RequestHandler(const RegisterMap& map, WritePolicy policy, int unit_id, control::ControllerConfig tuning_base,
+                 double mm_per_volt, runtime::LoopChannels& channels, core::AuditSink* audit);
+
+  // `req` is a whole Modbus TCP ADU (7-byte MBAP header, then the PDU). Returns 0 when `image`
+  // holds what modbus_reply needs for the answer, else the exception code to send.
+  std::uint8_t handle(const std::uint8_t* req, int length, const std::string& client, std::int64_t now_ns,
+                      _modbus_mapping_t* image);
+
+  ServerStatus status(std::int64_t now_ns) const;
+  void set_clients(int n) { clients_ = n; }
+  const RegisterMap& map() const { return map_; }
+
+ private:
+  struct Write {
+    const RegisterEntry* entry;
+    double value;
+  };
+  std::uint8_t read_into(Table table, int address, int quantity, const runtime::Snapshot& snap, std::int64_t now_ns,
+                         _modbus_mapping_t* image);
+  std::uint8_t collect_register_writes(int address, int quantity, const std::uint8_t* bytes, std::vector<Write>& out) const;
+  std::uint8_t collect_coil_writes(int address, int quantity, const std::uint8_t* bits, std::vector<Write>& out) const;
+  std::uint8_t apply_writes(const std::vector<Write>& writes, const std::string& client, const runtime::Snapshot& snap,
+                            std::int64_t now_ns);
+
+  const RegisterMap& map_;
+  WritePolicy policy_;
+  int unit_id_;
+  control::ControllerConfig tuning_base_;
+  double mm_per_volt_;
+  runtime::LoopChannels& channels_;
+  core::AuditSink* audit_;
+  std::int64_t unlocked_until_ns_ = 0;
+  std::uint32_t change_counter_ = 0;
+  std::uint64_t requests_ = 0;
+  int clients_ = 0;
+};
+
+}  // namespace epa::modbus

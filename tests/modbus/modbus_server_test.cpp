@@ -1,0 +1,230 @@
+// The server over real sockets on loopback, with a libmodbus client: every function code and
+// exception path, locked and unlocked writes, a half-float write, the unit id, the client cap, an
+// idle client, a client that sends one byte at a time and one that sends garbage. Floats are
+// encoded with our own pinned encoder: libmodbus 3.1.6's modbus_set_float_abcd gets ABCD wrong.
+#include "modbus/modbus_server.hpp"
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <modbus.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+#include "control/paper_controller.hpp"
+#include "core/word_order.hpp"
+
+namespace epa::modbus {
+namespace {
+
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+class Server : public ::testing::Test {
+ protected:
+  void start(ServerConfig c) {
+    auto m = RegisterMap::load(std::string(EPA_SOURCE_DIR) + "/registers/epa.csv");
+    ASSERT_TRUE(m.has_value()) << m.error().message;
+    map_ = std::make_unique<RegisterMap>(std::move(*m));
+    runtime::Snapshot s;
+    s.position_mm = 123.5;
+    s.mode = runtime::Mode::kRun;
+    s.saturated = true;
+    channels_.snapshot.publish(s);
+    c.address = "127.0.0.1";
+    c.port = 0;
+    auto server = ModbusServer::start(c, *map_, control::paper_controller_config(control::ControllerKind::kPpFfidz), 50.0,
+                                      channels_, nullptr);
+    ASSERT_TRUE(server.has_value()) << server.error().message;
+    server_ = std::move(*server);
+  }
+  void SetUp() override {
+    ServerConfig c;
+    c.max_clients = 3;
+    c.idle_timeout_s = 0.3;
+    c.policy.unlock_key = 4321;
+    start(c);
+  }
+  modbus_t* client(int unit = 1) {
+    modbus_t* ctx = modbus_new_tcp("127.0.0.1", server_->port());
+    modbus_set_slave(ctx, unit);
+    modbus_set_response_timeout(ctx, 1, 0);
+    EXPECT_EQ(modbus_connect(ctx), 0) << modbus_strerror(errno);
+    clients_.push_back(ctx);
+    return ctx;
+  }
+  int raw_socket() {
+    const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<std::uint16_t>(server_->port()));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    EXPECT_EQ(connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+    raw_.push_back(fd);
+    return fd;
+  }
+  void TearDown() override {
+    for (auto* c : clients_) { modbus_close(c); modbus_free(c); }
+    for (int fd : raw_) close(fd);
+    if (server_) server_->stop();
+  }
+  int drained() {
+    int n = 0;
+    runtime::Command c;
+    while (channels_.commands.try_pop(c)) ++n;
+    return n;
+  }
+
+  runtime::LoopChannels channels_{16};
+  std::unique_ptr<RegisterMap> map_;
+  std::unique_ptr<ModbusServer> server_;
+  std::vector<modbus_t*> clients_;
+  std::vector<int> raw_;
+};
+
+TEST_F(Server, EveryFunctionCode) {
+  modbus_t* c = client();
+  std::uint8_t bits[4] = {};
+  std::uint16_t regs[4] = {};
+  ASSERT_EQ(modbus_read_bits(c, 0, 1, bits), 1);                  // FC1: reset coil reads 0
+  EXPECT_EQ(bits[0], 0);
+  ASSERT_EQ(modbus_read_input_bits(c, 0, 4, bits), 4);            // FC2: fault_active, saturated, io_ok, locked
+  EXPECT_EQ(bits[1], 1);
+  EXPECT_EQ(bits[3], 1);
+  ASSERT_EQ(modbus_read_registers(c, 2, 1, regs), 1);             // FC3: mode
+  EXPECT_EQ(regs[0], 1);
+  ASSERT_EQ(modbus_read_input_registers(c, 0, 2, regs), 2);       // FC4: position
+  EXPECT_EQ(core::decode_f32({regs[0], regs[1]}, core::WordOrder::kABCD), 123.5f);
+  EXPECT_EQ(modbus_write_bit(c, 0, 1), 1);                        // FC5: reset
+  EXPECT_EQ(modbus_write_register(c, 2, 0), 1);                   // FC6: mode stop
+  const std::uint8_t one[1] = {1};
+  EXPECT_EQ(modbus_write_bits(c, 0, 1, one), 1);                  // FC15: reset
+  const auto setpoint_words = core::encode_f32(250.0f, core::WordOrder::kABCD);
+  std::uint16_t setpoint[2] = {setpoint_words[0], setpoint_words[1]};
+  EXPECT_EQ(modbus_write_registers(c, 0, 2, setpoint), 2) << modbus_strerror(errno);  // FC16: setpoint
+  std::uint16_t back[2] = {};
+  EXPECT_EQ(modbus_write_and_read_registers(c, 0, 2, setpoint, 0, 2, back), 2);  // FC23
+  EXPECT_EQ(core::decode_f32({back[0], back[1]}, core::WordOrder::kABCD), 250.0f);
+  EXPECT_EQ(drained(), 5);
+  EXPECT_EQ(server_->exceptions(), 0u);
+}
+
+TEST_F(Server, EveryExceptionPath) {
+  modbus_t* c = client();
+  std::uint16_t regs[130] = {};
+  EXPECT_EQ(modbus_read_registers(c, 200, 1, regs), -1);
+  EXPECT_EQ(errno, EMBXILADD);  // 02 unmapped
+  EXPECT_EQ(modbus_write_register(c, 0, 0x4248), -1);
+  EXPECT_EQ(errno, EMBXILVAL);  // 03 half a float
+  const auto too_far_words = core::encode_f32(900.0f, core::WordOrder::kABCD);
+  std::uint16_t too_far[2] = {too_far_words[0], too_far_words[1]};
+  EXPECT_EQ(modbus_write_registers(c, 0, 2, too_far), -1);
+  EXPECT_EQ(errno, EMBXILVAL);  // 03 above max
+  const auto lc_words = core::encode_f32(3.0f, core::WordOrder::kABCD);
+  std::uint16_t lc[2] = {lc_words[0], lc_words[1]};
+  EXPECT_EQ(modbus_write_registers(c, 28, 2, lc), -1);
+  EXPECT_EQ(errno, EMBXSFAIL);  // 04 tuning locked
+  const std::uint8_t raw_function[] = {0x01, 0x2B, 0x0E, 0x01, 0x00};  // unit 1, then the PDU
+  ASSERT_GT(modbus_send_raw_request(c, const_cast<std::uint8_t*>(raw_function), sizeof raw_function), 0);
+  std::uint8_t rsp[MODBUS_TCP_MAX_ADU_LENGTH];
+  EXPECT_EQ(modbus_receive_confirmation(c, rsp), 9);
+  EXPECT_EQ(rsp[7], 0x2B | 0x80);
+  EXPECT_EQ(rsp[8], 0x01);      // 01 illegal function
+  EXPECT_EQ(drained(), 0);
+}
+
+TEST_F(Server, TuningWritesAfterUnlock) {
+  modbus_t* c = client();
+  EXPECT_EQ(modbus_write_register(c, 9, 4321), 1);
+  const auto lc_words = core::encode_f32(3.0f, core::WordOrder::kABCD);
+  std::uint16_t lc[2] = {lc_words[0], lc_words[1]};
+  EXPECT_EQ(modbus_write_registers(c, 28, 2, lc), 2);
+  runtime::Command cmd;
+  ASSERT_TRUE(channels_.commands.try_pop(cmd));
+  EXPECT_EQ(cmd.kind, runtime::CommandKind::kTuning);
+  std::uint8_t locked = 1;
+  ASSERT_EQ(modbus_read_input_bits(c, 3, 1, &locked), 1);
+  EXPECT_EQ(locked, 0);
+}
+
+TEST_F(Server, OtherUnitIdGetsGatewayException) {
+  modbus_t* c = client(7);
+  std::uint16_t r[2];
+  EXPECT_EQ(modbus_read_input_registers(c, 0, 2, r), -1);
+  EXPECT_EQ(errno, EMBXGTAR);
+}
+
+TEST_F(Server, ClientsOverTheCapAreRefusedAndTheOthersKeepWorking) {
+  modbus_t* a = client();
+  modbus_t* b = client();
+  modbus_t* c = client();
+  std::uint16_t r[2];
+  for (auto* ctx : {a, b, c}) ASSERT_EQ(modbus_read_input_registers(ctx, 0, 2, r), 2);
+  modbus_t* d = modbus_new_tcp("127.0.0.1", server_->port());
+  clients_.push_back(d);
+  modbus_set_response_timeout(d, 0, 500000);
+  modbus_connect(d);  // the TCP handshake completes; the server then closes it
+  EXPECT_EQ(modbus_read_input_registers(d, 0, 2, r), -1);
+  EXPECT_EQ(modbus_read_input_registers(a, 0, 2, r), 2);
+  EXPECT_EQ(server_->clients(), 3);
+}
+
+TEST_F(Server, AnIdleClientIsDisconnected) {
+  const int fd = raw_socket();
+  char byte = 0;
+  const auto until = Clock::now() + 3s;  // idle timeout 0.3 s; bounded wait
+  timeval tv{0, 100000};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  ssize_t n = -1;
+  while (Clock::now() < until && (n = recv(fd, &byte, 1, 0)) < 0) {
+  }
+  EXPECT_EQ(n, 0);  // orderly close by the server
+}
+
+TEST_F(Server, AClientSendingOneByteAtATimeDoesNotBlockOthers) {
+  const int slow = raw_socket();
+  const std::uint8_t frame[] = {0x00, 0x01, 0x00, 0x00, 0x00, 0x06, 0x01, 0x04, 0x00, 0x00, 0x00, 0x02};
+  ASSERT_EQ(send(slow, frame, 3, 0), 3);  // a partial header, then nothing for a while
+  modbus_t* fast = client();
+  std::uint16_t r[2];
+  const auto t0 = Clock::now();
+  EXPECT_EQ(modbus_read_input_registers(fast, 0, 2, r), 2);
+  EXPECT_LT(Clock::now() - t0, 50ms);
+  for (std::size_t i = 3; i < sizeof frame; ++i) ASSERT_EQ(send(slow, frame + i, 1, 0), 1);  // the rest, byte by byte
+  std::uint8_t rsp[13] = {};
+  timeval tv{2, 0};
+  setsockopt(slow, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  EXPECT_EQ(recv(slow, rsp, sizeof rsp, MSG_WAITALL), 13);  // then it is answered like anyone
+  EXPECT_EQ(rsp[8], 4);  // byte count of two registers
+}
+
+TEST_F(Server, GarbageClosesOnlyThatClient) {
+  const int bad = raw_socket();
+  const std::uint8_t junk[] = {0x12, 0x34, 0xAB, 0xCD, 0x00, 0x06, 0x01, 0x03, 0x00, 0x00, 0x00, 0x01};
+  ASSERT_EQ(send(bad, junk, sizeof junk, 0), static_cast<ssize_t>(sizeof junk));
+  char byte = 0;
+  timeval tv{2, 0};
+  setsockopt(bad, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  EXPECT_EQ(recv(bad, &byte, 1, 0), 0);  // closed, no answer
+  modbus_t* good = client();
+  std::uint16_t r[2];
+  EXPECT_EQ(modbus_read_input_registers(good, 0, 2, r), 2);
+}
+
+TEST_F(Server, ReadOnlyServerRefusesEveryWrite) {
+  server_->stop();
+  ServerConfig c;
+  c.policy.read_only = true;
+  start(c);
+  modbus_t* ctx = client();
+  EXPECT_EQ(modbus_write_register(ctx, 2, 1), -1);
+  EXPECT_EQ(errno, EMBXSFAIL);
+  std::uint16_t r[2];
+  EXPECT_EQ(modbus_read_input_registers(ctx, 0, 2, r), 2);
+}
+
+}  // namespace
+}  // namespace epa::modbus

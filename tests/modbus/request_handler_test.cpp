@@ -1,0 +1,194 @@
+// The Modbus application layer without sockets: hand-built ADUs in, exception codes, register
+// images and queued commands out. Expected words are worked out by hand (50.0f = 0x42480000).
+#include "modbus/request_handler.hpp"
+
+#include <gtest/gtest.h>
+#include <modbus.h>
+
+#include "control/paper_controller.hpp"
+
+namespace epa::modbus {
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+constexpr std::int64_t kSecond = 1'000'000'000;
+
+Bytes adu(const Bytes& pdu, std::uint8_t unit = 1) {
+  Bytes a = {0x00, 0x01, 0x00, 0x00, 0x00, static_cast<std::uint8_t>(pdu.size() + 1), unit};
+  a.insert(a.end(), pdu.begin(), pdu.end());
+  return a;
+}
+
+struct RecordingSink final : core::AuditSink {
+  std::vector<core::AuditEntry> entries;
+  void record(const core::AuditEntry& e) override { entries.push_back(e); }
+};
+
+class Handler : public ::testing::Test {
+ protected:
+  void SetUp() override { make(WritePolicy{.read_only = false, .unlock_key = 4321, .unlock_timeout_s = 10, .write_clients = {}}); }
+  void make(WritePolicy policy) {
+    auto m = RegisterMap::load(std::string(EPA_SOURCE_DIR) + "/registers/epa.csv");
+    ASSERT_TRUE(m.has_value()) << m.error().message;
+    map_ = std::make_unique<RegisterMap>(std::move(*m));
+    handler_ = std::make_unique<RequestHandler>(*map_, std::move(policy), 1,
+                                                control::paper_controller_config(control::ControllerKind::kPpFfidz), 50.0,
+                                                channels_, &sink_);
+    if (image_) modbus_mapping_free(image_);
+    image_ = modbus_mapping_new_start_address(0, map_->end_address(Table::kCoil), 0, map_->end_address(Table::kDiscreteInput), 0,
+                                              map_->end_address(Table::kHoldingRegister), 0, map_->end_address(Table::kInputRegister));
+    publish();
+  }
+  void TearDown() override { modbus_mapping_free(image_); }
+  void publish() { channels_.snapshot.publish(snap_); }
+  std::uint8_t send(const Bytes& pdu, std::uint8_t unit = 1, const std::string& client = "127.0.0.1", std::int64_t now = 0) {
+    const Bytes a = adu(pdu, unit);
+    return handler_->handle(a.data(), static_cast<int>(a.size()), client, now, image_);
+  }
+  std::vector<runtime::Command> drain() {
+    std::vector<runtime::Command> out;
+    runtime::Command c;
+    while (channels_.commands.try_pop(c)) out.push_back(c);
+    return out;
+  }
+
+  runtime::Snapshot snap_ = [] {
+    runtime::Snapshot s;
+    s.position_mm = 123.5;
+    s.mode = runtime::Mode::kRun;
+    s.setpoint_mm = 100.0;
+    s.tuning.b_r = 1.232;
+    s.tuning.b_l = -1.722;
+    return s;
+  }();
+  runtime::LoopChannels channels_{16};
+  RecordingSink sink_;
+  std::unique_ptr<RegisterMap> map_;
+  std::unique_ptr<RequestHandler> handler_;
+  modbus_mapping_t* image_ = nullptr;
+};
+
+TEST_F(Handler, ReadsThePositionFloatFromTheSnapshot) {
+  EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x02}), 0);
+  EXPECT_EQ(image_->tab_input_registers[0], 0x42F7);  // 123.5f
+  EXPECT_EQ(image_->tab_input_registers[1], 0x0000);
+}
+
+TEST_F(Handler, ReadExceptions) {
+  EXPECT_EQ(send({0x03, 0x00, 0xC8, 0x00, 0x01}), 0x02);  // holding 200: unmapped
+  EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x0C}), 0x02);  // input 0..11: 11 is a gap
+  EXPECT_EQ(send({0x03, 0x00, 0x00, 0x00, 0x00}), 0x03);  // quantity 0
+  EXPECT_EQ(send({0x03, 0x00, 0x00, 0x00, 0x7E}), 0x03);  // quantity 126 > 125
+  EXPECT_EQ(send({0x2B, 0x0E, 0x01, 0x00}), 0x01);        // device identification: not supported
+  EXPECT_EQ(send({0x08, 0x00, 0x00, 0x12, 0x34}), 0x01);  // diagnostics: not supported
+}
+
+TEST_F(Handler, UnitIdIsChecked) {
+  EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x02}, 7), 0x0B);
+  EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x02}, 0xFF), 0);
+}
+
+TEST_F(Handler, SetpointWriteQueuesOneCommandAndIsAudited) {
+  EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x42, 0x48, 0x00, 0x00}), 0);  // 50.0f
+  const auto c = drain();
+  ASSERT_EQ(c.size(), 1u);
+  EXPECT_EQ(c[0].kind, runtime::CommandKind::kSetpoint);
+  EXPECT_EQ(c[0].value, 50.0);
+  EXPECT_EQ(handler_->status(0).change_counter, 1u);
+  ASSERT_EQ(sink_.entries.size(), 1u);
+  EXPECT_EQ(sink_.entries[0].point, "setpoint_mm");
+  EXPECT_EQ(sink_.entries[0].old_value, 100.0);
+  EXPECT_EQ(sink_.entries[0].new_value, 50.0);
+  EXPECT_EQ(sink_.entries[0].source, "modbus 127.0.0.1");
+}
+
+TEST_F(Handler, HalfAFloatIsRefusedAndNothingIsQueued) {
+  EXPECT_EQ(send({0x06, 0x00, 0x00, 0x42, 0x48}), 0x03);                    // FC6 on the first half
+  EXPECT_EQ(send({0x10, 0x00, 0x01, 0x00, 0x01, 0x02, 0x00, 0x00}), 0x03);  // FC16 on the second half
+  EXPECT_TRUE(drain().empty());
+  EXPECT_EQ(handler_->status(0).change_counter, 0u);
+}
+
+TEST_F(Handler, ValueOutsideTheRangeIs03) {
+  EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x44, 0x16, 0x00, 0x00}), 0x03);  // 600.0f > 500
+  EXPECT_EQ(send({0x06, 0x00, 0x02, 0x00, 0x03}), 0x03);                                // mode 3
+  EXPECT_TRUE(drain().empty());
+}
+
+TEST_F(Handler, WriteToAnUnmappedRegisterIs02) {
+  EXPECT_EQ(send({0x06, 0x00, 0x0C, 0x00, 0x01}), 0x02);  // holding 12: not mapped
+}
+
+TEST_F(Handler, ABlockWriteArrivesAsOneGroup) {
+  // setpoint (0-1) = 50.0 and mode (2) = 1 in one FC16.
+  EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x03, 0x06, 0x42, 0x48, 0x00, 0x00, 0x00, 0x01}), 0);
+  const auto c = drain();
+  ASSERT_EQ(c.size(), 2u);
+  EXPECT_EQ(c[0].kind, runtime::CommandKind::kSetpoint);
+  EXPECT_EQ(c[1].kind, runtime::CommandKind::kMode);
+  EXPECT_EQ(c[1].mode, runtime::Mode::kRun);
+  EXPECT_EQ(handler_->status(0).change_counter, 1u);  // one accepted write request
+}
+
+TEST_F(Handler, TuningIsLockedUntilTheKeyThenLocksAgain) {
+  const Bytes lc = {0x10, 0x00, 0x1C, 0x00, 0x02, 0x04, 0x40, 0x40, 0x00, 0x00};  // lc_mm = 3.0f
+  EXPECT_EQ(send(lc), 0x04);
+  EXPECT_EQ(send({0x06, 0x00, 0x09, 0x00, 0x01}), 0x03);  // wrong key
+  EXPECT_EQ(send({0x06, 0x00, 0x09, 0x10, 0xE1}, 1, "127.0.0.1", 0), 0);  // 4321
+  EXPECT_FALSE(handler_->status(kSecond).locked);
+  EXPECT_EQ(send(lc, 1, "127.0.0.1", kSecond), 0);
+  const auto c = drain();
+  ASSERT_EQ(c.size(), 1u);
+  EXPECT_EQ(c[0].kind, runtime::CommandKind::kTuning);
+  EXPECT_DOUBLE_EQ(c[0].tuning.ffidz.lc_v(), 3.0 / 50.0);
+  EXPECT_EQ(send(lc, 1, "127.0.0.1", 11 * kSecond), 0x04);  // the 10 s unlock has run out
+  for (const auto& e : sink_.entries) EXPECT_NE(e.point, "unlock");  // the key is never logged
+}
+
+TEST_F(Handler, TuningValuesThatDoNotValidateTogetherAreRefusedWhole) {
+  ASSERT_EQ(send({0x06, 0x00, 0x09, 0x10, 0xE1}), 0);
+  // b_l (26-27) = 2.0f > b_r = 1.232: the dead zone would be invalid.
+  EXPECT_EQ(send({0x10, 0x00, 0x1A, 0x00, 0x02, 0x04, 0x40, 0x00, 0x00, 0x00}), 0x03);
+  EXPECT_TRUE(drain().empty());
+}
+
+TEST_F(Handler, PolicyRefusalsAre04) {
+  make(WritePolicy{.read_only = true, .unlock_key = 0, .unlock_timeout_s = 10, .write_clients = {}});
+  EXPECT_EQ(send({0x06, 0x00, 0x02, 0x00, 0x01}), 0x04);
+  make(WritePolicy{.read_only = false, .unlock_key = 0, .unlock_timeout_s = 10, .write_clients = {"10.0.0.5"}});
+  EXPECT_EQ(send({0x06, 0x00, 0x02, 0x00, 0x01}, 1, "127.0.0.1"), 0x04);
+  EXPECT_EQ(send({0x06, 0x00, 0x02, 0x00, 0x01}, 1, "10.0.0.5"), 0);
+  EXPECT_EQ(send({0x06, 0x00, 0x09, 0x00, 0x00}, 1, "10.0.0.5"), 0x03);  // no key configured: never unlocks
+}
+
+TEST_F(Handler, ModeDependentWritesAre04) {
+  EXPECT_EQ(send({0x10, 0x00, 0x04, 0x00, 0x02, 0x04, 0x3F, 0x80, 0x00, 0x00}), 0x04);  // manual valve in RUN
+  snap_.mode = runtime::Mode::kManual;
+  publish();
+  EXPECT_EQ(send({0x10, 0x00, 0x04, 0x00, 0x02, 0x04, 0x3F, 0x80, 0x00, 0x00}), 0);
+  snap_.mode = runtime::Mode::kFault;
+  publish();
+  EXPECT_EQ(send({0x06, 0x00, 0x02, 0x00, 0x01}), 0x04);  // mode while a fault is latched: reset first
+  EXPECT_EQ(send({0x05, 0x00, 0x00, 0xFF, 0x00}), 0);     // reset coil
+  EXPECT_EQ(drain().back().kind, runtime::CommandKind::kReset);
+}
+
+TEST_F(Handler, AFullCommandQueueIsBusy06) {
+  for (std::size_t i = 0; i < runtime::kCommandQueueCapacity; ++i) ASSERT_TRUE(channels_.commands.try_push(runtime::heartbeat_command(1)));
+  EXPECT_EQ(send({0x06, 0x00, 0x02, 0x00, 0x01}), 0x06);
+}
+
+TEST_F(Handler, CoilValuesOtherThanOnOrOffAre03) {
+  EXPECT_EQ(send({0x05, 0x00, 0x00, 0x12, 0x34}), 0x03);
+}
+
+TEST_F(Handler, WriteAndReadInOneRequest) {
+  // FC23: read holding 0-1, write setpoint 0-1 = 50.0f.
+  EXPECT_EQ(send({0x17, 0x00, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00, 0x02, 0x04, 0x42, 0x48, 0x00, 0x00}), 0);
+  EXPECT_EQ(drain().size(), 1u);
+  EXPECT_EQ(send({0x17, 0x00, 0xC8, 0x00, 0x01, 0x00, 0x00, 0x00, 0x02, 0x04, 0x42, 0x48, 0x00, 0x00}), 0x02);  // read part unmapped
+  EXPECT_TRUE(drain().empty());  // nothing applied when the read part is wrong
+}
+
+}  // namespace
+}  // namespace epa::modbus
