@@ -9,7 +9,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libjs-chart.js
   libmodbus-dev libcomedi-dev libspdlog-dev libsystemd-dev
-  rt-tests mbpoll
+  rt-tests mbpoll python3-pymodbus python3-serial-asyncio
 )
 
 missing=()

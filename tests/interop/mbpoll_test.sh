@@ -1,0 +1,233 @@
+#!/usr/bin/env bash
+# Interoperability: Debian's mbpoll (a modpoll-style command-line Modbus master, libmodbus) against
+# a running appliance on the simulated plant, as a SCADA engineer would poke it.
+#
+#   mbpoll_test.sh <epa binary> <source dir>
+#
+# Starts `epa serve` on a free loopback port with registers/epa.csv, waits for it by polling, and
+# checks: the position float (input 0-1, ABCD, read with -B) is the simulated piston's (0 mm at
+# start), a setpoint written as an ABCD float plus mode RUN moves the piston there, an unmapped
+# register is refused (exception 02) and the tuning register lc_mm is refused while locked
+# (exception 04). The appliance is stopped by its PID (SIGTERM, SIGKILL after 5 s). Exit 0: all
+# passed; 1: a check failed (each failure says what was expected and what came back).
+set -uo pipefail
+
+if [ $# -ne 2 ]; then
+  echo "usage: $0 <epa binary> <source dir>" >&2
+  exit 2
+fi
+epa=$1
+src=$2
+host=127.0.0.1
+
+command -v mbpoll >/dev/null || { echo "FAIL: mbpoll is not installed (scripts/install-deps.sh installs it)" >&2; exit 1; }
+command -v python3 >/dev/null || { echo "FAIL: python3 is needed to pick a free port" >&2; exit 1; }
+[ -x "$epa" ] || { echo "FAIL: $epa is not an executable" >&2; exit 1; }
+[ -f "$src/registers/epa.csv" ] || { echo "FAIL: $src/registers/epa.csv not found" >&2; exit 1; }
+
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/epa-mbpoll.XXXXXX")
+pid=""
+passed=0
+failed=0
+
+now_ms() { echo $(( ${EPOCHREALTIME/./} / 1000 )); }
+
+# Stop the appliance by its PID: SIGTERM, then SIGKILL if it is still there after 5 s.
+stop_appliance() {
+  [ -n "$pid" ] || return 0
+  local status=0
+  if kill -0 "$pid" 2>/dev/null; then
+    kill -TERM "$pid" 2>/dev/null
+    local deadline=$(( $(now_ms) + 5000 ))
+    while kill -0 "$pid" 2>/dev/null && [ "$(now_ms)" -lt "$deadline" ]; do sleep 0.05; done
+    if kill -0 "$pid" 2>/dev/null; then
+      echo "appliance (pid $pid) ignored SIGTERM for 5 s: SIGKILL" >&2
+      kill -KILL "$pid" 2>/dev/null
+    fi
+  fi
+  wait "$pid" 2>/dev/null
+  status=$?
+  pid=""
+  return $status
+}
+cleanup() {
+  stop_appliance
+  rm -rf "$tmp"
+}
+trap cleanup EXIT
+trap 'exit 1' INT TERM HUP
+
+pass() { passed=$((passed + 1)); echo "PASS: $*"; }
+fail() {
+  failed=$((failed + 1))
+  echo "FAIL: $*" >&2
+}
+show_log() {
+  echo "---- appliance log ($tmp/epa.log) ----" >&2
+  cat "$tmp/epa.log" >&2
+  echo "---- end of log ----" >&2
+}
+abort() {  # a failure the later checks cannot recover from
+  fail "$*"
+  show_log
+  echo "$passed passed, $failed failed"
+  exit 1
+}
+
+# mbpoll against the appliance: TCP, unit 1, 0-based (PDU) addresses, one poll, 1 s timeout.
+mb() { mbpoll -m tcp -a 1 -p "$port" -0 -1 -o 1 "$@"; }
+
+# The value mbpoll printed for reference $1 ("[0]: 	12.5" -> 12.5); empty when there is none.
+value_of() { awk -v ref="[$1]:" '$1 == ref { print $2; exit }'; }
+
+# |a - b| <= tol for decimal numbers.
+near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(a != "" && d <= t) }'; }
+
+read_position() { mb -t 3:float -B -r 0 -c 1 "$host" 2>&1 | value_of 0; }
+
+# ---- start the appliance on a free loopback port ----
+port=$(python3 -c "import socket; s=socket.socket(); s.bind(('127.0.0.1',0)); print(s.getsockname()[1])")
+cat >"$tmp/epa.toml" <<EOF
+# written by tests/interop/mbpoll_test.sh
+[modbus]
+address = "127.0.0.1"
+port = $port
+register_map = "$src/registers/epa.csv"
+unlock_key = 4321
+
+[log]
+status_interval_s = 0
+
+[recorder]
+directory = "$tmp/runs"
+EOF
+"$epa" serve --config "$tmp/epa.toml" --mode stop >"$tmp/epa.log" 2>&1 &
+pid=$!
+echo "appliance pid $pid on $host:$port (config $tmp/epa.toml)"
+
+# ---- readiness: poll with mbpoll until it answers, at most 10 s ----
+deadline=$(( $(now_ms) + 10000 ))
+ready=0
+while [ "$(now_ms)" -lt "$deadline" ]; do
+  kill -0 "$pid" 2>/dev/null || abort "the appliance exited during start-up"
+  if mbpoll -m tcp -a 1 -p "$port" -0 -1 -o 0.2 -t 3 -r 12 -c 1 "$host" >/dev/null 2>&1; then ready=1; break; fi
+  sleep 0.1
+done
+[ "$ready" -eq 1 ] || abort "the appliance did not answer Modbus requests on $host:$port within 10 s"
+echo "ready after $(( $(now_ms) - deadline + 10000 )) ms"
+
+# ---- (1) the position float, ABCD (-B), input register 0-1: the simulated piston at 0 mm ----
+out=$(mb -t 3:float -B -r 0 -c 1 "$host" 2>&1)
+rc=$?
+pos=$(value_of 0 <<<"$out")
+if [ $rc -eq 0 ] && near "$pos" 0 0.5; then
+  pass "(1) position read with -t 3:float -B at input 0 is $pos mm (piston at rest at 0 mm)"
+else
+  fail "(1) position read with -t 3:float -B at input 0: expected 0 +- 0.5 mm, got '${pos}' (mbpoll exit $rc): $out"
+fi
+# The same point through mbpoll's default 1-based reference (30001), as most HMIs name it.
+out=$(mbpoll -m tcp -a 1 -p "$port" -1 -o 1 -t 3:float -B -r 1 -c 1 "$host" 2>&1)
+rc=$?
+pos1=$(value_of 1 <<<"$out")
+if [ $rc -eq 0 ] && near "$pos1" 0 0.5; then
+  pass "(1) position read through the 1-based reference 30001 (-r 1, no -0) is $pos1 mm"
+else
+  fail "(1) position through the 1-based reference -r 1: expected 0 +- 0.5 mm, got '${pos1}' (mbpoll exit $rc): $out"
+fi
+
+# ---- (2) write setpoint 120 mm (holding 0-1, float ABCD) and mode 1 (RUN, holding 2) ----
+out=$(mb -t 4:float -B -r 0 "$host" 120 2>&1)
+rc=$?
+if [ $rc -eq 0 ] && grep -q "Written 1 references" <<<"$out"; then
+  pass "(2) setpoint 120 written as a float with -t 4:float -B at holding 0"
+else
+  fail "(2) writing setpoint 120 (-t 4:float -B -r 0): expected success, mbpoll exit $rc: $out"
+fi
+sp=$(mb -t 4:float -B -r 0 -c 1 "$host" 2>&1 | value_of 0)
+if near "$sp" 120 0; then
+  pass "(2) setpoint reads back as $sp"
+else
+  fail "(2) setpoint read back (-t 4:float -B -r 0): expected 120, got '${sp}'"
+fi
+out=$(mb -t 4 -r 2 "$host" 1 2>&1)
+rc=$?
+if [ $rc -eq 0 ] && grep -q "Written 1 references" <<<"$out"; then
+  pass "(2) mode 1 (run) written at holding 2"
+else
+  fail "(2) writing mode 1 (-t 4 -r 2): expected success, mbpoll exit $rc: $out"
+fi
+
+# ---- (3) the simulated piston reaches 120 +- 3 mm within 15 s (polled every 0.2 s) ----
+# Three polls in a row inside the band, so that the piston is there rather than swinging through
+# (FF-IDZ overshoots on the paper's model: README, "FF-IDZ overshoot and settling").
+deadline=$(( $(now_ms) + 15000 ))
+start=$(now_ms)
+pos=""
+in_band=0
+while [ "$(now_ms)" -lt "$deadline" ]; do
+  pos=$(read_position)
+  if near "$pos" 120 3; then in_band=$((in_band + 1)); else in_band=0; fi
+  [ "$in_band" -ge 3 ] && break
+  sleep 0.2
+done
+if [ "$in_band" -ge 3 ]; then
+  pass "(3) position $pos mm within 3 mm of 120 (3 polls in a row) after $(( $(now_ms) - start )) ms"
+else
+  fail "(3) position did not stay within 3 mm of 120 for 3 polls in a row within 15 s: last read '${pos}' mm"
+fi
+mode=$(mb -t 4 -r 2 -c 1 "$host" 2>&1 | value_of 2)
+if [ "$mode" = "1" ]; then
+  pass "(3) mode reads 1 (run) after the move"
+else
+  fail "(3) mode after the move: expected 1 (run), got '${mode}' (a fault? see the log)"
+  show_log
+fi
+
+# ---- (4) an unmapped register is refused with exception 02 (illegal data address) ----
+out=$(mb -t 3 -r 200 -c 1 "$host" 2>&1)
+rc=$?
+if [ $rc -ne 0 ] && grep -qi "illegal data address" <<<"$out"; then
+  pass "(4) reading unmapped input register 200: mbpoll exit $rc, $(grep -i 'illegal data address' <<<"$out")"
+else
+  fail "(4) reading unmapped input register 200: expected a non-zero exit and 'Illegal data address', got exit $rc: $out"
+fi
+out=$(mb -t 4 -r 15 -c 1 "$host" 2>&1)
+rc=$?
+if [ $rc -ne 0 ] && grep -qi "illegal data address" <<<"$out"; then
+  pass "(4) reading unmapped holding register 15: refused with 'Illegal data address'"
+else
+  fail "(4) reading unmapped holding register 15: expected a non-zero exit and 'Illegal data address', got exit $rc: $out"
+fi
+
+# ---- (5) the tuning register lc_mm (holding 28-29) is refused while locked (exception 04) ----
+out=$(mb -t 4:float -B -r 28 "$host" 7.5 2>&1)
+rc=$?
+if [ $rc -ne 0 ] && grep -qi "slave device or server failure" <<<"$out"; then
+  pass "(5) writing lc_mm 7.5 while locked: mbpoll exit $rc, $(grep -i 'failed' <<<"$out")"
+else
+  fail "(5) writing lc_mm while locked: expected a non-zero exit and exception 04 'Slave device or server failure', got exit $rc: $out"
+fi
+lc=$(mb -t 4:float -B -r 28 -c 1 "$host" 2>&1 | value_of 28)
+if near "$lc" 5 0.0001; then
+  pass "(5) lc_mm still reads $lc (the refused write changed nothing)"
+else
+  fail "(5) lc_mm after the refused write: expected 5, got '${lc}'"
+fi
+
+# ---- the appliance is still up and stops cleanly on SIGTERM ----
+if kill -0 "$pid" 2>/dev/null; then
+  stop_appliance
+  status=$?
+  if [ $status -eq 0 ]; then
+    pass "appliance stopped on SIGTERM with exit status 0"
+  else
+    fail "appliance stop: expected exit status 0 after SIGTERM, got $status"
+  fi
+else
+  fail "the appliance died during the test"
+  pid=""
+fi
+
+[ "$failed" -eq 0 ] || show_log
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
