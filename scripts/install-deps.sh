@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build ccache pkg-config
   libeigen3-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libjs-chart.js
+  libjs-chart.js libpagmo-dev
   libmodbus-dev libcomedi-dev libspdlog-dev libsystemd-dev
   rt-tests mbpoll python3-pymodbus python3-serial-asyncio
 )

@@ -4,6 +4,8 @@
 #include <iostream>
 
 #include "app/design_command.hpp"
+#include "app/excite_command.hpp"
+#include "app/identify_command.hpp"
 #include "app/plant_server_command.hpp"
 #include "app/registers_command.hpp"
 #include "app/serve_command.hpp"
@@ -16,6 +18,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "epa 0.1.0");
   epa::app::SimulateOptions simulate;
   epa::app::DesignOptions design;
+  epa::app::ExciteOptions excite;
+  epa::app::IdentifyOptions identify;
   epa::app::ServeOptions serve;
   epa::app::PlantServerOptions plant_server;
   epa::app::RegistersOptions registers;
@@ -24,6 +28,8 @@ int main(int argc, char** argv) {
   epa::app::add_registers_command(app, registers);
   epa::app::add_simulate_command(app, simulate);
   epa::app::add_design_command(app, design);
+  epa::app::add_excite_command(app, excite);
+  epa::app::add_identify_command(app, identify);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -32,6 +38,8 @@ int main(int argc, char** argv) {
   try {
     if (app.got_subcommand("simulate")) return epa::app::run_simulate(simulate, std::cout, std::cerr);
     if (app.got_subcommand("design")) return epa::app::run_design(design, std::cout, std::cerr);
+    if (app.got_subcommand("excite")) return epa::app::run_excite(excite, std::cout, std::cerr);
+    if (app.got_subcommand("identify")) return epa::app::run_identify(identify, std::cout, std::cerr);
     if (app.got_subcommand("serve")) return epa::app::run_serve(serve, std::cerr);
     if (app.got_subcommand("registers")) return epa::app::run_registers(registers, std::cout, std::cerr);
     if (app.got_subcommand("plant-server")) return epa::app::run_plant_server(plant_server, std::cout, std::cerr);

@@ -1,0 +1,107 @@
+#include "app/excite_command.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "app/svg_chart.hpp"
+#include "app/tuning_source.hpp"
+#include "core/format.hpp"
+#include "core/run_file.hpp"
+#include "ident/excitation.hpp"
+
+namespace epa::app {
+
+void add_excite_command(CLI::App& app, ExciteOptions& o) {
+  auto* cmd = app.add_subcommand(
+      "excite", "Open-loop identification run on a simulated plant (ramps and pseudo-random pulses) for epa identify");
+  cmd->add_option("--out", o.out_path, "Write the run here (epa-run/1 CSV, controller=open-loop)")->required();
+  cmd->add_option("--model", o.model_path, "Plant model file (epa-model/1 TOML); default: the paper's eq 9-10")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--plot", o.plot_path, "Draw the run (position and valve command) as an SVG picture");
+  cmd->add_option("--duration", o.duration_s, "Length of the run, s")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--seed", o.seed, "Seed of the pulse sequence and of the sensor noise")->capture_default_str();
+  cmd->add_option("--noise", o.noise_mm, "Sensor noise standard deviation, mm")->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--amplitude-max", o.amplitude_max_v, "Largest |valve command|, V (beyond both break points)")
+      ->capture_default_str();
+  cmd->add_option("--amplitude-min", o.amplitude_min_v, "Smallest pulse level, V (inside the dead band)")->capture_default_str();
+  cmd->add_option("--ramp-rate", o.ramp_rate_v_per_s, "Slope of the ramps through the dead band, V/s")->capture_default_str();
+  cmd->add_option("--ramp-travel", o.ramp_travel_mm, "A ramp turns back once the piston has moved this far, mm")
+      ->capture_default_str();
+  cmd->add_option("--guard", o.guard_mm, "Pulses away from the middle end this close to a stroke end, mm")->capture_default_str();
+}
+
+namespace {
+
+// The whole run, then the ramps alone (where the piston starts to move shows the break points, as
+// in the paper's figure 6).
+std::string render_excitation_plot(const core::Run& run, double ramps_end_s, const std::string& title) {
+  Series y{"measured position", "#000000", run.t_s, run.y_mm, false};
+  Series u{"valve command", "#1f77b4", run.t_s, run.u_V, false};
+  Panel position{"position", "time (s)", "position (mm)", {y}, {}, {}, {}, 0.0, 500.0};
+  Panel valve{"valve command", "time (s)", "valve command (V)", {u}, {}, {}, {}, {}, {}};
+  std::vector<Panel> panels = {position, valve};
+  if (ramps_end_s > 0.0) {
+    Panel ramp_y{"ramps through the dead band: position", "time (s)", "position (mm)", {y}, {}, 0.0, ramps_end_s, {}, {}};
+    Panel ramp_u{"ramps through the dead band: valve command", "time (s)", "valve command (V)", {u}, {}, 0.0, ramps_end_s,
+                 {}, {}};
+    panels.push_back(std::move(ramp_y));
+    panels.push_back(std::move(ramp_u));
+  }
+  return render_svg(title, panels, 1, 1100, 260);
+}
+
+}  // namespace
+
+int run_excite(const ExciteOptions& o, std::ostream& out, std::ostream& err) {
+  auto fail = [&](const std::string& message) { return err << "epa excite: " << message << "\n", 1; };
+  auto model_file = load_model(o.model_path);
+  if (!model_file) return fail(model_file.error().message);
+  const core::HammersteinModel& model = model_file->model;
+
+  ident::ExcitationOptions eo;
+  eo.duration_s = o.duration_s;
+  eo.amplitude_max_v = o.amplitude_max_v;
+  eo.amplitude_min_v = o.amplitude_min_v;
+  eo.ramp_rate_v_per_s = o.ramp_rate_v_per_s;
+  eo.ramp_travel_mm = o.ramp_travel_mm;
+  eo.guard_mm = o.guard_mm;
+  eo.seed = o.seed;
+  auto result = ident::run_excitation(model, eo, o.noise_mm, "epa excite on " + model_file->source);
+  if (!result) return fail(result.error().message);
+  const core::Run& run = result->run;
+
+  const auto [u_min, u_max] = std::minmax_element(run.u_V.begin(), run.u_V.end());
+  const auto [y_min, y_max] = std::minmax_element(run.y_mm.begin(), run.y_mm.end());
+  char buf[600];
+  std::snprintf(buf, sizeof buf,
+                "Excitation run: plant %s, Ts = %g s, %g s (%zu samples), seed %llu, sensor noise %g mm\n"
+                "  ramps through the dead band: the piston first moved (%g mm) at u = %+.3f V and %+.3f V;\n"
+                "    the break points lie just inside these (the piston needs a moment to move %g mm)\n"
+                "  pulses: %zu, %zu of them cut short by the %g mm guard; levels %g-%g V\n"
+                "  valve command in [%g, %g] V, position in [%.1f, %.1f] mm\n",
+                model_file->source.c_str(), model.Ts, o.duration_s, run.size(), static_cast<unsigned long long>(o.seed),
+                o.noise_mm, ident::ExcitationGenerator::kMotionThresholdMm, result->ramp_motion_up_v,
+                result->ramp_motion_down_v, ident::ExcitationGenerator::kMotionThresholdMm, result->pulses,
+                result->pulses_cut, o.guard_mm, o.amplitude_min_v, o.amplitude_max_v, *u_min, *u_max, *y_min, *y_max);
+  out << buf;
+  if (std::isnan(result->ramp_motion_up_v) || std::isnan(result->ramp_motion_down_v))
+    out << "  warning: a ramp reached --amplitude-max without moving the piston: the dead band may be wider than "
+           "the amplitude; raise --amplitude-max\n";
+  if (result->samples_at_stops > 0)
+    out << "  warning: " << result->samples_at_stops
+        << " samples with the piston at an end stop (epa identify leaves them out); lower --amplitude-max or raise --guard\n";
+
+  if (auto s = core::write_run_file(o.out_path, run); !s) return fail(s.error().message);
+  out << "run written to " << o.out_path << "\n";
+  if (!o.plot_path.empty()) {
+    std::ofstream f(o.plot_path, std::ios::trunc);
+    if (!(f << render_excitation_plot(run, result->ramps_end_s, "Excitation run (" + model_file->source + ")")) || !f.flush())
+      return fail("cannot write " + o.plot_path);
+    out << "picture written to " << o.plot_path << "\n";
+  }
+  return 0;
+}
+
+}  // namespace epa::app

@@ -1,0 +1,196 @@
+#include "app/identify_command.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <optional>
+
+#include "app/identify_report.hpp"
+#include "core/format.hpp"
+#include "core/model_file.hpp"
+#include "core/paper_reference.hpp"
+#include "core/run_file.hpp"
+#include "ident/hammerstein_fit.hpp"
+#include "ident/order_selection.hpp"
+
+namespace epa::app {
+
+using core::format_number;
+
+void add_identify_command(CLI::App& app, IdentifyOptions& o) {
+  auto* cmd = app.add_subcommand(
+      "identify", "Identify the plant (dead zone + ARX, the paper's section 2.2) from open-loop run files");
+  cmd->add_option("runs", o.runs, "Estimation runs (epa-run/1 CSV, e.g. from epa excite)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--validate", o.validate, "Validation runs: scored, never fitted (give one: the order rule needs it)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--na", o.na, "Order of A: n or a range lo:hi to search")->capture_default_str();
+  cmd->add_option("--nb", o.nb, "Number of B coefficients: n or lo:hi")->capture_default_str();
+  cmd->add_option("--nk", o.nk, "Input delay in samples (>= 1): n or lo:hi")->capture_default_str();
+  cmd->add_option("--out", o.out_path, "Write the identified model (epa-model/1 TOML) for epa design/simulate --model");
+  cmd->add_option("--plot", o.plot_path, "Draw measured vs model output of the validation runs as an SVG picture");
+  cmd->add_option("--seed", o.seed, "Seed of the particle swarm (same seed, same data: same model)")->capture_default_str();
+  cmd->add_option("--particles", o.particles, "Particles in the swarm")->capture_default_str()->check(CLI::Range(2u, 10000u));
+  cmd->add_option("--generations", o.generations, "Swarm generations")->capture_default_str()->check(CLI::Range(1u, 100000u));
+  cmd->add_option("--m-l", o.m_l, "Normalisation: the left slope m_l the model is scaled to (the data fix only m B)")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--tolerance", o.tolerance_pct, "Order rule: fits within this many points of the best count as equal")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--mm-per-volt", o.mm_per_volt, "Sensor scale of the model's output y")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--stroke", o.stroke_mm, "Stroke, mm (samples at an end stop are left out)")->capture_default_str()->check(CLI::PositiveNumber);
+}
+
+namespace {
+
+constexpr const char* kFormatHint =
+    "epa identify reads epa-run/1 files: columns t_s, y_mm, u_V, uniformly sampled at Ts; see FORMATS.md";
+
+// Reads, splits at the end stops and checks one group of runs; the first run fixes Ts.
+core::Result<std::vector<IdentifiedRun>> load_runs(const std::vector<std::string>& paths, std::optional<double>& Ts,
+                                                   const IdentifyOptions& o, bool estimation, std::ostream& out) {
+  std::vector<IdentifiedRun> runs;
+  for (const auto& path : paths) {
+    auto run = core::read_run_file(path, Ts);
+    if (!run) {
+      const std::string same_Ts = Ts ? "; all runs must share the first run's Ts = " + format_number(*Ts) + " s" : "";
+      return core::Error{run.error().code, run.error().message + " (" + kFormatHint + same_Ts + ")"};
+    }
+    if (!Ts) Ts = run->Ts;
+    IdentifiedRun r{path, std::move(*run), {}};
+    ident::SegmentReport report;
+    r.segments = ident::split_run(r.run, path, {.mm_per_volt = o.mm_per_volt, .stroke_mm = o.stroke_mm}, &report);
+    const ident::ExcitationCheck check{.need_both_directions = estimation};
+    if (auto s = ident::check_excitation(r.segments, path, check, o.mm_per_volt); !s) return s.error();
+    char buf[320];
+    std::snprintf(buf, sizeof buf, "  %-11s %s: %zu samples (%g s), %zu segment(s)", estimation ? "estimation" : "validation",
+                  path.c_str(), r.run.size(), static_cast<double>(r.run.size()) * r.run.Ts, r.segments.size());
+    out << buf;
+    if (report.samples_at_stops + report.samples_in_short > 0)
+      out << "; " << report.samples_at_stops + report.samples_in_short
+          << " samples at or between end stops left out (the model is linear only inside the stroke)";
+    if (const auto c = r.run.meta("controller"); !c.empty() && c != "open-loop")
+      out << "; closed-loop run (" << c << "): the controller correlates u with the noise, expect some bias";
+    out << "\n";
+    runs.push_back(std::move(r));
+  }
+  return runs;
+}
+
+std::vector<ident::Segment> all_segments(const std::vector<IdentifiedRun>& runs) {
+  std::vector<ident::Segment> s;
+  for (const auto& r : runs) s.insert(s.end(), r.segments.begin(), r.segments.end());
+  return s;
+}
+
+core::Result<ident::ArxOrders> nesting_orders(const ident::OrderSearch& s) {
+  if (s.na.lo < 0) return core::invalid_argument("--na must be >= 0");
+  if (s.nb.lo < 1) return core::invalid_argument("--nb must be >= 1");
+  if (s.nk.lo < 1) return core::invalid_argument("--nk must be >= 1: y(k) is read before u(k) is applied");
+  // A, B of every candidate fit inside this one, so the dead zone it finds suits all of them.
+  const ident::ArxOrders n{.na = s.na.hi, .nb = s.nb.hi + s.nk.hi - s.nk.lo, .nk = s.nk.lo};
+  if (auto v = n.validate(); !v)
+    return core::invalid_argument("--na/--nb/--nk: the search reaches " + v.error().message + ": narrow the ranges");
+  return n;
+}
+
+}  // namespace
+
+int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err) {
+  auto fail = [&](const std::string& message) { return err << "epa identify: " << message << "\n", 1; };
+  const auto na = ident::parse_order_range(o.na, "--na");
+  const auto nb = ident::parse_order_range(o.nb, "--nb");
+  const auto nk = ident::parse_order_range(o.nk, "--nk");
+  for (const auto* r : {&na, &nb, &nk})
+    if (!*r) return fail(r->error().message);
+  const ident::OrderSearch search{.na = *na, .nb = *nb, .nk = *nk, .tolerance_pct = o.tolerance_pct};
+  const auto nesting = nesting_orders(search);
+  if (!nesting) return fail(nesting.error().message);
+
+  std::optional<double> Ts;
+  out << "Runs:\n";
+  auto est = load_runs(o.runs, Ts, o, true, out);
+  if (!est) return fail(est.error().message);
+  auto val = load_runs(o.validate, Ts, o, false, out);
+  if (!val) return fail(val.error().message);
+  const auto est_segments = all_segments(*est), val_segments = all_segments(*val);
+
+  // Step 1: the dead zone, with the ARX part of the nesting order solved inside every evaluation.
+  out << "\nDead zone: particle swarm (pagmo2 PSO, seed " << o.seed << ", " << o.particles << " particles x "
+      << o.generations << " generations) over m_r/m_l, b_r, b_l, with ARX " << nesting->to_string()
+      << " by least squares inside each evaluation, then a compass-search polish\n"
+      << std::flush;  // the progress lines go to err meanwhile
+  ident::HammersteinFitOptions fit_options;
+  fit_options.orders = *nesting;
+  fit_options.seed = o.seed;
+  fit_options.particles = o.particles;
+  fit_options.generations = o.generations;
+  fit_options.m_l = o.m_l;
+  fit_options.progress_every = std::max(1u, o.generations / 6);
+  fit_options.progress = [&err](const ident::FitProgress& p) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "  generation %u/%u: V = %.4e, b_r = %.4f V, b_l = %.4f V, m_r/m_l = %.4f (%zu fits)\n",
+                  p.generation, p.generations, p.best_loss, p.best.b_r, p.best.b_l, p.best.m_r / p.best.m_l, p.evaluations);
+    err << buf << std::flush;
+  };
+  auto first_fit = ident::fit_hammerstein(est_segments, fit_options);
+  if (!first_fit) return fail(first_fit.error().message);
+  if (first_fit->right_unidentified || first_fit->left_unidentified) {
+    const bool right = first_fit->right_unidentified;
+    char evidence[200];
+    std::snprintf(evidence, sizeof evidence, "b_%s = %g V, m_r/m_l = %g; with that side closed V grows only from %.3g to %.3g",
+                  right ? "r" : "l", right ? first_fit->dead_zone.b_r : first_fit->dead_zone.b_l, first_fit->ratio,
+                  first_fit->arx.loss, right ? first_fit->loss_without_right : first_fit->loss_without_left);
+    return fail(std::string("the ") + (right ? "right" : "left") + " side of the dead zone is not identified (" + evidence +
+                "): the runs never drive the valve far enough beyond the dead band on that side, so its break point "
+                "and slope cannot be identified; record runs with larger pulses (epa excite --amplitude-max)");
+  }
+
+  // Step 2: the ARX order, on u_d through the dead zone just found.
+  const auto ud_est = ident::through_dead_zone(est_segments, first_fit->dead_zone);
+  const auto ud_val = ident::through_dead_zone(val_segments, first_fit->dead_zone);
+  auto selection = ident::select_order(ud_est, ud_val, search);
+  if (!selection) return fail(selection.error().message);
+  out << "\nOrder selection (ARX on u_d = dead zone(u); fit % = 100 (1 - |y - yhat| / |y - mean y|), pooled over runs):\n"
+      << ident::format_order_table(*selection) << "Recommended " << selection->reason << "\n";
+
+  // Step 3: the dead zone polished again for the recommended order (the swarm's answer as start).
+  const ident::ArxOrders chosen = selection->candidates[selection->recommended].estimate.model.orders;
+  const std::size_t first_evaluations = chosen == *nesting ? 0 : first_fit->evaluations;
+  ident::HammersteinFit fit = std::move(*first_fit);
+  if (!(chosen == *nesting)) {
+    ident::HammersteinFitOptions polish = fit_options;
+    polish.orders = chosen;
+    polish.generations = 0;
+    polish.start = fit.dead_zone;
+    auto refined = ident::fit_hammerstein(est_segments, polish);
+    if (!refined) return fail(refined.error().message);
+    fit = std::move(*refined);
+  }
+  const core::HammersteinModel model = fit.model(*Ts, o.mm_per_volt);
+  if (auto s = model.validate(); !s) return fail("the identified model is not valid: " + s.error().message);
+
+  fit.evaluations += first_evaluations;
+  const ModelFitSummary summary = summarise_fit(fit, est_segments, val_segments);
+  print_identified_model(out, fit, model, summary, o.m_l);
+
+  std::string runs_text;
+  for (const auto& r : o.runs) runs_text += (runs_text.empty() ? "" : ", ") + r;
+  char source[512];
+  std::snprintf(source, sizeof source, "epa identify: %s from %s; %s free-run fit %.2f %%; PSO seed %llu",
+                chosen.to_string().c_str(), runs_text.c_str(), summary.validated ? "validation" : "estimation",
+                summary.validated ? summary.validation.simulation_pct : summary.estimation.simulation_pct,
+                static_cast<unsigned long long>(o.seed));
+  if (!o.out_path.empty()) {
+    if (auto s = core::write_model_file(o.out_path, {model, source}); !s) return fail(s.error().message);
+    out << "\nmodel written to " << o.out_path << "\n";
+  }
+  if (!o.plot_path.empty()) {
+    const auto& shown = val->empty() ? *est : *val;
+    std::ofstream f(o.plot_path, std::ios::trunc);
+    if (!(f << render_identification_plot(shown, fit, model, !val->empty())) || !f.flush())
+      return fail("cannot write " + o.plot_path);
+    out << "picture written to " << o.plot_path << "\n";
+  }
+  return 0;
+}
+
+}  // namespace epa::app

@@ -1,0 +1,137 @@
+#include "app/identify_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "app/svg_chart.hpp"
+#include "core/format.hpp"
+#include "core/paper_reference.hpp"
+
+namespace epa::app {
+
+ModelFitSummary summarise_fit(const ident::HammersteinFit& fit, const std::vector<ident::Segment>& est,
+                              const std::vector<ident::Segment>& val) {
+  ModelFitSummary s;
+  const std::size_t first = fit.arx.model.orders.first_row();
+  s.estimation = ident::fit_percent(fit.arx.model, ident::through_dead_zone(est, fit.dead_zone), first);
+  s.validated = !val.empty();
+  if (s.validated) s.validation = ident::fit_percent(fit.arx.model, ident::through_dead_zone(val, fit.dead_zone), first);
+  return s;
+}
+
+double piston_speed_mm_s_per_v(const core::HammersteinModel& m, double slope) {
+  double dA = 0.0;  // A'(1) = sum i a_i
+  for (std::size_t i = 1; i < m.A.size(); ++i) dA += static_cast<double>(i) * m.A[i];
+  return slope * m.B.at(1.0) / -dA * m.mm_per_volt / m.Ts;
+}
+
+namespace {
+
+constexpr double kDetailWindowS = 5.0;
+
+std::string coefficients(const core::Polynomial& p) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%s%.5g", i ? ", " : "", p[i]);
+    s += buf;
+  }
+  return s + "]";
+}
+
+void row(std::ostream& out, const char* name, double ours, double paper, const char* unit = "") {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "  %-34s %12.4f %12.4f %s\n", name, ours, paper, unit);
+  out << buf;
+}
+
+}  // namespace
+
+void print_identified_model(std::ostream& out, const ident::HammersteinFit& fit, const core::HammersteinModel& model,
+                            const ModelFitSummary& s, double m_l) {
+  const auto& dz = model.dead_zone;
+  const auto paper = core::paper::model();
+  const auto& pdz = paper.dead_zone;
+  char buf[400];
+  out << "\nIdentified model (" << fit.arx.model.orders.to_string() << ", y in sensor volts, " << model.mm_per_volt
+      << " mm/V, Ts = " << model.Ts << " s):\n"
+      << "  A = " << model.A.to_string('q', 5) << "\n  B = " << model.B.to_string('q', 5) << "\n";
+  std::snprintf(buf, sizeof buf, "  dead zone: m_r = %.5f, m_l = %.5f, b_r = %.5f V, b_l = %.5f V\n", dz.m_r, dz.m_l,
+                dz.b_r, dz.b_l);
+  out << buf;
+  std::snprintf(buf, sizeof buf,
+                "  fit (free-run simulation / one-step prediction): estimation %.2f %% / %.2f %%", s.estimation.simulation_pct,
+                s.estimation.one_step_pct);
+  out << buf;
+  if (s.validated) {
+    std::snprintf(buf, sizeof buf, ", validation %.2f %% / %.2f %%", s.validation.simulation_pct, s.validation.one_step_pct);
+    out << buf;
+  }
+  std::snprintf(buf, sizeof buf, "\n  loss V = %.4e, %zu least-squares fits in the dead-zone search\n", fit.arx.loss,
+                fit.evaluations);
+  out << buf;
+
+  out << "\nCompared with the paper (eq 9-10):          identified        paper\n";
+  row(out, "right break point b_r", dz.b_r, pdz.b_r, "V");
+  row(out, "left break point b_l", dz.b_l, pdz.b_l, "V");
+  row(out, "slope ratio m_r / m_l", dz.m_r / dz.m_l, pdz.m_r / pdz.m_l);
+  row(out, "speed per V beyond b_r", piston_speed_mm_s_per_v(model, dz.m_r), piston_speed_mm_s_per_v(paper, pdz.m_r), "mm/s");
+  row(out, "speed per V beyond b_l", piston_speed_mm_s_per_v(model, dz.m_l), piston_speed_mm_s_per_v(paper, pdz.m_l), "mm/s");
+  std::snprintf(buf, sizeof buf, "m_r (normalised: m_l := %g)", m_l);
+  row(out, buf, dz.m_r, pdz.m_r);
+  row(out, "m_l", dz.m_l, pdz.m_l);
+  if (fit.arx.model.orders == ident::ArxOrders{.na = 3, .nb = 3, .nk = 1}) {
+    out << "  A  " << coefficients(model.A) << "   paper " << coefficients(paper.A) << "\n"
+        << "  B  " << coefficients(model.B) << "   paper " << coefficients(paper.B) << "\n";
+  } else {
+    out << "  (eq 9 has na=3 nb=3 nk=1: compare the speeds above and the responses, not the coefficients)\n";
+  }
+  std::snprintf(buf, sizeof buf,
+                "  Normalisation: data determine only the products m_r B and m_l B (and b_r, b_l, m_r/m_l). The\n"
+                "  model fixes m_l = %g (the paper's value unless --m-l) and scales B to match, so the slopes and\n"
+                "  B are on the paper's scale; the speeds above do not depend on this choice.\n",
+                m_l);
+  out << buf;
+}
+
+std::string render_identification_plot(const std::vector<IdentifiedRun>& runs, const ident::HammersteinFit& fit,
+                                       const core::HammersteinModel& model, bool validation) {
+  std::vector<Panel> panels;
+  const std::size_t first = fit.arx.model.orders.first_row();
+  for (std::size_t r = 0; r < runs.size() && r < kMaxPlottedRuns; ++r) {
+    const auto& run = runs[r];
+    Series measured{"measured", "#000000", {}, {}, false}, simulated{"model (free run)", "#d62728", {}, {}, false};
+    std::vector<std::vector<double>> yhat;
+    const auto ud = ident::through_dead_zone(run.segments, fit.dead_zone);
+    for (std::size_t i = 0; i < ud.size(); ++i) {
+      yhat.push_back(ident::simulate_free_run(fit.arx.model, ud[i], first));
+      for (std::size_t k = 0; k < ud[i].size(); ++k) {
+        const double t = ud[i].t0_s + static_cast<double>(k) * model.Ts;
+        measured.x.push_back(t), simulated.x.push_back(t);
+        measured.y.push_back(ud[i].y[k] * model.mm_per_volt);
+        simulated.y.push_back(yhat.back()[k] * model.mm_per_volt);
+      }
+      // A gap between segments (an end stop) breaks both lines.
+      measured.x.push_back(NAN), measured.y.push_back(NAN), simulated.x.push_back(NAN), simulated.y.push_back(NAN);
+    }
+    char title[300];
+    std::snprintf(title, sizeof title, "%s (%s): position, free-run fit %.1f %%", run.path.c_str(),
+                  validation ? "validation" : "estimation", ident::nrmse_fit_percent(ud, yhat, first));
+    Panel position{title, "time (s)", "position (mm)", {simulated, measured}, {}, {}, {}, {}, {}};
+    Panel valve{"valve command", "time (s)", "valve command (V)", {}, {}, {}, {}, {}, {}};
+    Series u{"u", "#1f77b4", run.run.t_s, run.run.u_V, false};
+    valve.series.push_back(std::move(u));
+    valve.bands.push_back({model.dead_zone.b_l, model.dead_zone.b_r, "identified dead band"});
+    // A few seconds from the middle of the run, where the two lines can be told apart.
+    const double t_mid = run.run.t_s.empty() ? 0.0 : 0.5 * (run.run.t_s.front() + run.run.t_s.back());
+    Panel detail{run.path + ": detail", "time (s)", "position (mm)", {simulated, measured}, {}, t_mid, t_mid + kDetailWindowS,
+                 {}, {}};
+    panels.push_back(std::move(position));
+    panels.push_back(std::move(detail));
+    panels.push_back(std::move(valve));
+  }
+  return render_svg("Measured and model output (" + fit.arx.model.orders.to_string() + ")", panels, 1, 1100, 280);
+}
+
+}  // namespace epa::app

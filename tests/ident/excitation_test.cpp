@@ -1,0 +1,147 @@
+#include "ident/excitation.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "core/paper_reference.hpp"
+
+namespace epa::ident {
+namespace {
+
+const core::DeadZone kPaperDz = core::paper::model().dead_zone;
+
+ExcitationResult paper_run(std::uint64_t seed, double duration_s, double noise_mm, ExcitationOptions o = {}) {
+  o.seed = seed;
+  o.duration_s = duration_s;
+  return run_excitation(core::paper::model(), o, noise_mm, "test").value();
+}
+
+// Drives a generator with positions from `position(u_previous)` and returns its commands.
+template <typename Position>
+std::vector<double> drive(ExcitationOptions o, std::size_t n, Position position) {
+  o.duration_s = static_cast<double>(n) * o.Ts;
+  auto g = ExcitationGenerator::make(o).value();
+  std::vector<double> u;
+  double last = 0.0;
+  for (std::size_t k = 0; k < n; ++k) u.push_back(last = g.next(position(last)));
+  return u;
+}
+
+TEST(Excitation, TheSameSeedGivesTheSameRun) {
+  const auto a = paper_run(5, 20.0, 0.1), b = paper_run(5, 20.0, 0.1), c = paper_run(6, 20.0, 0.1);
+  EXPECT_EQ(a.run.u_V, b.run.u_V);
+  EXPECT_EQ(a.run.y_mm, b.run.y_mm);
+  EXPECT_NE(a.run.u_V, c.run.u_V);
+  EXPECT_EQ(a.run.size(), 4000u);  // 20 s at 5 ms
+  EXPECT_EQ(a.run.meta("controller"), "open-loop");
+}
+
+TEST(Excitation, NoiseDoesNotChangeTheValveSequenceOnlyTheReadings) {
+  // Noise may change a pulse sign through the position rule, but not the first ramp.
+  const auto quiet = paper_run(5, 3.0, 0.0), noisy = paper_run(5, 3.0, 0.5);
+  EXPECT_EQ(quiet.run.u_V, noisy.run.u_V);
+  EXPECT_NE(quiet.run.y_mm, noisy.run.y_mm);
+}
+
+TEST(Excitation, ThePistonStaysInsideTheStrokeOnThePapersPlant) {
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    const auto r = paper_run(seed, 120.0, 0.1);
+    EXPECT_EQ(r.samples_at_stops, 0u) << "seed " << seed;
+    const auto [lo, hi] = std::minmax_element(r.run.y_mm.begin(), r.run.y_mm.end());
+    EXPECT_GT(*lo, 1.0);
+    EXPECT_LT(*hi, 499.0);
+  }
+}
+
+TEST(Excitation, PulsesAreMultiLevelThroughAndBeyondTheDeadBand) {
+  const auto r = paper_run(1, 120.0, 0.1);
+  std::set<double> levels;
+  std::size_t inside = 0, beyond_right = 0, beyond_left = 0;
+  for (double u : r.run.u_V) {
+    EXPECT_LE(std::abs(u), 3.0 + 1e-12);
+    if (u == 0.0) continue;
+    levels.insert(std::abs(u));
+    if (u > kPaperDz.b_r) ++beyond_right;
+    else if (u < kPaperDz.b_l) ++beyond_left;
+    else ++inside;
+  }
+  EXPECT_GE(levels.size(), 15u);  // 15 pulse levels, plus the ramps' values
+  EXPECT_GT(inside, 1000u);
+  EXPECT_GT(beyond_right, 1000u);
+  EXPECT_GT(beyond_left, 1000u);
+  EXPECT_GT(r.pulses, 150u);
+}
+
+TEST(Excitation, TheFirstRampRisesAtTheGivenRate) {
+  ExcitationOptions o;  // 0.5 V/s at 5 ms: 0.0025 V per sample
+  const auto u = drive(o, 200, [](double) { return 250.0; });  // a piston that never moves
+  for (std::size_t k = 0; k < 200; ++k) EXPECT_NEAR(u[k], 0.0025 * static_cast<double>(k + 1), 1e-12);
+}
+
+TEST(Excitation, WhereTheRampsFirstMoveThePistonBoundsTheBreakPoints) {
+  // Noise-free paper plant: motion (2 mm) shows shortly after the command passes each break point.
+  const auto r = paper_run(1, 30.0, 0.0);
+  EXPECT_GT(r.ramp_motion_up_v, kPaperDz.b_r);
+  EXPECT_LT(r.ramp_motion_up_v, kPaperDz.b_r + 0.15);
+  EXPECT_LT(r.ramp_motion_down_v, kPaperDz.b_l);
+  EXPECT_GT(r.ramp_motion_down_v, kPaperDz.b_l - 0.15);
+}
+
+TEST(Excitation, PulseSignsLeanTowardsTheMiddle) {
+  ExcitationOptions o;
+  o.ramp_rate_v_per_s = 100.0;  // get the ramps out of the way quickly
+  o.ramp_rest_s = 0.0;
+  const std::size_t n = 20000, after_ramps = 1000;
+  const auto high = drive(o, n, [](double) { return 420.0; });  // beyond the upper guard line
+  const auto low = drive(o, n, [](double) { return 60.0; });
+  const auto middle = drive(o, n, [](double) { return 250.0; });
+  auto count = [&](const std::vector<double>& u, int sign) {
+    return std::count_if(u.begin() + after_ramps, u.end(), [&](double v) { return sign * v > 0.0; });
+  };
+  EXPECT_EQ(count(high, +1), 0);
+  EXPECT_GT(count(high, -1), 1000);
+  EXPECT_EQ(count(low, -1), 0);
+  EXPECT_GT(count(low, +1), 1000);
+  EXPECT_GT(count(middle, +1), 2000);  // about half each way
+  EXPECT_GT(count(middle, -1), 2000);
+}
+
+TEST(Excitation, AGuardCutsAPulseThatCarriesThePistonTowardsAnEnd) {
+  ExcitationOptions o;
+  o.ramp_rate_v_per_s = 100.0;
+  o.ramp_rest_s = 0.0;
+  o.duration_s = 50.0;
+  auto g = ExcitationGenerator::make(o).value();
+  double u = 0.0;
+  std::size_t longest_positive = 0, run = 0;
+  for (std::size_t k = 0; k < 10000; ++k) {
+    const double y = u > 0.0 ? 450.0 : 250.0;  // every positive command throws the piston past the guard
+    u = g.next(y);
+    run = u > 0.0 && k > 1000 ? run + 1 : 0;
+    longest_positive = std::max(longest_positive, run);
+  }
+  EXPECT_EQ(longest_positive, 1u);  // cut in the sample after it starts
+  EXPECT_GT(g.pulses_cut(), 10u);
+}
+
+TEST(Excitation, BadOptionsNameTheOption) {
+  ExcitationOptions o;
+  o.amplitude_max_v = 12.0;
+  auto g = ExcitationGenerator::make(o);
+  ASSERT_FALSE(g.has_value());
+  EXPECT_NE(g.error().message.find("--amplitude-max"), std::string::npos);
+  o = {};
+  o.guard_mm = 300.0;
+  g = ExcitationGenerator::make(o);
+  ASSERT_FALSE(g.has_value());
+  EXPECT_NE(g.error().message.find("--guard"), std::string::npos);
+  o = {};
+  o.duration_s = 0.0;
+  EXPECT_FALSE(ExcitationGenerator::make(o).has_value());
+}
+
+}  // namespace
+}  // namespace epa::ident
