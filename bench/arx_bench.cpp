@@ -20,7 +20,7 @@
 #include "ident/arx_estimator.hpp"
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
+  if (argc < 2 || argv[1][0] == '-') {  // the first argument is a file it writes: never an option
     std::fprintf(stderr, "usage: arx_bench DATA.csv [samples=100000] [repeats=20]\n");
     return 2;
   }
