@@ -210,7 +210,7 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
   publish();
 }
 
-void ScanCycle::publish() noexcept {
+void ScanCycle::publish(bool full_stats) noexcept {
   Snapshot& s = snap_;
   s.cycle = cycle_;
   s.time_s = static_cast<double>(cycle_) * config_.period_s;
@@ -236,7 +236,7 @@ void ScanCycle::publish() noexcept {
   const auto& m = last_move_.metrics;
   s.last_move = {last_move_.number, last_move_.from_mm, last_move_.to_mm, or_nan(m.rise_s), or_nan(m.settling_s),
                  last_move_.number ? m.ess_mm : kNaN, or_nan(m.overshoot_pct)};
-  if (cycle_ % 200 == 0) s.loop = stats_.view();  // percentiles scan the bins: a few times a second
+  if (cycle_ % 200 == 0 || full_stats) s.loop = stats_.view();  // percentiles scan the bins: a few times a second
   s.loop.overruns = stats_.overruns;
   const auto& p = tuning_.for_kind(controller_);
   const auto& rst = p.rst();
@@ -275,7 +275,7 @@ void ScanCycle::shut_down() noexcept {
   valve_v_ = config_.safe_valve_v;
   daq_.write_valve(valve_v_);
   if (mode_ != Mode::kFault) mode_ = Mode::kStop;
-  publish();
+  publish(/*full_stats=*/true);  // the last word: exact statistics, not up to 200 cycles old
 }
 
 }  // namespace epa::runtime

@@ -70,7 +70,7 @@ class ScanCycle {
   void finish_move() noexcept;
   FaultCode detect_fault(bool read_ok, std::int64_t now_ns) noexcept;
   void enter_fault(FaultCode code) noexcept;
-  void publish() noexcept;
+  void publish(bool full_stats = false) noexcept;
 
   RuntimeConfig config_;
   Tuning tuning_;

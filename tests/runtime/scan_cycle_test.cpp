@@ -221,6 +221,7 @@ TEST(ScanCycle, RunStopsWhenAskedAndLeavesTheValveSafe) {
   EXPECT_EQ(daq.last_written_v, 0.0);
   EXPECT_EQ(clock.now_ns(), 100 * kPeriodNs);  // absolute deadlines: exactly one period apart
   EXPECT_EQ(loop2.last_snapshot().loop.overruns, 0u);
+  EXPECT_EQ(loop2.last_snapshot().loop.cycles, 100u);  // the final statistics are exact, not up to 200 cycles old
 }
 
 TEST(Recorder, WritesEachMoveAsAValidRunFile) {
