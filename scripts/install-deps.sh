@@ -10,6 +10,7 @@ packages=(
   libjs-chart.js libpagmo-dev
   libmodbus-dev libcomedi-dev libspdlog-dev libsystemd-dev
   rt-tests mbpoll python3-pymodbus python3-serial-asyncio
+  libcpp-httplib-dev chromium
 )
 
 missing=()

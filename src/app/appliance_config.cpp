@@ -245,6 +245,14 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   mbs.text_list("write_clients", c.modbus.policy.write_clients);
   mbs.refuse_unknown_keys();
 
+  TableReader web(top.subtable("web"), "web", file, error);
+  web.boolean("enabled", c.web_enabled);
+  web.text("address", c.web.address);
+  web.integer("port", c.web.port, 0, 65535);
+  web.text("token", c.web.token);
+  web.text("static_dir", c.web.static_dir);
+  web.refuse_unknown_keys();
+
   TableReader hal_table(top.subtable("hal"), "hal", file, error);
   hal_table.choice<HalBackend>("backend", c.backend, parse_backend);
   TableReader sim(hal_table.subtable("sim"), "hal.sim", file, error);
@@ -289,7 +297,7 @@ core::Result<ApplianceConfig> read_appliance_config(const std::string& path) {
   if (!c) return c;
   // Files the configuration names are found next to it, wherever the appliance is started from.
   const auto folder = std::filesystem::path(path).parent_path();
-  for (std::string* p : {&c->model_path, &c->design_path, &c->register_map_path})
+  for (std::string* p : {&c->model_path, &c->design_path, &c->register_map_path, &c->web.static_dir})
     if (!p->empty() && std::filesystem::path(*p).is_relative()) *p = (folder / *p).lexically_normal().string();
   return c;
 }

@@ -3,7 +3,7 @@
 // backends' own config structs. Every key is optional (defaults as in config/epa.toml), every
 // value is type- and range-checked, and unknown keys are refused; messages name the file, the
 // line and the key. Relative paths of files the configuration names (model, design, register map)
-// are resolved against the configuration file's folder; the recorder's directory against the
+// (and the status page's static files) are resolved against the configuration file's folder; the recorder's directory against the
 // working directory (where the appliance keeps its data: /var/lib/epa under systemd).
 #include <string>
 
@@ -14,6 +14,7 @@
 #include "hal/realtime.hpp"
 #include "runtime/recorder.hpp"
 #include "runtime/runtime_config.hpp"
+#include "web/web_server.hpp"
 
 namespace epa::app {
 
@@ -35,6 +36,9 @@ struct ApplianceConfig {
   bool modbus_enabled = true;
   modbus::ServerConfig modbus;
   std::string register_map_path = "../registers/epa.csv";  // relative to the configuration file
+
+  bool web_enabled = true;
+  web::WebConfig web;  // static_dir relative to the configuration file
 
   HalBackend backend = HalBackend::kSim;
   plant::PlantOptions sim;

@@ -15,6 +15,8 @@
 #include "hal/realtime.hpp"
 #include "runtime/recorder.hpp"
 #include "runtime/scan_cycle.hpp"
+#include "web/recent_audit.hpp"
+#include "web/web_server.hpp"
 
 namespace epa::app {
 
@@ -24,6 +26,7 @@ void add_serve_command(CLI::App& app, ServeOptions& o) {
   cmd->add_option("--hal", o.hal, "DAQ backend, overriding the configuration: sim, modbus-io, comedi");
   cmd->add_option("--modbus-io-port", o.modbus_io_port, "TCP port of the remote I/O module (modbus-io)");
   cmd->add_option("--modbus-port", o.modbus_port, "TCP port of the Modbus server, overriding [modbus] port");
+  cmd->add_option("--web-port", o.web_port, "TCP port of the status page's HTTP server, overriding [web] port");
   cmd->add_option("--mode", o.mode, "Mode at start-up: stop or run");
   cmd->add_option("--setpoint", o.setpoint_mm, "Setpoint at start-up, mm");
   cmd->add_option("--record-dir", o.record_dir, "Directory for recorded run files");
@@ -42,6 +45,7 @@ core::Status apply_overrides(const ServeOptions& o, ApplianceConfig& c) {
   }
   if (o.modbus_io_port > 0) c.modbus_io.port = o.modbus_io_port;
   if (o.modbus_port >= 0) c.modbus.port = o.modbus_port;
+  if (o.web_port >= 0) c.web.port = o.web_port;
   if (!o.mode.empty()) {
     auto m = runtime::parse_mode(o.mode);
     if (!m) return core::invalid_argument("--mode: " + m.error().message);
@@ -121,7 +125,8 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
                               .source = std::string("appliance/") + to_string(c.backend)},
                              channels, [](const std::string& line) { spdlog::info("{}", line); });
   recorder.start();
-  LogAuditSink audit;
+  LogAuditSink log_audit;
+  web::RecentAudit audit(&log_audit);  // the log, plus the last entries for the status page
   std::unique_ptr<modbus::ModbusServer> modbus_server;
   if (register_map) {
     auto server = modbus::ModbusServer::start(c.modbus, *register_map, tuning_base, model.mm_per_volt, channels, &audit,
@@ -136,6 +141,24 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
     spdlog::info("modbus: listening on {}:{} (unit {}, map {}, {} points, {})", c.modbus.address, modbus_server->port(),
                  c.modbus.unit_id, c.register_map_path, register_map->entries().size(),
                  c.modbus.policy.read_only ? "read-only" : c.modbus.policy.unlock_key ? "tuning locked until unlocked" : "tuning locked (no unlock key)");
+  }
+
+  std::unique_ptr<web::WebServer> web_server;
+  if (c.web_enabled) {
+    const modbus::ModbusServer* mb = modbus_server.get();
+    auto server = web::WebServer::start(c.web, channels, c.runtime, &audit, [mb] {
+      return mb ? web::ModbusStats{true, mb->clients(), mb->requests(), mb->exceptions()} : web::ModbusStats{};
+    });
+    if (!server) {
+      spdlog::error("{}", server.error().message);
+      if (modbus_server) modbus_server->stop();
+      recorder.stop();
+      (*daq)->close();
+      return 1;
+    }
+    web_server = std::move(*server);
+    spdlog::info("web: listening on {}:{} (static files {}, commands {})", c.web.address, web_server->port(),
+                 c.web.static_dir, c.web.token.empty() ? "disabled: no token configured" : "enabled with the token");
   }
 
   std::atomic<bool> stop{false};
@@ -187,7 +210,8 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
     }
   }
   sd_notify(0, "STOPPING=1");
-  if (modbus_server) modbus_server->stop();  // no more commands; then the loop's last cycle
+  if (web_server) web_server->stop();        // no more commands from either interface;
+  if (modbus_server) modbus_server->stop();  // then the loop's last cycle
   stop = true;
   loop_thread.join();  // the loop's last act: valve to its safe command
   recorder.stop();

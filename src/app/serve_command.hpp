@@ -14,6 +14,7 @@ struct ServeOptions {
   std::string hal;            // overrides [hal] backend
   int modbus_io_port = 0;     // overrides [hal.modbus_io] port
   int modbus_port = -1;       // overrides [modbus] port (0: any free port, logged)
+  int web_port = -1;          // overrides [web] port (0: any free port, logged)
   std::string mode;           // overrides [startup] mode
   double setpoint_mm = -1.0;  // overrides [startup] setpoint_mm (< 0: not given)
   std::string record_dir;     // overrides [recorder] directory

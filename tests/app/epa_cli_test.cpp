@@ -111,7 +111,8 @@ TEST_F(EpaCli, ServeRefusesABadConfigurationNamingFileLineAndKey) {
 TEST_F(EpaCli, ServeOnTheSimPlantMovesRecordsAndStopsCleanly) {
   // move_window_s 0.5 so that the move is measured and recorded within the 1.5 s run.
   std::ofstream(path("fast.toml")) << "[recorder]\nmove_window_s = 0.5\n[log]\nstatus_interval_s = 0\n"
-                                    << "[modbus]\nport = 0\nregister_map = \"" << EPA_SOURCE_DIR << "/registers/epa.csv\"\n";
+                                    << "[modbus]\nport = 0\nregister_map = \"" << EPA_SOURCE_DIR << "/registers/epa.csv\"\n"
+                                    << "[web]\naddress = \"127.0.0.1\"\nport = 0\nstatic_dir = \"" << EPA_SOURCE_DIR << "/web\"\n";
   const auto o = run_epa("serve --config " + path("fast.toml") + " --mode run --setpoint 100 --duration 1.5 --record-dir " +
                          path("runs"));
   ASSERT_EQ(o.exit_code, 0) << o.output;

@@ -95,6 +95,9 @@ port = $port
 register_map = "$src/registers/epa.csv"
 unlock_key = 4321
 
+[web]
+enabled = false
+
 [log]
 status_interval_s = 0
 

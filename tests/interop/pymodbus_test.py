@@ -113,6 +113,8 @@ class Appliance:
                     f"port = {self.port}\n"
                     f'register_map = "{register_map}"\n'
                     f"unlock_key = {UNLOCK_KEY}\n"
+                    "[web]\n"
+                    "enabled = false\n"
                     "[log]\n"
                     "status_interval_s = 0\n"
                     "[recorder]\n"

@@ -1,0 +1,28 @@
+#pragma once
+// The JSON bodies of the read-only API, built from the published snapshot and the web thread's
+// own buffers. Numbers that mean "never" / "no value" (NaN) are written as null.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/audit.hpp"
+#include "runtime/snapshot.hpp"
+#include "web/trend_buffer.hpp"
+
+namespace epa::web {
+
+// What the Modbus server reports about itself (enabled = false when it is not running).
+struct ModbusStats {
+  bool enabled = false;
+  int clients = 0;
+  std::uint64_t requests = 0, exceptions = 0;
+};
+
+std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled);
+std::string trend_json(const std::vector<TrendPoint>& points, const runtime::Snapshot& s);
+std::string moves_json(const std::vector<MoveRecord>& moves);
+std::string tuning_json(const runtime::Snapshot& s);
+std::string audit_json(const std::vector<core::AuditEntry>& entries);
+std::string error_json(const std::string& message);
+
+}  // namespace epa::web

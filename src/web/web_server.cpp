@@ -1,0 +1,233 @@
+#include "web/web_server.hpp"
+
+#include <httplib.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "web/command_validation.hpp"
+#include "web/prometheus.hpp"
+#include "web/recent_audit.hpp"
+#include "web/trend_buffer.hpp"
+
+namespace epa::web {
+
+namespace {
+
+constexpr const char* kJson = "application/json";
+
+std::int64_t unix_time_ms() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+// Compares without an early exit, so the time taken says nothing about how much of a guess was right.
+bool constant_time_equal(const std::string& a, const std::string& b) {
+  unsigned char diff = a.size() == b.size() ? 0 : 1;
+  const std::size_t n = std::max(a.size(), b.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const unsigned char x = i < a.size() ? static_cast<unsigned char>(a[i]) : 0;
+    const unsigned char y = i < b.size() ? static_cast<unsigned char>(b[i]) : 0;
+    diff |= static_cast<unsigned char>(x ^ y);
+  }
+  return diff == 0;
+}
+
+void send_error(httplib::Response& res, int status, const std::string& message) {
+  res.status = status;
+  res.set_content(error_json(message), kJson);
+}
+
+}  // namespace
+
+struct WebServer::Impl {
+  WebConfig config;
+  runtime::LoopChannels& channels;
+  runtime::RuntimeConfig limits;
+  RecentAudit* audit;
+  ModbusStatsFn modbus_stats;
+  httplib::Server server;
+  TrendBuffer trend;
+  std::string chart_js;
+  int port = 0;
+  std::atomic<std::uint64_t> requests{0};
+  std::atomic<bool> listen_returned{false};
+
+  std::mutex stop_mutex;
+  std::condition_variable stop_cv;
+  bool stopping = false;
+  std::thread listener, sampler;
+
+  Impl(const WebConfig& c, runtime::LoopChannels& ch, const runtime::RuntimeConfig& l, RecentAudit* a, ModbusStatsFn m)
+      : config(c), channels(ch), limits(l), audit(a), modbus_stats(std::move(m)) {}
+
+  ModbusStats modbus() const { return modbus_stats ? modbus_stats() : ModbusStats{}; }
+  bool commands_enabled() const { return !config.token.empty(); }
+
+  void sample_until_stopped() {
+    std::unique_lock lock(stop_mutex);
+    while (!stopping) {
+      lock.unlock();
+      trend.add(channels.snapshot.read());
+      lock.lock();
+      stop_cv.wait_for(lock, std::chrono::duration<double>(TrendBuffer::kPeriodS), [this] { return stopping; });
+    }
+  }
+
+  // The token rule: none configured -> commands are off (403); else the bearer token must match (401).
+  bool authorised(const httplib::Request& req, httplib::Response& res) const {
+    if (config.token.empty()) {
+      send_error(res, 403, "commands are disabled: configure [web] token to enable them");
+      return false;
+    }
+    const std::string header = req.get_header_value("Authorization");
+    const std::string prefix = "Bearer ";
+    if (header.compare(0, prefix.size(), prefix) != 0 || !constant_time_equal(header.substr(prefix.size()), config.token)) {
+      res.set_header("WWW-Authenticate", "Bearer");
+      send_error(res, 401, "missing or wrong token: send 'Authorization: Bearer <token>'");
+      return false;
+    }
+    return true;
+  }
+
+  void command(CommandEndpoint endpoint, const httplib::Request& req, httplib::Response& res) {
+    if (!authorised(req, res)) return;
+    const runtime::Snapshot snap = channels.snapshot.read();
+    CommandDecision d = validate_command(endpoint, req.body, snap, limits);
+    if (d.status != 200) return send_error(res, d.status, d.error);
+    if (!channels.commands.try_push_all(d.commands.data(), d.commands.size()))
+      return send_error(res, 503, "the command queue is full: try again");
+    const std::string source = "web " + req.remote_addr;
+    if (audit)
+      for (const auto& c : d.changes) audit->record({unix_time_ms(), source, c.point, c.old_value, c.new_value});
+    res.set_content(R"({"accepted":true})", kJson);
+  }
+
+  void routes() {
+    auto& s = server;
+    s.set_pre_routing_handler([this](const httplib::Request&, httplib::Response& res) {
+      requests.fetch_add(1, std::memory_order_relaxed);
+      res.set_header("Cache-Control", "no-store");
+      return httplib::Server::HandlerResponse::Unhandled;
+    });
+    s.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_content(status_json(channels.snapshot.read(), modbus(), commands_enabled()), kJson);
+    });
+    s.Get("/api/trend", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_content(trend_json(trend.points(), channels.snapshot.read()), kJson);
+    });
+    s.Get("/api/moves", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_content(moves_json(trend.moves()), kJson);
+    });
+    s.Get("/api/tuning", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_content(tuning_json(channels.snapshot.read()), kJson);
+    });
+    s.Get("/api/audit", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_content(audit_json(audit ? audit->entries() : std::vector<core::AuditEntry>{}), kJson);
+    });
+    s.Get("/metrics", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_content(prometheus_text(channels.snapshot.read(), modbus(), requests.load()),
+                      "text/plain; version=0.0.4; charset=utf-8");
+    });
+    s.Get("/vendor/chart.js", [this](const httplib::Request&, httplib::Response& res) {
+      if (chart_js.empty()) return send_error(res, 404, "Chart.js is not installed (" + config.chart_js + "; Debian: libjs-chart.js)");
+      res.headers.erase("Cache-Control");  // a fixed file: the browser may keep it
+      res.set_header("Cache-Control", "max-age=86400");
+      res.set_content(chart_js, "text/javascript");
+    });
+    s.Post("/api/setpoint", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kSetpoint, q, r); });
+    s.Post("/api/mode", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kMode, q, r); });
+    s.Post("/api/reset", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kReset, q, r); });
+
+    // Every error leaves as JSON: httplib's own (404 no route, 413 payload too large, 400 bad request) included.
+    s.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
+      if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+      const char* what = res.status == 404   ? "no such resource"
+                         : res.status == 413 ? "request body too large"
+                         : res.status == 414 ? "request URI too long"
+                         : res.status == 405 ? "method not allowed"
+                         : res.status >= 500 ? "internal error"
+                                             : "bad request";
+      res.set_content(error_json(what), kJson);
+      return httplib::Server::HandlerResponse::Handled;
+    }));
+    s.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
+      std::string what = "internal error";
+      try {
+        if (ep) std::rethrow_exception(ep);
+      } catch (const std::exception& e) {
+        what += std::string(": ") + e.what();
+      } catch (...) {
+      }
+      send_error(res, 500, what);
+    });
+  }
+};
+
+core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& config, runtime::LoopChannels& channels,
+                                                          const runtime::RuntimeConfig& limits, RecentAudit* audit,
+                                                          ModbusStatsFn modbus_stats) {
+  if (config.worker_threads < 1) return core::invalid_argument("web: worker_threads must be >= 1");
+  auto impl = std::make_unique<Impl>(config, channels, limits, audit, std::move(modbus_stats));
+  if (!std::filesystem::is_directory(config.static_dir))
+    return core::io_error("web: static_dir '" + config.static_dir + "' is not a folder (it holds index.html, app.js, style.css)");
+  {
+    std::ifstream in(config.chart_js, std::ios::binary);
+    std::stringstream ss;
+    if (in) ss << in.rdbuf(), impl->chart_js = ss.str();  // empty: /vendor/chart.js answers 404 and the page shows numbers only
+  }
+  auto& s = impl->server;
+  const int threads = config.worker_threads;
+  s.new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<std::size_t>(threads)); };
+  s.set_payload_max_length(config.max_body_bytes);
+  s.set_read_timeout(5, 0);
+  s.set_write_timeout(5, 0);
+  s.set_keep_alive_timeout(2);
+  s.set_keep_alive_max_count(100);
+  if (!s.set_mount_point("/", config.static_dir))
+    return core::io_error("web: cannot serve static files from '" + config.static_dir + "'");
+  impl->routes();
+
+  if (config.port == 0) {
+    impl->port = s.bind_to_any_port(config.address);
+    if (impl->port <= 0) return core::io_error("web: cannot bind to " + config.address + " (any port)");
+  } else {
+    if (!s.bind_to_port(config.address, config.port))
+      return core::io_error("web: cannot bind to " + config.address + ":" + std::to_string(config.port) +
+                            " (in use, or not an address of this machine?)");
+    impl->port = config.port;
+  }
+  Impl* p = impl.get();
+  p->sampler = std::thread([p] { p->sample_until_stopped(); });
+  p->listener = std::thread([p] {
+    p->server.listen_after_bind();
+    p->listen_returned = true;
+  });
+  return std::unique_ptr<WebServer>(new WebServer(std::move(impl)));
+}
+
+WebServer::WebServer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+WebServer::~WebServer() { stop(); }
+
+int WebServer::port() const { return impl_->port; }
+
+void WebServer::stop() {
+  {
+    std::lock_guard lock(impl_->stop_mutex);
+    impl_->stopping = true;
+  }
+  impl_->stop_cv.notify_all();
+  if (impl_->listener.joinable()) {
+    // listen_after_bind may not have reached its loop yet, and a stop() before that is lost.
+    while (!impl_->server.is_running() && !impl_->listen_returned.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    impl_->server.stop();
+    impl_->listener.join();
+  }
+  if (impl_->sampler.joinable()) impl_->sampler.join();
+}
+
+}  // namespace epa::web

@@ -1,0 +1,52 @@
+#pragma once
+// The status page's HTTP server (cpp-httplib): the JSON API, /metrics, the page's static files
+// and Chart.js, and, when a token is configured, the setpoint/mode/reset commands. It reads only
+// the published snapshot and keeps its own buffers (a sampler thread fills the 30 s trend), so it
+// cannot slow the scan cycle; a bounded worker pool, timeouts and a payload cap bound what a
+// crowd of clients can cost.
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "core/audit.hpp"
+#include "core/result.hpp"
+#include "runtime/runtime_config.hpp"
+#include "runtime/scan_cycle.hpp"
+#include "web/json_api.hpp"
+
+namespace epa::web {
+
+struct WebConfig {
+  std::string address = "0.0.0.0";  // IPv4 address to listen on
+  int port = 8080;                   // 0: any free port (see port())
+  std::string token;                 // "": commands refused (403); else "Authorization: Bearer <token>"
+  std::string static_dir = "../web"; // index.html, app.js, style.css
+  std::string chart_js = "/usr/share/javascript/chart.js/chart.min.js";  // Debian's libjs-chart.js
+  int worker_threads = 64;           // connections served at once; an idle one holds a worker until it times out
+  std::size_t max_body_bytes = 4096;
+};
+
+class RecentAudit;
+
+class WebServer {
+ public:
+  using ModbusStatsFn = std::function<ModbusStats()>;
+  // Binds, then serves on its own thread. channels, limits and audit must outlive the server.
+  // `audit` may be null; when it is a RecentAudit, /api/audit shows its entries.
+  static core::Result<std::unique_ptr<WebServer>> start(const WebConfig& config, runtime::LoopChannels& channels,
+                                                        const runtime::RuntimeConfig& limits, RecentAudit* audit,
+                                                        ModbusStatsFn modbus_stats = {});
+  ~WebServer();
+  WebServer(const WebServer&) = delete;
+  WebServer& operator=(const WebServer&) = delete;
+
+  int port() const;
+  void stop();
+
+ private:
+  struct Impl;
+  explicit WebServer(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace epa::web

@@ -1,0 +1,162 @@
+#!/usr/bin/env bash
+# The status page in a real browser: Debian's headless Chromium against a running appliance on
+# the simulated plant, as the commissioning engineer's laptop would open it.
+#
+#   status_page_test.sh <epa binary> <source dir> <artifacts dir>
+#
+# Starts `epa serve` (sim, RUN, setpoint 50 mm; Modbus and web on free loopback ports; the page
+# from <source dir>/web), waits for it by polling, then: (1) the page's DOM, after its scripts ran,
+# has trend points and shows a position; (2) a setpoint of 150 mm written over Modbus (mbpoll)
+# shows up as a position that changed by more than 50 mm; (3) screenshots at laptop (1280x900) and
+# phone (390x844) size go to <artifacts dir>. The appliance is stopped by its PID.
+set -uo pipefail
+
+if [ $# -ne 3 ]; then
+  echo "usage: $0 <epa binary> <source dir> <artifacts dir>" >&2
+  exit 2
+fi
+epa=$1
+src=$2
+artifacts=$3
+host=127.0.0.1
+
+command -v chromium >/dev/null || { echo "FAIL: chromium is not installed (scripts/install-deps.sh installs it)" >&2; exit 1; }
+command -v mbpoll >/dev/null || { echo "FAIL: mbpoll is not installed" >&2; exit 1; }
+command -v curl >/dev/null || command -v python3 >/dev/null || { echo "FAIL: need curl or python3" >&2; exit 1; }
+[ -x "$epa" ] || { echo "FAIL: $epa is not an executable" >&2; exit 1; }
+mkdir -p "$artifacts"
+
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/epa-browser.XXXXXX")
+pid=""
+passed=0
+failed=0
+
+now_ms() { echo $(( ${EPOCHREALTIME/./} / 1000 )); }
+
+stop_appliance() {
+  [ -n "$pid" ] || return 0
+  if kill -0 "$pid" 2>/dev/null; then
+    kill -TERM "$pid" 2>/dev/null
+    local deadline=$(( $(now_ms) + 5000 ))
+    while kill -0 "$pid" 2>/dev/null && [ "$(now_ms)" -lt "$deadline" ]; do sleep 0.05; done
+    kill -0 "$pid" 2>/dev/null && kill -KILL "$pid" 2>/dev/null
+  fi
+  wait "$pid" 2>/dev/null
+  pid=""
+}
+cleanup() {
+  stop_appliance
+  rm -rf "$tmp"
+}
+trap cleanup EXIT
+trap 'exit 1' INT TERM HUP
+
+pass() { passed=$((passed + 1)); echo "PASS: $*"; }
+fail() { failed=$((failed + 1)); echo "FAIL: $*" >&2; }
+abort() {
+  fail "$*"
+  echo "---- appliance log ----" >&2; cat "$tmp/epa.log" >&2
+  echo "$passed passed, $failed failed"
+  exit 1
+}
+
+free_port() { python3 -c "import socket; s=socket.socket(); s.bind(('127.0.0.1',0)); print(s.getsockname()[1])"; }
+http_get() { curl -s --max-time 2 "$1" 2>/dev/null; }
+
+# Chromium, headless, in a fresh profile each time, bounded by `timeout`; its stderr is noise.
+browser() {
+  local profile
+  profile=$(mktemp -d "$tmp/chromium.XXXXXX")
+  timeout 60 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run \
+    --disable-background-networking --disable-component-update --disable-sync --hide-scrollbars \
+    --user-data-dir="$profile" "$@" 2>>"$tmp/chromium.log"
+}
+# The page after 3 s of its own polling (virtual time: chromium runs the timers and fetches).
+dump_dom() { browser --virtual-time-budget=3000 --dump-dom "$url"; }
+body_attr() { grep -o "<body[^>]*>" | grep -o "$1=\"[^\"]*\"" | head -1 | cut -d'"' -f2; }
+
+# ---- start the appliance ----
+modbus_port=$(free_port)
+web_port=$(free_port)
+cat >"$tmp/epa.toml" <<EOF2
+# written by tests/browser/status_page_test.sh
+[modbus]
+address = "127.0.0.1"
+port = $modbus_port
+register_map = "$src/registers/epa.csv"
+
+[web]
+address = "127.0.0.1"
+port = $web_port
+static_dir = "$src/web"
+
+[log]
+status_interval_s = 0
+
+[recorder]
+directory = "$tmp/runs"
+EOF2
+"$epa" serve --config "$tmp/epa.toml" --mode run --setpoint 50 >"$tmp/epa.log" 2>&1 &
+pid=$!
+url="http://$host:$web_port/"
+echo "appliance pid $pid: web $url, modbus $host:$modbus_port"
+
+deadline=$(( $(now_ms) + 10000 ))
+ready=0
+while [ "$(now_ms)" -lt "$deadline" ]; do
+  kill -0 "$pid" 2>/dev/null || abort "the appliance exited during start-up"
+  if http_get "${url}api/status" | grep -q '"mode"'; then ready=1; break; fi
+  sleep 0.1
+done
+[ "$ready" -eq 1 ] || abort "the web server did not answer on $url within 10 s"
+
+# Let the piston reach 50 mm so that the trend has a story to show.
+sleep 2
+
+# ---- (1) the page draws the trend and shows the position ----
+dom=$(dump_dom)
+points=$(body_attr data-trend-points <<<"$dom")
+pos1=$(body_attr data-position-mm <<<"$dom")
+if [ -n "$points" ] && [ "$points" -gt 0 ] 2>/dev/null; then
+  pass "(1) the page drew $points trend points"
+else
+  fail "(1) data-trend-points: expected > 0, got '${points}'"
+fi
+if awk -v p="$pos1" 'BEGIN { exit !(p != "" && p > 40 && p < 60) }'; then
+  pass "(1) the page shows position $pos1 mm (setpoint 50)"
+else
+  fail "(1) data-position-mm: expected about 50, got '${pos1}'"
+fi
+grep -q 'id="position-chart"' <<<"$dom" && grep -q '<canvas' <<<"$dom" || fail "(1) the chart canvas is missing from the page"
+
+# ---- (2) a setpoint written over Modbus moves the position shown ----
+out=$(mbpoll -m tcp -a 1 -p "$modbus_port" -0 -1 -o 1 -t 4:float -B -r 0 "$host" 150 2>&1)
+grep -q "Written 1 references" <<<"$out" || fail "(2) writing setpoint 150 over Modbus: $out"
+pos2=""
+deadline=$(( $(now_ms) + 20000 ))
+while [ "$(now_ms)" -lt "$deadline" ]; do
+  sleep 1
+  pos2=$(dump_dom | body_attr data-position-mm)
+  awk -v a="$pos1" -v b="$pos2" 'BEGIN { exit !(b != "" && b - a > 50) }' && break
+done
+if awk -v a="$pos1" -v b="$pos2" 'BEGIN { exit !(b != "" && b - a > 50) }'; then
+  pass "(2) after setpoint 150 over Modbus the page shows $pos2 mm (was $pos1)"
+else
+  fail "(2) after setpoint 150 over Modbus: expected the shown position to rise by > 50 mm from $pos1, got '${pos2}'"
+fi
+http_get "${url}api/audit" | grep -q '"point":"setpoint_mm"' && pass "(2) the Modbus write is in /api/audit" \
+  || fail "(2) /api/audit does not show the Modbus setpoint write"
+
+# ---- (3) screenshots ----
+rm -f "$artifacts/status_page.png" "$artifacts/status_page_phone.png"
+browser --virtual-time-budget=3000 --window-size=1280,900 --screenshot="$artifacts/status_page.png" "$url" >/dev/null
+browser --virtual-time-budget=3000 --window-size=390,844 --screenshot="$artifacts/status_page_phone.png" "$url" >/dev/null
+for f in status_page.png status_page_phone.png; do
+  if [ -s "$artifacts/$f" ]; then pass "(3) screenshot $artifacts/$f"; else fail "(3) no screenshot $artifacts/$f"; fi
+done
+
+kill -0 "$pid" 2>/dev/null && pass "the appliance is still running" || fail "the appliance died during the test"
+stop_appliance
+[ "$failed" -eq 0 ] || { echo "---- appliance log ----" >&2; cat "$tmp/epa.log" >&2; }
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]

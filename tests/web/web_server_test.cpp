@@ -1,0 +1,361 @@
+// The status page's HTTP server in-process on 127.0.0.1 (port 0), against a LoopChannels whose
+// snapshot the test publishes: every endpoint's JSON, /metrics, the token rule, validation, and
+// that bad requests and idle connections are survived.
+#include "web/web_server.hpp"
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <map>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "web/recent_audit.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+using nlohmann::json;
+using epa::runtime::Command;
+using epa::runtime::CommandKind;
+
+class Collecting : public epa::core::AuditSink {
+ public:
+  void record(const epa::core::AuditEntry& e) override { entries.push_back(e); }
+  std::vector<epa::core::AuditEntry> entries;
+};
+
+class WebServerTest : public ::testing::Test {
+ protected:
+  void start(const std::string& token = "") {
+    snap_.cycle = 1234;
+    snap_.time_s = 6.17;
+    snap_.Ts = 0.005;
+    snap_.mode = epa::runtime::Mode::kRun;
+    snap_.setpoint_mm = 120.0;
+    snap_.position_mm = 118.5;
+    snap_.error_mm = 1.5;
+    snap_.valve_v = 1.25;
+    snap_.heartbeat = 42;
+    snap_.moves = 3;
+    snap_.loop.jitter_p99_us = 17.0;
+    snap_.loop.overruns = 2;
+    snap_.last_move = {3, 50.0, 120.0, 0.21, std::nan(""), 0.4, 12.5};
+    snap_.tuning.F = {1.0, -1.778, 0.7828};
+    snap_.tuning.nF = 2;
+    snap_.tuning.b_l = -1.722;
+    snap_.tuning.b_r = 1.232;
+    snap_.tuning.lc_mm = 5.0;
+    channels_.snapshot.publish(snap_);
+    epa::web::WebConfig config;
+    config.address = "127.0.0.1";
+    config.port = 0;
+    config.token = token;
+    config.static_dir = std::string(EPA_SOURCE_DIR) + "/web";
+    auto server = epa::web::WebServer::start(config, channels_, limits_, &audit_, [] {
+      return epa::web::ModbusStats{true, 2, 77, 1};
+    });
+    ASSERT_TRUE(server.has_value()) << server.error().message;
+    server_ = std::move(*server);
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", server_->port());
+    client_->set_connection_timeout(2, 0);
+    client_->set_read_timeout(2, 0);
+  }
+  json get_json(const std::string& path, int expected_status = 200) {
+    auto res = client_->Get(path.c_str());
+    EXPECT_TRUE(res) << path;
+    if (!res) return {};
+    EXPECT_EQ(res->status, expected_status) << path << ": " << res->body;
+    EXPECT_EQ(res->get_header_value("Content-Type"), "application/json") << path;
+    return json::parse(res->body);
+  }
+  httplib::Result post(const std::string& path, const std::string& body, const std::string& token = "") {
+    httplib::Headers headers;
+    if (!token.empty()) headers.emplace("Authorization", "Bearer " + token);
+    return client_->Post(path.c_str(), headers, body, "application/json");
+  }
+  std::vector<Command> queued() {
+    std::vector<Command> out;
+    Command c;
+    while (channels_.commands.try_pop(c)) out.push_back(c);
+    return out;
+  }
+
+  epa::runtime::LoopChannels channels_{16};
+  epa::runtime::RuntimeConfig limits_;  // setpoint range [0, 500] mm
+  epa::runtime::Snapshot snap_;
+  Collecting log_;
+  epa::web::RecentAudit audit_{&log_};
+  std::unique_ptr<epa::web::WebServer> server_;
+  std::unique_ptr<httplib::Client> client_;
+};
+
+TEST_F(WebServerTest, StatusShowsThePublishedSnapshotWithNanAsNull) {
+  start();
+  const json s = get_json("/api/status");
+  EXPECT_EQ(s["cycle"], 1234);
+  EXPECT_EQ(s["mode"], "run");
+  EXPECT_EQ(s["fault"], "none");
+  EXPECT_TRUE(s["fault_text"].is_null());
+  EXPECT_EQ(s["controller"], "pp-ffidz");
+  EXPECT_EQ(s["controller_name"], "PP FF-IDZ");
+  EXPECT_DOUBLE_EQ(s["setpoint_mm"].get<double>(), 120.0);
+  EXPECT_DOUBLE_EQ(s["position_mm"].get<double>(), 118.5);
+  EXPECT_DOUBLE_EQ(s["error_mm"].get<double>(), 1.5);
+  EXPECT_DOUBLE_EQ(s["valve_v"].get<double>(), 1.25);
+  EXPECT_EQ(s["heartbeat"], 42);
+  EXPECT_EQ(s["counters"]["moves"], 3);
+  EXPECT_DOUBLE_EQ(s["loop"]["jitter_p99_us"].get<double>(), 17.0);
+  EXPECT_EQ(s["loop"]["overruns"], 2);
+  EXPECT_EQ(s["last_move"]["number"], 3);
+  EXPECT_DOUBLE_EQ(s["last_move"]["rise_s"].get<double>(), 0.21);
+  EXPECT_TRUE(s["last_move"]["settling_s"].is_null());  // NaN: never settled
+  EXPECT_EQ(s["modbus"]["clients"], 2);
+  EXPECT_EQ(s["modbus"]["requests"], 77);
+  EXPECT_FALSE(s["commands_enabled"].get<bool>());
+}
+
+TEST_F(WebServerTest, StatusNamesALatchedFaultInWords) {
+  start();
+  snap_.mode = epa::runtime::Mode::kFault;
+  snap_.fault = epa::runtime::FaultCode::kFollowingError;
+  channels_.snapshot.publish(snap_);
+  const json s = get_json("/api/status");
+  EXPECT_EQ(s["mode"], "fault");
+  EXPECT_EQ(s["fault"], "following-error");
+  EXPECT_EQ(s["fault_text"], std::string(epa::runtime::describe(epa::runtime::FaultCode::kFollowingError)));
+}
+
+TEST_F(WebServerTest, TrendMovesTuningAndAuditHaveTheirShapes) {
+  start();
+  std::this_thread::sleep_for(200ms);  // the sampler takes a point every 50 ms
+  const json t = get_json("/api/trend");
+  ASSERT_GE(t["t_s"].size(), 2u);
+  EXPECT_EQ(t["t_s"].size(), t["position_mm"].size());
+  EXPECT_EQ(t["t_s"].size(), t["setpoint_mm"].size());
+  EXPECT_EQ(t["t_s"].size(), t["valve_v"].size());
+  EXPECT_DOUBLE_EQ(t["position_mm"].back().get<double>(), 118.5);
+  EXPECT_DOUBLE_EQ(t["dead_zone"]["b_l"].get<double>(), -1.722);
+  EXPECT_DOUBLE_EQ(t["dead_zone"]["b_r"].get<double>(), 1.232);
+  EXPECT_DOUBLE_EQ(t["window_s"].get<double>(), 30.0);
+
+  const json m = get_json("/api/moves");
+  ASSERT_EQ(m["moves"].size(), 1u);
+  EXPECT_EQ(m["moves"][0]["number"], 3);
+  EXPECT_EQ(m["moves"][0]["controller"], "pp-ffidz");
+  EXPECT_TRUE(m["moves"][0]["settling_s"].is_null());
+  snap_.last_move.number = 4;
+  channels_.snapshot.publish(snap_);
+  std::this_thread::sleep_for(200ms);
+  const json m2 = get_json("/api/moves");
+  ASSERT_EQ(m2["moves"].size(), 2u);
+  EXPECT_EQ(m2["moves"][0]["number"], 4);  // newest first
+
+  const json u = get_json("/api/tuning");
+  EXPECT_EQ(u["F"], json::array({1.0, -1.778, 0.7828}));
+  EXPECT_DOUBLE_EQ(u["b_l"].get<double>(), -1.722);
+  EXPECT_DOUBLE_EQ(u["lc_mm"].get<double>(), 5.0);
+  EXPECT_DOUBLE_EQ(u["Ts"].get<double>(), 0.005);
+
+  audit_.record({1000, "modbus 127.0.0.1:5000", "setpoint_mm", 0.0, 50.0});
+  const json a = get_json("/api/audit");
+  ASSERT_EQ(a["entries"].size(), 1u);
+  EXPECT_EQ(a["entries"][0]["source"], "modbus 127.0.0.1:5000");
+  EXPECT_DOUBLE_EQ(a["entries"][0]["new_value"].get<double>(), 50.0);
+  EXPECT_EQ(log_.entries.size(), 1u);  // forwarded to the next sink
+}
+
+TEST_F(WebServerTest, MetricsAreValidPrometheusText) {
+  start();
+  auto res = client_->Get("/metrics");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  EXPECT_NE(res->get_header_value("Content-Type").find("text/plain"), std::string::npos);
+  std::istringstream in(res->body);
+  std::string line;
+  std::map<std::string, double> samples;
+  std::set<std::string> help, type;
+  while (std::getline(in, line)) {
+    ASSERT_FALSE(line.empty());
+    std::istringstream words(line);
+    std::string a, b;
+    if (line.rfind("# HELP ", 0) == 0) { words >> a >> a >> b; help.insert(b); continue; }
+    if (line.rfind("# TYPE ", 0) == 0) {
+      std::string kind;
+      words >> a >> a >> b >> kind;
+      EXPECT_TRUE(kind == "gauge" || kind == "counter") << line;
+      type.insert(b);
+      continue;
+    }
+    std::string value, rest;
+    words >> a >> value;
+    EXPECT_FALSE(words >> rest) << "more than 'name value': " << line;
+    char* end = nullptr;
+    const double v = std::strtod(value.c_str(), &end);
+    EXPECT_EQ(*end, '\0') << line;
+    samples[a] = v;
+  }
+  for (const char* name : {"epa_position_mm", "epa_error_mm", "epa_valve_volts", "epa_loop_jitter_p99_microseconds",
+                           "epa_loop_overruns_total", "epa_faults_total", "epa_modbus_requests_total", "epa_mode"}) {
+    EXPECT_TRUE(samples.count(name)) << name;
+    EXPECT_TRUE(help.count(name)) << name;
+    EXPECT_TRUE(type.count(name)) << name;
+  }
+  EXPECT_DOUBLE_EQ(samples["epa_position_mm"], 118.5);
+  EXPECT_DOUBLE_EQ(samples["epa_modbus_requests_total"], 77);
+  EXPECT_DOUBLE_EQ(samples["epa_loop_overruns_total"], 2);
+  EXPECT_DOUBLE_EQ(samples["epa_mode"], 1);
+}
+
+TEST_F(WebServerTest, WithoutATokenEveryPostIsForbidden) {
+  start();
+  for (const char* path : {"/api/setpoint", "/api/mode", "/api/reset"}) {
+    auto res = post(path, "{}", "anything");
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 403) << path;
+    EXPECT_NE(json::parse(res->body)["error"].get<std::string>().find("token"), std::string::npos);
+  }
+  EXPECT_TRUE(queued().empty());
+  EXPECT_TRUE(audit_.entries().empty());
+}
+
+TEST_F(WebServerTest, WithATokenOnlyTheRightBearerIsObeyedAndAudited) {
+  start("s3cret-token");
+  auto missing = post("/api/setpoint", R"({"setpoint_mm": 150})");
+  ASSERT_TRUE(missing);
+  EXPECT_EQ(missing->status, 401);
+  auto wrong = post("/api/setpoint", R"({"setpoint_mm": 150})", "s3cret-tokeN");
+  ASSERT_TRUE(wrong);
+  EXPECT_EQ(wrong->status, 401);
+  EXPECT_TRUE(json::parse(wrong->body).contains("error"));
+  EXPECT_TRUE(queued().empty());
+
+  auto right = post("/api/setpoint", R"({"setpoint_mm": 150})", "s3cret-token");
+  ASSERT_TRUE(right);
+  EXPECT_EQ(right->status, 200) << right->body;
+  auto q = queued();
+  ASSERT_EQ(q.size(), 1u);
+  EXPECT_EQ(q[0].kind, CommandKind::kSetpoint);
+  EXPECT_DOUBLE_EQ(q[0].value, 150.0);
+  const auto entries = audit_.entries();
+  ASSERT_EQ(entries.size(), 1u);
+  EXPECT_EQ(entries[0].source, "web 127.0.0.1");
+  EXPECT_EQ(entries[0].point, "setpoint_mm");
+  EXPECT_DOUBLE_EQ(entries[0].old_value, 120.0);
+  EXPECT_DOUBLE_EQ(entries[0].new_value, 150.0);
+
+  auto mode = post("/api/mode", R"({"mode": "stop"})", "s3cret-token");
+  ASSERT_TRUE(mode);
+  EXPECT_EQ(mode->status, 200);
+  auto reset = post("/api/reset", "{}", "s3cret-token");
+  ASSERT_TRUE(reset);
+  EXPECT_EQ(reset->status, 200);
+  q = queued();
+  ASSERT_EQ(q.size(), 2u);
+  EXPECT_EQ(q[0].kind, CommandKind::kMode);
+  EXPECT_EQ(q[0].mode, epa::runtime::Mode::kStop);
+  EXPECT_EQ(q[1].kind, CommandKind::kReset);
+  EXPECT_EQ(get_json("/api/audit")["entries"].size(), 3u);
+  EXPECT_TRUE(get_json("/api/status")["commands_enabled"].get<bool>());
+}
+
+TEST_F(WebServerTest, CommandsAreValidatedLikeModbusWrites) {
+  start("t");
+  auto far = post("/api/setpoint", R"({"setpoint_mm": 600})", "t");
+  ASSERT_TRUE(far);
+  EXPECT_EQ(far->status, 400);
+  EXPECT_NE(json::parse(far->body)["error"].get<std::string>().find("[0, 500]"), std::string::npos) << far->body;
+  for (const char* body : {"{\"setpoint_mm\": ", "not json", "[1,2]", R"({"setpoint_mm": "100"})", R"({"setpoint": 100})"}) {
+    auto res = post("/api/setpoint", body, "t");
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 400) << body;
+    EXPECT_TRUE(json::parse(res->body).contains("error")) << body;
+  }
+  auto bad_mode = post("/api/mode", R"({"mode": "fault"})", "t");
+  ASSERT_TRUE(bad_mode);
+  EXPECT_EQ(bad_mode->status, 400);
+
+  snap_.mode = epa::runtime::Mode::kFault;
+  snap_.fault = epa::runtime::FaultCode::kSoftLimit;
+  channels_.snapshot.publish(snap_);
+  auto refused = post("/api/mode", R"({"mode": "run"})", "t");
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 409);
+  EXPECT_NE(json::parse(refused->body)["error"].get<std::string>().find("fault"), std::string::npos);
+  EXPECT_TRUE(queued().empty());
+  EXPECT_TRUE(audit_.entries().empty());
+  auto reset = post("/api/reset", "", "t");  // reset is what a latched fault needs
+  ASSERT_TRUE(reset);
+  EXPECT_EQ(reset->status, 200);
+}
+
+TEST_F(WebServerTest, UnknownPathsAndOversizedBodiesGetJsonErrors) {
+  start("t");
+  const json e = get_json("/api/nothing", 404);
+  EXPECT_TRUE(e.contains("error"));
+  auto wrong_method = client_->Delete("/api/status");
+  ASSERT_TRUE(wrong_method);
+  EXPECT_GE(wrong_method->status, 400);
+  EXPECT_LT(wrong_method->status, 500);
+  EXPECT_TRUE(json::parse(wrong_method->body).contains("error"));
+  auto big = post("/api/setpoint", "{\"setpoint_mm\": 1" + std::string(100000, '0') + "}", "t");
+  ASSERT_TRUE(big);
+  EXPECT_EQ(big->status, 413);
+  EXPECT_TRUE(json::parse(big->body).contains("error"));
+  // Still serving afterwards.
+  httplib::Client again("127.0.0.1", server_->port());
+  auto ok = again.Get("/api/status");
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 200);
+}
+
+TEST_F(WebServerTest, ServesThePageAndChartJs) {
+  start();
+  auto page = client_->Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_NE(page->body.find("data-trend-points"), std::string::npos);
+  auto js = client_->Get("/app.js");
+  ASSERT_TRUE(js);
+  EXPECT_EQ(js->status, 200);
+  auto chart = client_->Get("/vendor/chart.js");
+  ASSERT_TRUE(chart);
+  EXPECT_EQ(chart->status, 200);  // Debian's libjs-chart.js
+  EXPECT_NE(chart->body.find("Chart.js"), std::string::npos);
+}
+
+TEST_F(WebServerTest, FiftyIdleConnectionsDoNotStopANormalRequest) {
+  start();
+  std::vector<int> idle;
+  for (int i = 0; i < 50; ++i) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    ASSERT_GE(fd, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<std::uint16_t>(server_->port()));
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+    if (i % 2) {
+      ASSERT_GT(::send(fd, "GET /api/sta", 12, 0), 0);  // half of them stop mid-request
+    }
+    idle.push_back(fd);
+  }
+  std::this_thread::sleep_for(100ms);  // let the server accept them all
+  const auto t0 = std::chrono::steady_clock::now();
+  auto res = client_->Get("/api/status");
+  const auto took = std::chrono::steady_clock::now() - t0;
+  for (int fd : idle) ::close(fd);
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  EXPECT_LT(took, 200ms);
+}
+
+}  // namespace

@@ -1,0 +1,171 @@
+// The status page: polls /api/status and /api/trend every 250 ms, the slower-changing
+// /api/moves, /api/tuning and /api/audit every 2 s, and draws with Chart.js (Debian's
+// libjs-chart.js, served at /vendor/chart.js). No build step.
+"use strict";
+
+const FAST_MS = 250, SLOW_MS = 2000;
+const $ = (id) => document.getElementById(id);
+const fmt = (v, digits = 2) => (v === null || v === undefined || !Number.isFinite(v)) ? "never" : v.toFixed(digits);
+const num = (v, digits = 2) => (v === null || v === undefined || !Number.isFinite(v)) ? "–" : v.toFixed(digits);
+const setText = (id, text) => { const e = $(id); if (e && e.textContent !== text) e.textContent = text; };
+
+let positionChart = null, valveChart = null;
+
+function makeCharts() {
+  if (typeof Chart === "undefined") return;  // Chart.js missing: numbers only
+  const common = {
+    animation: false, responsive: true, maintainAspectRatio: false, parsing: false, normalized: true,
+    interaction: { mode: "nearest", intersect: false },
+    elements: { point: { radius: 0 }, line: { borderWidth: 2, tension: 0 } },
+    scales: { x: { type: "linear", title: { display: true, text: "time, s" }, ticks: { maxTicksLimit: 8 } } },
+    plugins: { legend: { labels: { boxWidth: 12 } } },
+  };
+  positionChart = new Chart($("position-chart"), {
+    type: "line",
+    data: { datasets: [
+      { label: "setpoint, mm", data: [], borderColor: "#8a94a6", borderDash: [6, 4], stepped: true },
+      { label: "position, mm", data: [], borderColor: "#1f5fbf" },
+    ] },
+    options: { ...common, scales: { ...common.scales, y: { title: { display: true, text: "mm" } } } },
+  });
+  valveChart = new Chart($("valve-chart"), {
+    type: "line",
+    data: { datasets: [
+      { label: "dead zone b_l", data: [], borderColor: "rgba(198,40,40,0.5)", borderWidth: 1, borderDash: [3, 3] },
+      { label: "dead zone b_r", data: [], borderColor: "rgba(198,40,40,0.5)", borderWidth: 1, borderDash: [3, 3],
+        backgroundColor: "rgba(198,40,40,0.10)", fill: "-1" },
+      { label: "valve, V", data: [], borderColor: "#b7791f" },
+    ] },
+    options: { ...common, scales: { ...common.scales, y: { title: { display: true, text: "V" } } },
+               plugins: { legend: { labels: { boxWidth: 12, filter: (item) => item.text !== "dead zone b_l" } } } },
+  });
+  valveChart.data.datasets[1].label = "dead zone [b_l, b_r]";
+}
+
+async function getJson(path) {
+  const res = await fetch(path, { cache: "no-store" });
+  if (!res.ok) throw new Error(`${path}: HTTP ${res.status}`);
+  return res.json();
+}
+
+function showStatus(s) {
+  const mode = $("mode");
+  setText("mode", s.mode);
+  mode.className = "badge " + s.mode;
+  setText("controller", s.controller_name);
+  setText("uptime", `up ${num(s.time_s, 0)} s`);
+  const fault = $("fault");
+  fault.hidden = s.mode !== "fault";
+  if (s.mode === "fault") { setText("fault-code", s.fault); setText("fault-text", s.fault_text || ""); }
+  setText("position", num(s.position_mm, 1));
+  setText("setpoint", num(s.setpoint_mm, 1));
+  setText("error", num(s.error_mm, 2));
+  setText("valve", num(s.valve_v, 3));
+  const L = s.loop;
+  setText("s-jitter", `${num(L.jitter_p50_us, 0)} / ${num(L.jitter_p99_us, 0)} / ${num(L.jitter_max_us, 0)} µs`);
+  setText("s-wake", `${num(L.wake_p99_us, 0)} µs`);
+  setText("s-compute", `${num(L.compute_p99_us, 0)} µs`);
+  setText("s-cycles", `${L.cycles} / ${L.overruns}`);
+  setText("s-faults", `${s.counters.faults} / ${s.counters.io_errors}`);
+  setText("s-commands", `${s.counters.commands_applied} / ${s.counters.commands_rejected}`);
+  setText("s-heartbeat", String(s.heartbeat));
+  setText("s-modbus", s.modbus.enabled ? `${s.modbus.clients} / ${s.modbus.requests}` : "off");
+  setText("s-web", s.commands_enabled ? "enabled (token)" : "read-only");
+  const m = s.last_move;
+  setText("last-move-head", m ? `#${m.number}: ${num(m.from_mm, 1)} → ${num(m.to_mm, 1)} mm` : "none yet");
+  setText("lm-rise", m ? `${fmt(m.rise_s, 3)}${m.rise_s === null ? "" : " s"}` : "–");
+  setText("lm-settling", m ? `${fmt(m.settling_s, 3)}${m.settling_s === null ? "" : " s"}` : "–");
+  setText("lm-ess", m ? `${fmt(m.ess_mm, 2)}${m.ess_mm === null ? "" : " mm"}` : "–");
+  setText("lm-overshoot", m ? `${fmt(m.overshoot_pct, 1)}${m.overshoot_pct === null ? "" : " %"}` : "–");
+  document.body.dataset.positionMm = Number.isFinite(s.position_mm) ? s.position_mm.toFixed(3) : "";
+  document.body.dataset.mode = s.mode;
+}
+
+function showTrend(t) {
+  const n = t.t_s.length;
+  document.body.dataset.trendPoints = String(n);
+  if (!positionChart) return;
+  const sp = new Array(n), pos = new Array(n), u = new Array(n);
+  for (let i = 0; i < n; ++i) {
+    sp[i] = { x: t.t_s[i], y: t.setpoint_mm[i] };
+    pos[i] = { x: t.t_s[i], y: t.position_mm[i] };
+    u[i] = { x: t.t_s[i], y: t.valve_v[i] };
+  }
+  const x0 = n ? t.t_s[0] : 0, x1 = n ? t.t_s[n - 1] : 1;
+  const xmin = Math.max(x0, x1 - t.window_s);
+  for (const c of [positionChart, valveChart]) { c.options.scales.x.min = xmin; c.options.scales.x.max = x1; }
+  positionChart.data.datasets[0].data = sp;
+  positionChart.data.datasets[1].data = pos;
+  const bl = t.dead_zone.b_l, br = t.dead_zone.b_r;
+  valveChart.data.datasets[0].data = n && bl !== null ? [{ x: x0, y: bl }, { x: x1, y: bl }] : [];
+  valveChart.data.datasets[1].data = n && br !== null ? [{ x: x0, y: br }, { x: x1, y: br }] : [];
+  valveChart.data.datasets[2].data = u;
+  positionChart.update("none");
+  valveChart.update("none");
+}
+
+function showMoves(d) {
+  const body = $("moves").tBodies[0];
+  const rows = d.moves.map((m) => `<tr><td>${m.number}</td><td>${num(m.from_mm, 0)} → ${num(m.to_mm, 0)}</td>` +
+    `<td>${m.controller}</td><td>${fmt(m.rise_s, 3)}</td><td>${fmt(m.settling_s, 3)}</td>` +
+    `<td>${fmt(m.ess_mm, 2)}</td><td>${fmt(m.overshoot_pct, 1)}</td></tr>`);
+  const html = rows.length ? rows.join("") : `<tr><td colspan="7" class="muted">no moves yet</td></tr>`;
+  if (body.innerHTML !== html) body.innerHTML = html;
+}
+
+function showTuning(t) {
+  setText("t-m", `${num(t.m_r, 4)} / ${num(t.m_l, 4)}`);
+  setText("t-b", `${num(t.b_r, 4)} / ${num(t.b_l, 4)} V`);
+  setText("t-lc", `${num(t.lc_mm, 2)} mm`);
+  setText("t-ts", `${num(t.Ts * 1000, 2)} ms`);
+  const poly = (c) => c.map((v) => (v === null ? "–" : Number(v.toPrecision(5)))).join(", ");
+  setText("t-f", poly(t.F));
+  setText("t-g", poly(t.G));
+  setText("t-h", poly(t.H));
+}
+
+const escapeHtml = (s) => String(s).replace(/[&<>"']/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;", "'": "&#39;" }[c]));
+
+function showAudit(a) {
+  const body = $("audit").tBodies[0];
+  const rows = a.entries.map((e) => `<tr><td>${new Date(e.unix_time_ms).toLocaleTimeString()}</td>` +
+    `<td>${escapeHtml(e.source)}</td><td>${escapeHtml(e.point)}</td><td>${num(e.old_value, 3)}</td><td>${num(e.new_value, 3)}</td></tr>`);
+  const html = rows.length ? rows.join("") : `<tr><td colspan="5" class="muted">no changes yet</td></tr>`;
+  if (body.innerHTML !== html) body.innerHTML = html;
+}
+
+function linkState(ok, message) {
+  const link = $("link");
+  link.classList.toggle("down", !ok);
+  setText("link", ok ? "live" : message);
+}
+
+async function fast() {
+  try {
+    const [s, t] = await Promise.all([getJson("/api/status"), getJson("/api/trend")]);
+    showStatus(s);
+    showTrend(t);
+    linkState(true);
+  } catch (e) {
+    linkState(false, "no connection");
+  } finally {
+    setTimeout(fast, FAST_MS);
+  }
+}
+
+async function slow() {
+  try {
+    const [m, t, a] = await Promise.all([getJson("/api/moves"), getJson("/api/tuning"), getJson("/api/audit")]);
+    showMoves(m);
+    showTuning(t);
+    showAudit(a);
+  } catch (e) {
+    // the fast poll shows the connection state
+  } finally {
+    setTimeout(slow, SLOW_MS);
+  }
+}
+
+makeCharts();
+fast();
+slow();
