@@ -26,41 +26,8 @@ command -v curl >/dev/null || command -v python3 >/dev/null || { echo "FAIL: nee
 [ -x "$epa" ] || { echo "FAIL: $epa is not an executable" >&2; exit 1; }
 mkdir -p "$artifacts"
 
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/epa-browser.XXXXXX")
-pid=""
-passed=0
-failed=0
+source "$(dirname "$0")/../support/appliance.sh" browser
 
-now_ms() { echo $(( ${EPOCHREALTIME/./} / 1000 )); }
-
-stop_appliance() {
-  [ -n "$pid" ] || return 0
-  if kill -0 "$pid" 2>/dev/null; then
-    kill -TERM "$pid" 2>/dev/null
-    local deadline=$(( $(now_ms) + 5000 ))
-    while kill -0 "$pid" 2>/dev/null && [ "$(now_ms)" -lt "$deadline" ]; do sleep 0.05; done
-    kill -0 "$pid" 2>/dev/null && kill -KILL "$pid" 2>/dev/null
-  fi
-  wait "$pid" 2>/dev/null
-  pid=""
-}
-cleanup() {
-  stop_appliance
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-trap 'exit 1' INT TERM HUP
-
-pass() { passed=$((passed + 1)); echo "PASS: $*"; }
-fail() { failed=$((failed + 1)); echo "FAIL: $*" >&2; }
-abort() {
-  fail "$*"
-  echo "---- appliance log ----" >&2; cat "$tmp/epa.log" >&2
-  echo "$passed passed, $failed failed"
-  exit 1
-}
-
-free_port() { python3 -c "import socket; s=socket.socket(); s.bind(('127.0.0.1',0)); print(s.getsockname()[1])"; }
 http_get() { curl -s --max-time 2 "$1" 2>/dev/null; }
 
 # Chromium, headless, in a fresh profile each time, bounded by `timeout`; its stderr is noise.
@@ -157,6 +124,6 @@ done
 
 kill -0 "$pid" 2>/dev/null && pass "the appliance is still running" || fail "the appliance died during the test"
 stop_appliance
-[ "$failed" -eq 0 ] || { echo "---- appliance log ----" >&2; cat "$tmp/epa.log" >&2; }
+[ "$failed" -eq 0 ] || show_log
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

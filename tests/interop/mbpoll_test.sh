@@ -25,54 +25,7 @@ command -v python3 >/dev/null || { echo "FAIL: python3 is needed to pick a free 
 [ -x "$epa" ] || { echo "FAIL: $epa is not an executable" >&2; exit 1; }
 [ -f "$src/registers/epa.csv" ] || { echo "FAIL: $src/registers/epa.csv not found" >&2; exit 1; }
 
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/epa-mbpoll.XXXXXX")
-pid=""
-passed=0
-failed=0
-
-now_ms() { echo $(( ${EPOCHREALTIME/./} / 1000 )); }
-
-# Stop the appliance by its PID: SIGTERM, then SIGKILL if it is still there after 5 s.
-stop_appliance() {
-  [ -n "$pid" ] || return 0
-  local status=0
-  if kill -0 "$pid" 2>/dev/null; then
-    kill -TERM "$pid" 2>/dev/null
-    local deadline=$(( $(now_ms) + 5000 ))
-    while kill -0 "$pid" 2>/dev/null && [ "$(now_ms)" -lt "$deadline" ]; do sleep 0.05; done
-    if kill -0 "$pid" 2>/dev/null; then
-      echo "appliance (pid $pid) ignored SIGTERM for 5 s: SIGKILL" >&2
-      kill -KILL "$pid" 2>/dev/null
-    fi
-  fi
-  wait "$pid" 2>/dev/null
-  status=$?
-  pid=""
-  return $status
-}
-cleanup() {
-  stop_appliance
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-trap 'exit 1' INT TERM HUP
-
-pass() { passed=$((passed + 1)); echo "PASS: $*"; }
-fail() {
-  failed=$((failed + 1))
-  echo "FAIL: $*" >&2
-}
-show_log() {
-  echo "---- appliance log ($tmp/epa.log) ----" >&2
-  cat "$tmp/epa.log" >&2
-  echo "---- end of log ----" >&2
-}
-abort() {  # a failure the later checks cannot recover from
-  fail "$*"
-  show_log
-  echo "$passed passed, $failed failed"
-  exit 1
-}
+source "$(dirname "$0")/../support/appliance.sh" mbpoll
 
 # mbpoll against the appliance: TCP, unit 1, 0-based (PDU) addresses, one poll, 1 s timeout.
 mb() { mbpoll -m tcp -a 1 -p "$port" -0 -1 -o 1 "$@"; }
@@ -86,7 +39,7 @@ near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d
 read_position() { mb -t 3:float -B -r 0 -c 1 "$host" 2>&1 | value_of 0; }
 
 # ---- start the appliance on a free loopback port ----
-port=$(python3 -c "import socket; s=socket.socket(); s.bind(('127.0.0.1',0)); print(s.getsockname()[1])")
+port=$(free_port)
 cat >"$tmp/epa.toml" <<EOF
 # written by tests/interop/mbpoll_test.sh
 [modbus]
