@@ -4,15 +4,16 @@
 #include <systemd/sd-daemon.h>
 
 #include <csignal>
-#include <optional>
 #include <ctime>
+#include <optional>
 #include <thread>
 
 #include "app/daq_factory.hpp"
 #include "app/log_audit_sink.hpp"
 #include "app/tuning_source.hpp"
-#include "runtime/clock.hpp"
+#include "core/format.hpp"
 #include "hal/realtime.hpp"
+#include "runtime/clock.hpp"
 #include "runtime/recorder.hpp"
 #include "runtime/scan_cycle.hpp"
 #include "web/recent_audit.hpp"
@@ -67,49 +68,143 @@ std::string describe_snapshot(const runtime::Snapshot& s) {
   return buf;
 }
 
-}  // namespace
+// Everything the control law needs, from the configuration's model and design files.
+struct ControlSetup {
+  core::ModelFile model_file;
+  core::HammersteinModel model;
+  ControllerPolynomials polynomials;
+  control::ControllerConfig tuning_base;  // what tuning writes edit (Modbus)
+  runtime::Tuning tuning;
+};
 
-int run_serve(const ServeOptions& o, std::ostream& err) {
-  auto config = read_appliance_config(o.config_path);
-  if (!config) return err << "epa serve: " << config.error().message << "\n", 1;
-  if (auto s = apply_overrides(o, *config); !s) return err << "epa serve: " << s.error().message << "\n", 1;
-  ApplianceConfig& c = *config;
-
+core::Result<ControlSetup> prepare_control(ApplianceConfig& c) {
   auto model_file = load_model(c.model_path);
-  if (!model_file) return err << "epa serve: " << model_file.error().message << "\n", 1;
+  if (!model_file) return model_file.error();
   core::HammersteinModel model = model_file->model;
   // The paper does not print its Ts (NOTES.md), so its model takes the loop's period; an
   // identified model is only valid at the Ts it was identified at.
   if (c.model_path.empty()) model.Ts = c.runtime.period_s;
   if (std::abs(model.Ts - c.runtime.period_s) > 1e-12)
-    return err << "epa serve: loop.period_s " << c.runtime.period_s << " s differs from the model's Ts " << model.Ts
-               << " s (" << c.model_path << ")\n", 1;
+    return core::invalid_argument("loop.period_s " + core::format_number(c.runtime.period_s) + " s differs from the model's Ts " +
+                                  core::format_number(model.Ts) + " s (" + c.model_path + ")");
   c.runtime.mm_per_volt = model.mm_per_volt;
   auto polynomials = load_controller_polynomials(c.design_path);
-  if (!polynomials) return err << "epa serve: " << polynomials.error().message << "\n", 1;
-  const control::ControllerConfig tuning_base{.kind = c.runtime.controller, .F = polynomials->F, .G = polynomials->G,
-                                              .H = polynomials->H, .dead_zone = model.dead_zone,
-                                              .lc_v = c.lc_mm / model.mm_per_volt, .valve_limit_v = c.valve_limit_v,
-                                              .safe_valve_v = c.runtime.safe_valve_v};
-  auto tuning = runtime::make_tuning(tuning_base);
-  if (!tuning) return err << "epa serve: " << tuning.error().message << "\n", 1;
+  if (!polynomials) return polynomials.error();
+  const control::ControllerConfig base{.kind = c.runtime.controller, .F = polynomials->F, .G = polynomials->G,
+                                       .H = polynomials->H, .dead_zone = model.dead_zone,
+                                       .lc_v = c.lc_mm / model.mm_per_volt, .valve_limit_v = c.valve_limit_v,
+                                       .safe_valve_v = c.runtime.safe_valve_v};
+  auto tuning = runtime::make_tuning(base);
+  if (!tuning) return tuning.error();
+  return ControlSetup{std::move(*model_file), model, std::move(*polynomials), base, *tuning};
+}
+
+core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const ApplianceConfig& c, const modbus::RegisterMap& map,
+                                                                 const ControlSetup& control, runtime::LoopChannels& channels,
+                                                                 core::AuditSink& audit) {
+  auto server = modbus::ModbusServer::start(c.modbus, map, control.tuning_base, control.model.mm_per_volt, channels, &audit,
+                                            [](const std::string& line) { spdlog::info("{}", line); });
+  if (!server) return server.error();
+  const auto& p = c.modbus.policy;
+  spdlog::info("modbus: listening on {}:{} (unit {}, map {}, {} points, {})", c.modbus.address, (*server)->port(),
+               c.modbus.unit_id, c.register_map_path, map.entries().size(),
+               p.read_only ? "read-only" : p.unlock_key ? "tuning locked until unlocked" : "tuning locked (no unlock key)");
+  return server;
+}
+
+core::Result<std::unique_ptr<web::WebServer>> start_web(const ApplianceConfig& c, runtime::LoopChannels& channels,
+                                                        web::RecentAudit& audit, const modbus::ModbusServer* mb) {
+  auto server = web::WebServer::start(c.web, channels, c.runtime, &audit, [mb] {
+    return mb ? web::ModbusStats{true, mb->clients(), mb->requests(), mb->exceptions()} : web::ModbusStats{};
+  });
+  if (!server) return server.error();
+  spdlog::info("web: listening on {}:{} (static files {}, commands {})", c.web.address, (*server)->port(), c.web.static_dir,
+               c.web.token.empty() ? "disabled: no token configured" : "enabled with the token");
+  return server;
+}
+
+// What the operator should read in the log between two snapshots: mode changes, faults, moves.
+void log_changes(const runtime::Snapshot& previous, const runtime::Snapshot& s) {
+  if (s.mode != previous.mode) spdlog::info("mode {} -> {}", runtime::to_string(previous.mode), runtime::to_string(s.mode));
+  if (s.faults != previous.faults)
+    spdlog::error("FAULT {}: {} (position {:.2f} mm, sensor {:.3f} V)", runtime::to_string(s.fault), runtime::describe(s.fault),
+                  s.position_mm, s.sensor_v);
+  if (s.moves != previous.moves)
+    spdlog::info("move {} {:.1f} -> {:.1f} mm: rise {:.3f} s, settling {:.3f} s, e_ss {:.2f} mm, overshoot {:.1f} %",
+                 s.last_move.number, s.last_move.from_mm, s.last_move.to_mm, s.last_move.rise_s, s.last_move.settling_s,
+                 s.last_move.ess_mm, s.last_move.overshoot_pct);
+}
+
+// The main thread while the appliance runs: waits for SIGTERM/SIGINT (or the duration), logs
+// events and a periodic status, and pings the systemd watchdog only while the loop advances,
+// so a stuck loop gets the unit restarted.
+void supervise(const ApplianceConfig& c, double duration_s, const runtime::LoopChannels& channels, const sigset_t& signals) {
+  std::uint64_t watchdog_usec = 0;
+  const bool watchdog = sd_watchdog_enabled(0, &watchdog_usec) > 0;
+  const auto started = std::chrono::steady_clock::now();
+  auto last_status = started, last_ping = started;
+  runtime::Snapshot previous = channels.snapshot.read();
+  std::uint64_t cycle_at_last_ping = previous.cycle;
+  const timespec tick{0, 50'000'000};  // 50 ms: events are logged within that
+  for (;;) {
+    const int sig = sigtimedwait(&signals, nullptr, &tick);
+    if (sig == SIGTERM || sig == SIGINT) {
+      spdlog::info("signal {}: shutting down", sig == SIGTERM ? "SIGTERM" : "SIGINT");
+      return;
+    }
+    const auto now = std::chrono::steady_clock::now();
+    const runtime::Snapshot s = channels.snapshot.read();
+    log_changes(previous, s);
+    previous = s;
+    if (c.status_interval_s > 0 && now - last_status >= std::chrono::duration<double>(c.status_interval_s)) {
+      spdlog::info("status: {}", describe_snapshot(s));
+      last_status = now;
+    }
+    if (watchdog && now - last_ping >= std::chrono::microseconds(watchdog_usec / 2)) {
+      if (s.cycle != cycle_at_last_ping) sd_notify(0, "WATCHDOG=1");
+      cycle_at_last_ping = s.cycle;
+      last_ping = now;
+    }
+    if (duration_s > 0 && now - started >= std::chrono::duration<double>(duration_s)) {
+      spdlog::info("duration of {} s reached: shutting down", duration_s);
+      return;
+    }
+  }
+}
+
+// Closes the DAQ on every way out of run_serve.
+struct DaqCloser {
+  hal::Daq& daq;
+  ~DaqCloser() { daq.close(); }
+};
+
+}  // namespace
+
+int run_serve(const ServeOptions& o, std::ostream& err) {
+  auto fail = [&err](const core::Error& e) { return err << "epa serve: " << e.message << "\n", 1; };
+  auto config = read_appliance_config(o.config_path);
+  if (!config) return fail(config.error());
+  if (auto s = apply_overrides(o, *config); !s) return fail(s.error());
+  ApplianceConfig& c = *config;
+  auto control = prepare_control(c);
+  if (!control) return fail(control.error());
   std::optional<modbus::RegisterMap> register_map;
   if (c.modbus_enabled) {
     auto map = modbus::RegisterMap::load(c.register_map_path);
-    if (!map) return err << "epa serve: " << map.error().message << "\n", 1;
+    if (!map) return fail(map.error());
     register_map = std::move(*map);
   }
-
-  auto daq = make_daq(c, model);
-  if (!daq) return err << "epa serve: " << daq.error().message << "\n", 1;
+  auto daq = make_daq(c, control->model);
+  if (!daq) return fail(daq.error());
   spdlog::info("epa serve starting: config {}, DAQ {}", o.config_path, (*daq)->describe());
   if (auto s = (*daq)->open(); !s) {
     spdlog::error("DAQ: {}", s.error().message);
     return 1;
   }
+  const DaqCloser closer{**daq};
   spdlog::info("controller {} ({}), model {}, Ts {} s, start mode {}, setpoint {} mm",
-               control::to_string(c.runtime.controller), polynomials->source, model_file->source, model.Ts,
-               runtime::to_string(c.runtime.start_mode), c.runtime.start_setpoint_mm);
+               control::to_string(c.runtime.controller), control->polynomials.source, control->model_file.source,
+               control->model.Ts, runtime::to_string(c.runtime.start_mode), c.runtime.start_setpoint_mm);
 
   // SIGTERM/SIGINT are taken synchronously by this thread; the threads below inherit the mask.
   sigset_t signals;
@@ -120,46 +215,25 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
 
   runtime::LoopChannels channels(static_cast<std::size_t>(c.runtime.record_buffer_s / c.runtime.period_s));
   runtime::MonotonicClock clock;
-  runtime::ScanCycle loop(c.runtime, *tuning, **daq, clock, channels);
-  runtime::Recorder recorder({.directory = c.record_directory, .per_move = c.record_per_move, .Ts = model.Ts,
-                              .source = std::string("appliance/") + to_string(c.backend)},
-                             channels, [](const std::string& line) { spdlog::info("{}", line); });
-  recorder.start();
+  runtime::ScanCycle loop(c.runtime, control->tuning, **daq, clock, channels);
   LogAuditSink log_audit;
   web::RecentAudit audit(&log_audit);  // the log, plus the last entries for the status page
   std::unique_ptr<modbus::ModbusServer> modbus_server;
   if (register_map) {
-    auto server = modbus::ModbusServer::start(c.modbus, *register_map, tuning_base, model.mm_per_volt, channels, &audit,
-                                              [](const std::string& line) { spdlog::info("{}", line); });
-    if (!server) {
-      spdlog::error("{}", server.error().message);
-      recorder.stop();
-      (*daq)->close();
-      return 1;
-    }
+    auto server = start_modbus(c, *register_map, *control, channels, audit);
+    if (!server) return spdlog::error("{}", server.error().message), 1;
     modbus_server = std::move(*server);
-    spdlog::info("modbus: listening on {}:{} (unit {}, map {}, {} points, {})", c.modbus.address, modbus_server->port(),
-                 c.modbus.unit_id, c.register_map_path, register_map->entries().size(),
-                 c.modbus.policy.read_only ? "read-only" : c.modbus.policy.unlock_key ? "tuning locked until unlocked" : "tuning locked (no unlock key)");
   }
-
   std::unique_ptr<web::WebServer> web_server;
   if (c.web_enabled) {
-    const modbus::ModbusServer* mb = modbus_server.get();
-    auto server = web::WebServer::start(c.web, channels, c.runtime, &audit, [mb] {
-      return mb ? web::ModbusStats{true, mb->clients(), mb->requests(), mb->exceptions()} : web::ModbusStats{};
-    });
-    if (!server) {
-      spdlog::error("{}", server.error().message);
-      if (modbus_server) modbus_server->stop();
-      recorder.stop();
-      (*daq)->close();
-      return 1;
-    }
+    auto server = start_web(c, channels, audit, modbus_server.get());
+    if (!server) return spdlog::error("{}", server.error().message), 1;
     web_server = std::move(*server);
-    spdlog::info("web: listening on {}:{} (static files {}, commands {})", c.web.address, web_server->port(),
-                 c.web.static_dir, c.web.token.empty() ? "disabled: no token configured" : "enabled with the token");
   }
+  runtime::Recorder recorder({.directory = c.record_directory, .per_move = c.record_per_move, .Ts = control->model.Ts,
+                              .source = std::string("appliance/") + to_string(c.backend)},
+                             channels, [](const std::string& line) { spdlog::info("{}", line); });
+  recorder.start();
 
   std::atomic<bool> stop{false};
   std::thread loop_thread([&] {
@@ -168,54 +242,14 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   });
   sd_notify(0, "READY=1");
   spdlog::info("running");
+  supervise(c, o.duration_s, channels, signals);
 
-  std::uint64_t watchdog_usec = 0;
-  const bool watchdog = sd_watchdog_enabled(0, &watchdog_usec) > 0;
-  const auto started = std::chrono::steady_clock::now();
-  auto last_status = started;
-  runtime::Snapshot previous = channels.snapshot.read();
-  std::uint64_t cycle_at_last_ping = previous.cycle;
-  auto last_ping = started;
-  const timespec tick{0, 50'000'000};  // 50 ms: events are logged within that
-  for (;;) {
-    const int sig = sigtimedwait(&signals, nullptr, &tick);
-    if (sig == SIGTERM || sig == SIGINT) {
-      spdlog::info("signal {}: shutting down", sig == SIGTERM ? "SIGTERM" : "SIGINT");
-      break;
-    }
-    const auto now = std::chrono::steady_clock::now();
-    const runtime::Snapshot s = channels.snapshot.read();
-    if (s.mode != previous.mode) spdlog::info("mode {} -> {}", runtime::to_string(previous.mode), runtime::to_string(s.mode));
-    if (s.faults != previous.faults)
-      spdlog::error("FAULT {}: {} (position {:.2f} mm, sensor {:.3f} V)", runtime::to_string(s.fault),
-                    runtime::describe(s.fault), s.position_mm, s.sensor_v);
-    if (s.moves != previous.moves)
-      spdlog::info("move {} {:.1f} -> {:.1f} mm: rise {:.3f} s, settling {:.3f} s, e_ss {:.2f} mm, overshoot {:.1f} %",
-                   s.last_move.number, s.last_move.from_mm, s.last_move.to_mm, s.last_move.rise_s, s.last_move.settling_s,
-                   s.last_move.ess_mm, s.last_move.overshoot_pct);
-    if (c.status_interval_s > 0 && now - last_status >= std::chrono::duration<double>(c.status_interval_s)) {
-      spdlog::info("status: {}", describe_snapshot(s));
-      last_status = now;
-    }
-    // Ping the systemd watchdog only while the loop advances: a stuck loop gets the unit restarted.
-    if (watchdog && now - last_ping >= std::chrono::microseconds(watchdog_usec / 2)) {
-      if (s.cycle != cycle_at_last_ping) sd_notify(0, "WATCHDOG=1");
-      cycle_at_last_ping = s.cycle;
-      last_ping = now;
-    }
-    previous = s;
-    if (o.duration_s > 0 && now - started >= std::chrono::duration<double>(o.duration_s)) {
-      spdlog::info("duration of {} s reached: shutting down", o.duration_s);
-      break;
-    }
-  }
   sd_notify(0, "STOPPING=1");
   if (web_server) web_server->stop();        // no more commands from either interface;
   if (modbus_server) modbus_server->stop();  // then the loop's last cycle
   stop = true;
   loop_thread.join();  // the loop's last act: valve to its safe command
-  recorder.stop();
-  (*daq)->close();
+  recorder.stop();     // writes what is pending; the DAQ closes on the way out
   spdlog::info("stopped: {}", describe_snapshot(channels.snapshot.read()));
   return 0;
 }
