@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <new>
 #include <thread>
 
@@ -344,44 +345,70 @@ TEST(ModbusIoDaq, CycleCallsAllocateNothingConnectedLostOrReconnecting) {
   EXPECT_GE(ok, 9);  // reconnected within the interval of 10 cycles
 }
 
+// A one-client Modbus module on a free loopback port whose answers the test scripts: before
+// request n (from 1) is answered, `script(n)` runs (it may sleep, as a slow module would) and
+// returns false to leave that request unanswered. Input register 0 holds `input0`.
+class ScriptedModule {
+ public:
+  ScriptedModule(std::function<bool(int)> script, std::uint16_t input0) : script_(std::move(script)) {
+    server_ = modbus_new_tcp("127.0.0.1", 0);
+    listener_ = server_ ? modbus_tcp_listen(server_, 1) : -1;
+    sockaddr_in addr{};
+    socklen_t len = sizeof addr;
+    if (listener_ >= 0 && getsockname(listener_, reinterpret_cast<sockaddr*>(&addr), &len) == 0) port_ = ntohs(addr.sin_port);
+    mapping_ = modbus_mapping_new(0, 0, 1, 1);
+    mapping_->tab_input_registers[0] = input0;
+    if (port_ > 0) thread_ = std::thread([this] { serve(); });
+  }
+  ~ScriptedModule() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+    if (server_) modbus_close(server_);
+    if (listener_ >= 0) close(listener_);
+    modbus_mapping_free(mapping_);
+    if (server_) modbus_free(server_);
+  }
+  int port() const { return port_; }  // 0: could not listen
+
+ private:
+  void serve() {
+    for (pollfd p{listener_, POLLIN, 0}; poll(&p, 1, 20) <= 0;)
+      if (stop_.load()) return;
+    if (modbus_tcp_accept(server_, &listener_) < 0) return;
+    // Like the simulator and real modules: answers leave at once. Without this, Nagle's algorithm
+    // holds each small answer until the previous one is acknowledged, and a lag never clears.
+    const int one = 1;
+    setsockopt(modbus_get_socket(server_), IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    std::uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
+    for (int request = 1; !stop_.load();) {
+      pollfd p{modbus_get_socket(server_), POLLIN, 0};
+      if (poll(&p, 1, 20) <= 0) continue;
+      const int n = modbus_receive(server_, query);
+      if (n < 0) break;
+      if (script_(request++)) modbus_reply(server_, query, n, mapping_);
+    }
+  }
+
+  std::function<bool(int)> script_;
+  modbus_t* server_ = nullptr;
+  int listener_ = -1, port_ = 0;
+  modbus_mapping_t* mapping_ = nullptr;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
 // A module that answers open()'s first request and then stays silent: the next read must give
 // kTimeout after about the response timeout, not block.
 TEST(ModbusIoDaq, ReadReportsTimeoutWithinTheResponseTimeoutWhenTheModuleFallsSilent) {
-  modbus_t* server = modbus_new_tcp("127.0.0.1", 0);
-  ASSERT_NE(server, nullptr);
-  int listener = modbus_tcp_listen(server, 1);
-  ASSERT_GE(listener, 0);
-  sockaddr_in addr{};
-  socklen_t len = sizeof addr;
-  ASSERT_EQ(getsockname(listener, reinterpret_cast<sockaddr*>(&addr), &len), 0);
-  modbus_mapping_t* mapping = modbus_mapping_new(0, 0, 1, 1);
-  std::atomic<bool> stop{false};
-  std::thread silent([&] {
-    for (pollfd p{listener, POLLIN, 0}; poll(&p, 1, 20) <= 0;)
-      if (stop.load()) return;
-    if (modbus_tcp_accept(server, &listener) < 0) return;
-    std::uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
-    for (int answered = 0; !stop.load();) {
-      pollfd p{modbus_get_socket(server), POLLIN, 0};
-      if (poll(&p, 1, 20) <= 0) continue;
-      const int n = modbus_receive(server, query);
-      if (n < 0) break;
-      if (answered++ == 0) modbus_reply(server, query, n, mapping);
-    }
-  });
-  ModbusIoConfig c = daq_config(ntohs(addr.sin_port));
+  ScriptedModule module([](int request) { return request == 1; }, 0);
+  ASSERT_GT(module.port(), 0);
+  ModbusIoConfig c = daq_config(module.port());
   c.response_timeout_ms = 50;  // not 2 ms: open()'s first answer needs this test's thread to wake up
   ModbusIoDaq daq(c);
   const auto opened = daq.open();
   const auto t0 = Clock::now();
   const SensorReading r = opened ? daq.read_sensor() : SensorReading{};
   const double took_ms = elapsed_ms(t0);
-  stop.store(true);
-  silent.join();
-  modbus_close(server);
-  close(listener);
-  modbus_mapping_free(mapping);
-  modbus_free(server);
   ASSERT_TRUE(opened.has_value()) << opened.error().message;
   EXPECT_EQ(r.status, IoStatus::kTimeout);
   EXPECT_TRUE(daq.connected());  // one late answer costs a sample, not the link
@@ -398,36 +425,15 @@ TEST(ModbusIoDaq, ReadReportsTimeoutWithinTheResponseTimeoutWhenTheModuleFallsSi
 // the failure would miss the next answer, still 1 ms away, and every later request would read
 // its predecessor's answer.)
 TEST(ModbusIoDaq, OneLateAnswerCostsAtMostTwoRequestsAndKeepsTheLink) {
-  modbus_t* server = modbus_new_tcp("127.0.0.1", 0);
-  ASSERT_NE(server, nullptr);
-  int listener = modbus_tcp_listen(server, 1);
-  ASSERT_GE(listener, 0);
-  sockaddr_in addr{};
-  socklen_t len = sizeof addr;
-  ASSERT_EQ(getsockname(listener, reinterpret_cast<sockaddr*>(&addr), &len), 0);
-  modbus_mapping_t* mapping = modbus_mapping_new(0, 0, 1, 1);
-  mapping->tab_input_registers[0] = 6553;  // 2.0 V
-  std::atomic<bool> stop{false};
-  std::thread module([&] {
-    for (pollfd p{listener, POLLIN, 0}; poll(&p, 1, 20) <= 0;)
-      if (stop.load()) return;
-    if (modbus_tcp_accept(server, &listener) < 0) return;
-    // Like the simulator and real modules: answers leave at once. Without this, Nagle's algorithm
-    // holds each small answer until the previous one is acknowledged, and the lag never clears.
-    const int one = 1;
-    setsockopt(modbus_get_socket(server), IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-    std::uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
-    for (int request = 0; !stop.load();) {
-      pollfd p{modbus_get_socket(server), POLLIN, 0};
-      if (poll(&p, 1, 20) <= 0) continue;
-      const int n = modbus_receive(server, query);
-      if (n < 0) break;
-      // 1 ms to answer, as a module's firmware takes; request 3 is answered late, past the timeout.
-      std::this_thread::sleep_for(std::chrono::milliseconds(++request == 3 ? 30 : 1));
-      modbus_reply(server, query, n, mapping);
-    }
-  });
-  ModbusIoConfig c = daq_config(ntohs(addr.sin_port));
+  // 1 ms to answer, as a module's firmware takes; request 3 is answered late, past the timeout.
+  ScriptedModule module(
+      [](int request) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(request == 3 ? 30 : 1));
+        return true;
+      },
+      6553);  // 2.0 V
+  ASSERT_GT(module.port(), 0);
+  ModbusIoConfig c = daq_config(module.port());
   c.response_timeout_ms = 20;
   ModbusIoDaq daq(c);
   const auto opened = daq.open();  // request 1
@@ -436,12 +442,6 @@ TEST(ModbusIoDaq, OneLateAnswerCostsAtMostTwoRequestsAndKeepsTheLink) {
     statuses.push_back(daq.read_sensor().status);  // request 2, 3 (late), 4, ...
     std::this_thread::sleep_for(std::chrono::milliseconds(5));  // the scan period between requests
   }
-  stop.store(true);
-  module.join();
-  modbus_close(server);
-  close(listener);
-  modbus_mapping_free(mapping);
-  modbus_free(server);
   ASSERT_TRUE(opened.has_value()) << opened.error().message;
   ASSERT_EQ(statuses.size(), 12u);
   EXPECT_EQ(statuses[0], IoStatus::kOk);
