@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "app/output_file.hpp"
 #include "app/tuning_source.hpp"
 #include "control/diophantine.hpp"
 #include "control/pole_placement_design.hpp"
@@ -181,8 +181,7 @@ int run_design(const DesignOptions& o, std::ostream& out, std::ostream& err) {
     for (const auto& b : branches)
       j["closed_loop"].push_back({{"branch", b.name}, {"P", b.P.coefficients()}, {"max_root_abs", b.max_root_abs},
                                   {"jury_stable", b.jury.verdict == control::Stability::kStable}});
-    std::ofstream f(o.json_path, std::ios::trunc);
-    if (!(f << j.dump(1) << "\n") || !f.flush()) return err << "epa design: cannot write " << o.json_path << "\n", 1;
+    if (auto s = write_output(o.json_path, j.dump(1) + "\n", out); !s) return err << "epa design: " << s.error().message << "\n", 1;
     out << "\ndesign written to " << o.json_path << "\n";
   }
   return 0;

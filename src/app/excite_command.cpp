@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 
+#include "app/output_file.hpp"
 #include "app/svg_chart.hpp"
 #include "app/tuning_source.hpp"
 #include "core/format.hpp"
@@ -96,9 +96,9 @@ int run_excite(const ExciteOptions& o, std::ostream& out, std::ostream& err) {
   if (auto s = core::write_run_file(o.out_path, run); !s) return fail(s.error().message);
   out << "run written to " << o.out_path << "\n";
   if (!o.plot_path.empty()) {
-    std::ofstream f(o.plot_path, std::ios::trunc);
-    if (!(f << render_excitation_plot(run, result->ramps_end_s, "Excitation run (" + model_file->source + ")")) || !f.flush())
-      return fail("cannot write " + o.plot_path);
+    if (auto s = write_output(o.plot_path, render_excitation_plot(run, result->ramps_end_s, "Excitation run (" + model_file->source + ")"), out);
+        !s)
+      return fail(s.error().message);
     out << "picture written to " << o.plot_path << "\n";
   }
   return 0;

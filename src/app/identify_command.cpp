@@ -2,10 +2,10 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <optional>
 
 #include "app/identify_report.hpp"
+#include "app/output_file.hpp"
 #include "core/format.hpp"
 #include "core/model_file.hpp"
 #include "core/paper_reference.hpp"
@@ -185,9 +185,8 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   }
   if (!o.plot_path.empty()) {
     const auto& shown = val->empty() ? *est : *val;
-    std::ofstream f(o.plot_path, std::ios::trunc);
-    if (!(f << render_identification_plot(shown, fit, model, !val->empty())) || !f.flush())
-      return fail("cannot write " + o.plot_path);
+    if (auto s = write_output(o.plot_path, render_identification_plot(shown, fit, model, !val->empty()), out); !s)
+      return fail(s.error().message);
     out << "picture written to " << o.plot_path << "\n";
   }
   return 0;

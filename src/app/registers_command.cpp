@@ -1,7 +1,6 @@
 #include "app/registers_command.hpp"
 
-#include <fstream>
-
+#include "app/output_file.hpp"
 #include "modbus/register_export.hpp"
 #include "modbus/register_map.hpp"
 
@@ -15,21 +14,6 @@ void add_registers_command(CLI::App& app, RegistersOptions& o) {
   cmd->add_flag("--points", o.points, "List the points a register map can bind");
 }
 
-namespace {
-bool emit(const std::string& path, const std::string& text, std::ostream& out, std::ostream& err) {
-  if (path == "-") {
-    out << text;
-    return true;
-  }
-  std::ofstream f(path, std::ios::trunc);
-  if (!(f << text) || !f.flush()) {
-    err << "epa registers: cannot write " << path << "\n";
-    return false;
-  }
-  return true;
-}
-}  // namespace
-
 int run_registers(const RegistersOptions& o, std::ostream& out, std::ostream& err) {
   if (o.points) {
     out << modbus::points_markdown();
@@ -37,8 +21,11 @@ int run_registers(const RegistersOptions& o, std::ostream& out, std::ostream& er
   }
   auto map = modbus::RegisterMap::load(o.map_path);
   if (!map) return err << "epa registers: " << map.error().message << "\n", 1;
-  if (!o.markdown_path.empty() && !emit(o.markdown_path, modbus::export_markdown(*map), out, err)) return 1;
-  if (!o.csv_path.empty() && !emit(o.csv_path, modbus::export_csv(*map), out, err)) return 1;
+  for (const auto& [path, text] : {std::pair{o.markdown_path, modbus::export_markdown(*map)},
+                                   std::pair{o.csv_path, modbus::export_csv(*map)}}) {
+    if (path.empty()) continue;
+    if (auto s = write_output(path, text, out); !s) return err << "epa registers: " << s.error().message << "\n", 1;
+  }
   if (o.markdown_path != "-" && o.csv_path != "-")
     out << o.map_path << ": valid, " << map->entries().size() << " registers\n";
   return 0;

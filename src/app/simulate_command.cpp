@@ -2,9 +2,9 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "app/output_file.hpp"
 #include "app/response_plot.hpp"
 #include "app/simulation_case.hpp"
 #include "app/table1_report.hpp"
@@ -36,15 +36,6 @@ void add_simulate_command(CLI::App& app, SimulateOptions& o) {
 namespace {
 
 nlohmann::json optional_json(std::optional<double> v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
-
-bool write_text(const std::string& path, const std::string& text, std::ostream& err) {
-  std::ofstream f(path, std::ios::trunc);
-  if (!(f << text) || !f.flush()) {
-    err << "epa simulate: cannot write " << path << "\n";
-    return false;
-  }
-  return true;
-}
 
 }  // namespace
 
@@ -106,13 +97,14 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
                               {"rise_s", optional_json(m.rise_s)}, {"settling_s", optional_json(m.settling_s)},
                               {"ess_mm", m.ess_mm}, {"overshoot_pct", optional_json(m.overshoot_pct)}});
     }
-    if (!write_text(o.json_path, j.dump(1) + "\n", err)) return 1;
+    if (auto s = write_output(o.json_path, j.dump(1) + "\n", out); !s) return err << "epa simulate: " << s.error().message << "\n", 1;
     out << "metrics written to " << o.json_path << "\n";
   }
 
   if (!o.plot_path.empty()) {
     const std::string title = "Closed-loop step responses (" + model_file->source + ", Ts = " + core::format_number(model.Ts) + " s)";
-    if (!write_text(o.plot_path, render_response_plot(cases, model.dead_zone, o.plot_window_s, title), err)) return 1;
+    if (auto s = write_output(o.plot_path, render_response_plot(cases, model.dead_zone, o.plot_window_s, title), out); !s)
+      return err << "epa simulate: " << s.error().message << "\n", 1;
     out << "picture written to " << o.plot_path << "\n";
   }
   return 0;
