@@ -1,9 +1,10 @@
 #pragma once
-// A command's text output (JSON, SVG, Markdown, CSV) to a file, or to standard output for "-".
-#include <fstream>
+// A command's text output (JSON, SVG, Markdown, CSV) to a file, written atomically, or to
+// standard output for "-".
 #include <ostream>
 #include <string>
 
+#include "core/atomic_file.hpp"
 #include "core/result.hpp"
 
 namespace epa::app {
@@ -13,8 +14,7 @@ inline core::Status write_output(const std::string& path, const std::string& tex
     out << text;
     return core::ok();
   }
-  std::ofstream f(path, std::ios::trunc);
-  if (!(f << text) || !f.flush()) return core::io_error("cannot write " + path);
+  if (auto s = core::write_file_atomically(path, text); !s) return core::io_error("cannot write " + path + ": " + s.error().message);
   return core::ok();
 }
 

@@ -1,10 +1,11 @@
 #include "core/model_file.hpp"
 
 #include <charconv>
-#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <toml++/toml.h>
+
+#include "core/atomic_file.hpp"
 
 namespace epa::core {
 
@@ -111,14 +112,8 @@ std::string format_model_toml(const ModelFile& f) {
 }
 
 Status write_model_file(const std::string& path, const ModelFile& file) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    if (!out) return io_error(path + ": cannot write model file");
-    out << format_model_toml(file);
-    if (!out.flush()) return io_error(path + ": write failed");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) return io_error(path + ": cannot replace the model file");
+  if (auto s = write_file_atomically(path, format_model_toml(file)); !s)
+    return io_error(path + ": cannot write the model file: " + s.error().message);
   return ok();
 }
 

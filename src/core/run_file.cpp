@@ -2,11 +2,9 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -16,6 +14,8 @@
 #include <ostream>
 #include <string_view>
 #include <vector>
+
+#include "core/atomic_file.hpp"
 
 namespace epa::core {
 namespace {
@@ -259,12 +259,6 @@ std::string one_line(std::string text) {
   return text;
 }
 
-std::string unique_suffix() {
-  static std::atomic<unsigned> counter{0};
-  const auto now = std::chrono::steady_clock::now().time_since_epoch().count();
-  return std::to_string(now) + "-" + std::to_string(counter++);
-}
-
 }  // namespace
 
 void write_run(std::ostream& out, const Run& run) {
@@ -300,28 +294,9 @@ void write_run(std::ostream& out, const Run& run) {
 Status write_run_file(const std::string& path, const Run& run) {
   if (auto status = check_writable(run); !status)
     return invalid_argument("cannot write run file '" + path + "': " + status.error().message);
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  try {
-    const fs::path tmp = fs::path(path) += ".tmp-" + unique_suffix();  // same folder: the rename is atomic
-    errno = 0;
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return io_error("cannot write run file '" + path + "': cannot create " + tmp.string() + errno_text());
-    write_run(out, run);
-    out.close();
-    if (!out) {
-      fs::remove(tmp, ec);
-      return io_error("cannot write run file '" + path + "': writing '" + tmp.string() + "' failed");
-    }
-    fs::rename(tmp, path, ec);  // readers see the old file or the whole new one
-    if (ec) {
-      const std::string reason = ec.message();
-      fs::remove(tmp, ec);
-      return io_error("cannot write run file '" + path + "': rename failed: " + reason);
-    }
-  } catch (const std::exception& e) {
-    return io_error("cannot write run file '" + path + "': " + e.what());
-  }
+  // Readers see the old file or the whole new one.
+  if (auto s = write_file_atomically(path, [&run](std::ostream& out) { write_run(out, run); }); !s)
+    return io_error("cannot write run file '" + path + "': " + s.error().message);
   return ok();
 }
 
