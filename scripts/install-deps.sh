@@ -7,7 +7,8 @@ packages=(
   build-essential cmake ninja-build ccache pkg-config
   libeigen3-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libjs-chart.js libpagmo-dev
+  libjs-chart.js libpagmo-dev libnlopt-cxx-dev libsqlite3-dev sqlite3
+  clang libclang-rt-14-dev
   libmodbus-dev libcomedi-dev libspdlog-dev libsystemd-dev
   rt-tests mbpoll python3-pymodbus python3-serial-asyncio
   libcpp-httplib-dev chromium
