@@ -6,6 +6,7 @@
 #include <toml++/toml.h>
 
 #include "core/atomic_file.hpp"
+#include "core/toml_number.hpp"
 
 namespace epa::core {
 
@@ -88,20 +89,8 @@ Result<ModelFile> read_model_file(const std::string& path) {
 }
 
 std::string format_model_toml(const ModelFile& f) {
-  // Shortest text that reads back to the same double: identified models round-trip exactly and
-  // the paper's values stay as printed (0.9094, not 0.90939999999999999).
-  auto num = [](double v) {
-    char buf[32];
-    const auto res = std::to_chars(buf, buf + sizeof buf, v);
-    std::string s(buf, res.ptr);
-    if (s.find_first_of(".en") == std::string::npos) s += ".0";  // keep TOML floats floats
-    return s;
-  };
-  auto list = [&](const Polynomial& p) {
-    std::string s = "[";
-    for (std::size_t i = 0; i < p.size(); ++i) s += (i ? ", " : "") + num(p[i]);
-    return s + "]";
-  };
+  auto num = [](double v) { return toml_float(v); };
+  auto list = [](const Polynomial& p) { return toml_float_array(p.coefficients()); };
   const auto& m = f.model;
   std::ostringstream source;
   source << toml::value<std::string>(f.source);  // TOML string escaping by the library

@@ -1,0 +1,43 @@
+#include "store/audit_log.hpp"
+
+#include "store/statement.hpp"
+
+namespace epa::store {
+
+core::Status AuditLog::append(const core::AuditEntry& e) {
+  auto stmt = db_.prepare("INSERT INTO audit_log (time_ms, source, point, old_value, new_value) VALUES (?, ?, ?, ?, ?)");
+  if (!stmt) return stmt.error();
+  stmt->bind(1, e.unix_time_ms).bind(2, e.source).bind(3, e.point).bind_real_or_null(4, e.old_value).bind_real_or_null(5, e.new_value);
+  return stmt->run();
+}
+
+core::Result<std::vector<AuditRecord>> AuditLog::query(const AuditFilter& f) {
+  // Fixed SQL with optional conditions: every filter is a bound parameter, never spliced text.
+  auto stmt = db_.prepare(
+      "SELECT id, time_ms, source, point, old_value, new_value FROM audit_log "
+      "WHERE (?1 IS NULL OR time_ms >= ?1) AND (?2 IS NULL OR time_ms <= ?2) "
+      "AND (?3 = '' OR instr(source, ?3) > 0) AND (?4 = '' OR point = ?4) "
+      "ORDER BY id DESC LIMIT ?5");
+  if (!stmt) return stmt.error();
+  stmt->bind(1, f.since_ms).bind(2, f.until_ms).bind(3, f.source).bind(4, f.point);
+  stmt->bind(5, f.limit == 0 ? std::int64_t{-1} : static_cast<std::int64_t>(f.limit));
+  std::vector<AuditRecord> out;
+  for (;;) {
+    auto row = stmt->step();
+    if (!row) return row.error();
+    if (!*row) return out;
+    out.push_back({stmt->column_int(0),
+                   {stmt->column_int(1), stmt->column_text(2), stmt->column_text(3), stmt->column_double_or_nan(4),
+                    stmt->column_double_or_nan(5)}});
+  }
+}
+
+core::Result<std::int64_t> AuditLog::count() {
+  auto stmt = db_.prepare("SELECT count(*) FROM audit_log");
+  if (!stmt) return stmt.error();
+  auto row = stmt->step();
+  if (!row) return row.error();
+  return stmt->column_int(0);
+}
+
+}  // namespace epa::store

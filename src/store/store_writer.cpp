@@ -1,0 +1,141 @@
+#include "store/store_writer.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "store/audit_log.hpp"
+#include "store/retained_points.hpp"
+#include "store/run_table.hpp"
+#include "store/transaction.hpp"
+#include "store/tuning_points.hpp"
+#include "store/tuning_set_table.hpp"
+
+namespace epa::store {
+
+StoreWriter::StoreWriter(Database db, TuningSet running, std::set<std::string> persisted, Log log)
+    : db_(std::move(db)), running_(std::move(running)), persisted_(std::move(persisted)), log_(std::move(log)) {}
+
+StoreWriter::~StoreWriter() { stop(0.0); }
+
+void StoreWriter::start() {
+  if (!thread_.joinable()) thread_ = std::thread([this] { loop(); });
+}
+
+void StoreWriter::stop(double drain_s) {
+  {
+    std::lock_guard lock(mutex_);
+    if (stop_ && !thread_.joinable()) return;
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(drain_s);
+  while (!flush() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const StoreHealth h = health();
+  if (h.pending > 0 && log_) log_("store: " + std::to_string(h.pending) + " accepted changes could not be saved: " + h.last_error);
+}
+
+void StoreWriter::record(const std::vector<core::AuditEntry>& change) {
+  if (change.empty()) return;
+  {
+    std::lock_guard lock(mutex_);
+    pending_.emplace_back(change);
+    ++accepted_;
+  }
+  wake_.notify_one();
+}
+
+void StoreWriter::record_run(const RunRecord& run) {
+  {
+    std::lock_guard lock(mutex_);
+    pending_.emplace_back(run);
+  }
+  wake_.notify_one();
+}
+
+core::ChangeCounters StoreWriter::counters() const {
+  std::lock_guard lock(mutex_);
+  return {accepted_, saved_.load()};
+}
+
+StoreHealth StoreWriter::health() const {
+  std::lock_guard lock(mutex_);
+  StoreHealth h = health_;
+  h.pending = accepted_ - saved_.load();
+  return h;
+}
+
+core::Status StoreWriter::write(const std::deque<Item>& batch, TuningSet& running) {
+  auto tx = Transaction::begin(db_);
+  if (!tx) return tx.error();
+  AuditLog audit(db_);
+  RetainedPoints retained(db_);
+  RunTable runs(db_);
+  bool tuning_changed = false;
+  for (const Item& item : batch) {
+    if (const auto* run = std::get_if<RunRecord>(&item)) {
+      RunRecord r = *run;
+      r.tuning_set_id = running.id;
+      if (auto id = runs.insert(r); !id) return id.error();
+      continue;
+    }
+    for (const core::AuditEntry& e : std::get<std::vector<core::AuditEntry>>(item)) {
+      if (auto s = audit.append(e); !s) return s;
+      if (!persisted_.contains(e.point)) continue;
+      if (apply_tuning_point(running, e.point, e.new_value)) {
+        running.modified_ms = e.unix_time_ms;
+        tuning_changed = true;
+      } else if (auto s = retained.put(e.point, e.new_value, e.unix_time_ms); !s) {
+        return s;
+      }
+    }
+  }
+  if (tuning_changed)
+    if (auto s = TuningSetTable(db_).update(running); !s) return s;
+  return tx->commit();
+}
+
+bool StoreWriter::flush() {
+  std::lock_guard writing(write_mutex_);
+  std::deque<Item> batch;
+  {
+    std::lock_guard lock(mutex_);
+    batch = pending_;  // copied, not taken: on failure it stays queued, in order
+  }
+  if (batch.empty()) return true;
+  TuningSet running = running_;
+  const auto status = write(batch, running);
+  std::lock_guard lock(mutex_);
+  if (!status) {
+    ++health_.failures;
+    if (health_.ok && log_) log_("store: cannot save (will retry): " + status.error().message);
+    health_.ok = false;
+    health_.last_error = status.error().message;
+    return false;
+  }
+  if (!health_.ok && log_) log_("store: saving again after " + std::to_string(health_.failures) + " failed attempts");
+  health_.ok = true;
+  running_ = running;
+  std::uint64_t changes = 0;
+  for (const Item& item : batch) changes += std::holds_alternative<RunRecord>(item) ? 0 : 1;
+  pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(batch.size()));
+  saved_.fetch_add(changes);
+  return true;
+}
+
+void StoreWriter::loop() {
+  auto pause = std::chrono::milliseconds(0);
+  for (;;) {
+    {
+      std::unique_lock lock(mutex_);
+      if (pause.count() > 0) wake_.wait_for(lock, pause, [this] { return stop_; });
+      wake_.wait(lock, [this] { return stop_ || !pending_.empty(); });
+      if (stop_) return;
+    }
+    // Retry pause after a failure: 50 ms doubling to 800 ms, so a full disk is retried often
+    // enough that a change is on disk within a second of the space coming back.
+    pause = flush() ? std::chrono::milliseconds(0) : std::clamp(pause * 2, std::chrono::milliseconds(50), std::chrono::milliseconds(800));
+  }
+}
+
+}  // namespace epa::store

@@ -1,0 +1,79 @@
+#pragma once
+// The store thread. The Modbus and web threads hand it accepted changes (AuditSink::record) and
+// the recorder hands it run files; it writes them in one transaction per batch (group commit),
+// appending the audit entries and applying the persisted points to the running tuning set or
+// the retained points. The saved counter advances only after COMMIT returned, with
+// synchronous=FULL, so "saved" means on disk. A failed write (disk full, read-only) keeps the
+// batch and retries with a growing pause; nothing is dropped and the counter does not lie.
+// The scan cycle never waits for any of this.
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <set>
+#include <string>
+#include <thread>
+#include <variant>
+
+#include "core/audit.hpp"
+#include "store/database.hpp"
+#include "store/run_record.hpp"
+#include "store/tuning_set.hpp"
+
+namespace epa::store {
+
+struct StoreHealth {
+  bool ok = true;               // the last write succeeded
+  std::string last_error;       // of the last failed write
+  std::uint64_t pending = 0;    // accepted, not yet on disk
+  std::uint64_t failures = 0;   // failed write attempts since start
+};
+
+class StoreWriter final : public core::AuditSink {
+ public:
+  using Log = std::function<void(const std::string&)>;
+
+  // `running` is the tuning set the loop runs: persisted tuning points edit it. `persisted`
+  // names the points whose new values are kept (the register map's persisted column).
+  StoreWriter(Database db, TuningSet running, std::set<std::string> persisted, Log log = {});
+  ~StoreWriter() override;
+  StoreWriter(const StoreWriter&) = delete;
+  StoreWriter& operator=(const StoreWriter&) = delete;
+
+  void start();
+  // Writes what is pending (trying for at most `drain_s`), then joins. Logs what could not be saved.
+  void stop(double drain_s = 2.0);
+
+  void record(const std::vector<core::AuditEntry>& change) override;
+  core::ChangeCounters counters() const override;
+  void record_run(const RunRecord& run);
+
+  StoreHealth health() const;
+  std::int64_t running_set_id() const { return running_.id; }
+
+  // One write attempt of everything pending (the thread calls this; tests may call it directly).
+  bool flush();
+
+ private:
+  using Item = std::variant<std::vector<core::AuditEntry>, RunRecord>;
+  core::Status write(const std::deque<Item>& batch, TuningSet& running);
+  void loop();
+
+  Database db_;
+  TuningSet running_;  // owned by the writing side (the thread, or flush() in tests)
+  std::set<std::string> persisted_;
+  Log log_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<Item> pending_;
+  std::uint64_t accepted_ = 0;
+  std::atomic<std::uint64_t> saved_{0};
+  StoreHealth health_;
+  bool stop_ = false;
+  std::mutex write_mutex_;  // one writer at a time: the thread, or a direct flush()
+  std::thread thread_;
+};
+
+}  // namespace epa::store

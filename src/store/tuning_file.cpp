@@ -1,0 +1,147 @@
+#include "store/tuning_file.hpp"
+
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "core/model_file.hpp"
+#include "core/toml_number.hpp"
+
+namespace epa::store {
+
+namespace {
+
+constexpr const char* kSchema = "epa-tuning/1";
+
+std::string quoted(const std::string& s) {
+  std::ostringstream out;
+  out << toml::value<std::string>(s);  // TOML string escaping by the library
+  return out.str();
+}
+
+core::Status only_keys(const toml::table& t, const std::set<std::string>& allowed, const std::string& where) {
+  for (const auto& [key, node] : t)
+    if (!allowed.contains(std::string(key.str())))
+      return core::parse_error(where + ": unknown key '" + std::string(key.str()) + "'");
+  return core::ok();
+}
+
+core::Result<double> number(const toml::table& t, const char* key, const std::string& where) {
+  const auto* node = t.get(key);
+  if (!node) return core::parse_error(where + " " + key + " is missing");
+  if (auto v = node->value<double>()) return *v;
+  return core::parse_error(where + " " + key + " must be a number");
+}
+
+core::Result<core::Polynomial> polynomial(const toml::table& t, const char* key, const std::string& where) {
+  const auto* arr = t.get_as<toml::array>(key);
+  if (!arr) return core::parse_error(where + " " + key + " is missing or not an array of numbers");
+  std::vector<double> c;
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    auto v = arr->get(i)->value<double>();
+    if (!v) return core::parse_error(where + " " + key + "[" + std::to_string(i) + "] is not a number");
+    c.push_back(*v);
+  }
+  return core::Polynomial(std::move(c));
+}
+
+}  // namespace
+
+std::string format_tuning_toml(const TuningSet& t, const ModelRecord& m) {
+  using core::toml_float;
+  using core::toml_float_array;
+  std::string s = "schema = \"" + std::string(kSchema) + "\"\n";
+  s += "name = " + quoted(t.name) + "\nsource = " + quoted(t.source) + "\n";
+  s += "controller = \"" + std::string(control::to_string(t.controller)) + "\"\n";
+  s += "lc_mm = " + toml_float(t.lc_mm) + "\nvalve_limit_v = " + toml_float(t.valve_limit_v) + "\n";
+  s += "design = " + quoted(t.design_json) + "\n";
+  s += "\n[rst]\nF = " + toml_float_array(t.F.coefficients()) + "\nG = " + toml_float_array(t.G.coefficients()) +
+       "\nH = " + toml_float_array(t.H.coefficients()) + "\n";
+  const auto& dz = t.dead_zone;
+  s += "\n[dead_zone]\nm_r = " + toml_float(dz.m_r) + "\nm_l = " + toml_float(dz.m_l) + "\nb_r = " + toml_float(dz.b_r) +
+       "\nb_l = " + toml_float(dz.b_l) + "\n";
+  // The model section is the model file's own text, moved under [model].
+  std::string model_text = core::format_model_toml({m.model, m.source});
+  model_text = model_text.substr(model_text.find('\n') + 1);  // drop its schema line
+  std::string nested;
+  std::istringstream lines(model_text);
+  for (std::string line; std::getline(lines, line);)
+    nested += (line.size() > 1 && line.front() == '[' ? "[model." + line.substr(1) : line) + "\n";
+  s += "\n[model]\nname = " + quoted(m.name) + "\nfit = " + quoted(m.fit_json) + "\n" + nested;
+  return s;
+}
+
+core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::string& src) {
+  toml::table root;
+  try {
+    root = toml::parse(text, src);
+  } catch (const toml::parse_error& e) {
+    return core::parse_error(src + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()));
+  }
+  const auto schema = root["schema"].value<std::string>();
+  if (!schema) return core::parse_error(src + ": schema is missing (expected \"" + kSchema + "\")");
+  if (*schema != kSchema) return core::parse_error(src + ": schema \"" + *schema + "\" is not supported (expected \"" + kSchema + "\")");
+  if (auto s = only_keys(root, {"schema", "name", "source", "controller", "lc_mm", "valve_limit_v", "design", "rst", "dead_zone", "model"}, src); !s)
+    return s.error();
+
+  TuningFile f;
+  TuningSet& t = f.set;
+  t.name = root["name"].value_or(std::string());
+  if (t.name.empty()) return core::parse_error(src + ": name is missing");
+  t.source = root["source"].value_or(std::string());
+  t.design_json = root["design"].value_or(std::string("{}"));
+  auto kind = control::parse_controller_kind(root["controller"].value_or(std::string()));
+  if (!kind) return core::parse_error(src + ": controller: " + kind.error().message);
+  t.controller = *kind;
+  auto lc = number(root, "lc_mm", src + ":");
+  if (!lc) return lc.error();
+  t.lc_mm = *lc;
+  auto limit = number(root, "valve_limit_v", src + ":");
+  if (!limit) return limit.error();
+  t.valve_limit_v = *limit;
+
+  const auto* rst = root["rst"].as_table();
+  if (!rst) return core::parse_error(src + ": table [rst] is missing");
+  if (auto s = only_keys(*rst, {"F", "G", "H"}, src + ": [rst]"); !s) return s.error();
+  core::Polynomial* polys[] = {&t.F, &t.G, &t.H};
+  const char* names[] = {"F", "G", "H"};
+  for (int i = 0; i < 3; ++i) {
+    auto p = polynomial(*rst, names[i], src + ": [rst]");
+    if (!p) return p.error();
+    *polys[i] = *p;
+  }
+  const auto* dz = root["dead_zone"].as_table();
+  if (!dz) return core::parse_error(src + ": table [dead_zone] is missing");
+  if (auto s = only_keys(*dz, {"m_r", "m_l", "b_r", "b_l"}, src + ": [dead_zone]"); !s) return s.error();
+  double* fields[] = {&t.dead_zone.m_r, &t.dead_zone.m_l, &t.dead_zone.b_r, &t.dead_zone.b_l};
+  const char* dz_names[] = {"m_r", "m_l", "b_r", "b_l"};
+  for (int i = 0; i < 4; ++i) {
+    auto v = number(*dz, dz_names[i], src + ": [dead_zone]");
+    if (!v) return v.error();
+    *fields[i] = *v;
+  }
+
+  const auto* model = root["model"].as_table();
+  if (!model) return core::parse_error(src + ": table [model] is missing");
+  if (auto s = only_keys(*model, {"name", "fit", "source", "Ts", "mm_per_volt", "arx", "dead_zone"}, src + ": [model]"); !s)
+    return s.error();
+  f.model.name = (*model)["name"].value_or(std::string());
+  if (f.model.name.empty()) return core::parse_error(src + ": [model] name is missing");
+  f.model.fit_json = (*model)["fit"].value_or(std::string("{}"));
+  // The rest of [model] is an epa-model/1 document: read it with the model file's own reader.
+  toml::table model_doc = *model;
+  model_doc.erase("name");
+  model_doc.erase("fit");
+  model_doc.insert_or_assign("schema", "epa-model/1");
+  std::ostringstream doc;
+  doc << model_doc;
+  auto parsed = core::parse_model_toml(doc.str(), src + " [model]");
+  if (!parsed) return parsed.error();
+  f.model.model = parsed->model;
+  f.model.source = parsed->source;
+
+  if (auto s = validate(t, f.model.model); !s) return core::invalid_argument(src + ": " + s.error().message);
+  return f;
+}
+
+}  // namespace epa::store

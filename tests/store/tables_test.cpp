@@ -1,0 +1,205 @@
+// The tables: models, tuning sets with the active one, the audit log, runs, retained points.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "store/audit_log.hpp"
+#include "store/database.hpp"
+#include "store/model_table.hpp"
+#include "store/retained_points.hpp"
+#include "store/run_table.hpp"
+#include "store/statement.hpp"
+#include "store/transaction.hpp"
+#include "store/tuning_set_table.hpp"
+#include "store_fixture.hpp"
+
+namespace epa::store {
+namespace {
+
+using testing::paper_seed;
+using testing::seeded_memory_db;
+
+TEST(ModelTable, AModelRoundTripsWithItsProvenance) {
+  Database db = seeded_memory_db();
+  ModelRecord m = paper_seed().model;
+  m.name = "identified";
+  m.source = "identified from runs/a.csv, runs/b.csv";
+  m.fit_json = R"({"fit_pct":91.2})";
+  m.model.A = core::Polynomial({1.0, -0.5, 0.1234567890123});
+  m.model.Ts = 0.01;
+  auto id = ModelTable(db).insert(m);
+  ASSERT_TRUE(id) << id.error().message;
+  auto back = ModelTable(db).get(*id);
+  ASSERT_TRUE(back);
+  EXPECT_EQ(back->name, "identified");
+  EXPECT_EQ(back->source, m.source);
+  EXPECT_EQ(back->fit_json, m.fit_json);
+  EXPECT_EQ(back->model.A.coefficients(), m.model.A.coefficients());  // exact: JSON keeps every digit
+  EXPECT_EQ(back->model.B.coefficients(), m.model.B.coefficients());
+  EXPECT_EQ(back->model.Ts, 0.01);
+  EXPECT_EQ(back->model.dead_zone.b_l, m.model.dead_zone.b_l);
+  EXPECT_EQ(ModelTable(db).all()->size(), 2u);
+}
+
+TEST(ModelTable, DuplicateNamesAndInvalidModelsAreRefusedByName) {
+  Database db = seeded_memory_db();
+  auto dup = ModelTable(db).insert(paper_seed().model);
+  ASSERT_FALSE(dup);
+  EXPECT_NE(dup.error().message.find("'paper' exists"), std::string::npos) << dup.error().message;
+  ModelRecord bad = paper_seed().model;
+  bad.name = "bad";
+  bad.model.A = core::Polynomial({2.0, 0.1});  // not monic
+  auto r = ModelTable(db).insert(bad);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("model 'bad'"), std::string::npos) << r.error().message;
+  EXPECT_FALSE(ModelTable(db).get(42));
+}
+
+TEST(TuningSetTable, SetsAreFoundByIdOrNameAndUpdatedInPlace) {
+  Database db = seeded_memory_db();
+  TuningSetTable sets(db);
+  auto paper = sets.find("paper");
+  ASSERT_TRUE(paper) << paper.error().message;
+  EXPECT_EQ(sets.find(std::to_string(paper->id))->name, "paper");
+  EXPECT_EQ(paper->F.coefficients(), core::paper::F().coefficients());
+
+  TuningSet copy = *paper;
+  copy.name = "slow";
+  copy.controller = control::ControllerKind::kPp;
+  auto id = sets.insert(copy);
+  ASSERT_TRUE(id);
+  copy.id = *id;
+  copy.dead_zone.m_r = 2.5;
+  copy.modified_ms = 9000;
+  ASSERT_TRUE(sets.update(copy));
+  auto back = sets.get(*id);
+  EXPECT_EQ(back->dead_zone.m_r, 2.5);
+  EXPECT_EQ(back->modified_ms, 9000);
+  EXPECT_EQ(back->controller, control::ControllerKind::kPp);
+  EXPECT_EQ(sets.get(paper->id)->dead_zone.m_r, paper->dead_zone.m_r);  // the other set is untouched
+
+  auto missing = sets.find("nope");
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error().message.find("'nope'"), std::string::npos);
+}
+
+TEST(TuningSetTable, DuplicateNamesUnknownModelsAndUnknownSetsAreRefused) {
+  Database db = seeded_memory_db();
+  TuningSetTable sets(db);
+  TuningSet t = *sets.find("paper");
+  auto dup = sets.insert(t);
+  ASSERT_FALSE(dup);
+  EXPECT_NE(dup.error().message.find("exists already"), std::string::npos);
+  t.name = "orphan";
+  t.model_id = 77;
+  auto orphan = sets.insert(t);
+  ASSERT_FALSE(orphan);
+  EXPECT_NE(orphan.error().message.find("model 77"), std::string::npos) << orphan.error().message;
+  EXPECT_FALSE(sets.activate(77));
+}
+
+TEST(TuningSetTable, OneSetIsActive) {
+  Database db = seeded_memory_db();
+  TuningSetTable sets(db);
+  TuningSet t = *sets.find("paper");
+  const auto paper_id = t.id;
+  EXPECT_EQ(**sets.active_id(), paper_id);
+  t.name = "second";
+  const auto second = *sets.insert(t);
+  ASSERT_TRUE(sets.activate(second));
+  EXPECT_EQ(**sets.active_id(), second);
+  EXPECT_EQ(**sets.last_good_id(), paper_id);  // last good changes only when the appliance loads one
+}
+
+TEST(AuditLog, EntriesAreAppendOnly) {
+  Database db = seeded_memory_db();
+  AuditLog log(db);
+  ASSERT_TRUE(log.append({1000, "modbus 127.0.0.1:5000", "m_r", 1.7627, 1.9}));
+  auto update = db.exec("UPDATE audit_log SET new_value = 0");
+  ASSERT_FALSE(update);
+  EXPECT_NE(update.error().message.find("append-only"), std::string::npos) << update.error().message;
+  EXPECT_FALSE(db.exec("DELETE FROM audit_log"));
+  EXPECT_EQ(*log.count(), 1);
+  EXPECT_EQ(log.query({})->front().entry.new_value, 1.9);
+}
+
+TEST(AuditLog, FiltersSelectByTimeSourcePointAndLimitNewestFirst) {
+  Database db = seeded_memory_db();
+  AuditLog log(db);
+  ASSERT_TRUE(log.append({1000, "modbus 10.0.0.5:5000", "m_r", 1.0, 2.0}));
+  ASSERT_TRUE(log.append({2000, "web 10.0.0.7", "setpoint_mm", 0.0, 50.0}));
+  ASSERT_TRUE(log.append({3000, "modbus 10.0.0.6:5001", "setpoint_mm", 50.0, 80.0}));
+  ASSERT_TRUE(log.append({4000, "cli", "active_tuning_set", 1.0, 2.0}));
+
+  auto all = log.query({});
+  ASSERT_EQ(all->size(), 4u);
+  EXPECT_EQ(all->front().entry.unix_time_ms, 4000);  // newest first
+  EXPECT_EQ(log.query({.since_ms = 2000, .until_ms = 3000})->size(), 2u);
+  EXPECT_EQ(log.query({.source = "modbus"})->size(), 2u);
+  EXPECT_EQ(log.query({.source = "10.0.0.7"})->front().entry.point, "setpoint_mm");
+  EXPECT_EQ(log.query({.point = "setpoint_mm"})->size(), 2u);
+  EXPECT_EQ(log.query({.source = "modbus", .point = "setpoint_mm"})->front().entry.new_value, 80.0);
+  EXPECT_EQ(log.query({.limit = 1})->size(), 1u);
+  EXPECT_EQ(log.query({.source = "' OR 1=1 --"})->size(), 0u);  // filters are parameters, not SQL
+}
+
+TEST(AuditLog, NotANumberIsKeptAsNull) {
+  Database db = seeded_memory_db();
+  AuditLog log(db);
+  ASSERT_TRUE(log.append({1000, "modbus", "setpoint_mm", std::nan(""), 5.0}));
+  const auto e = log.query({})->front().entry;
+  EXPECT_TRUE(std::isnan(e.old_value));
+  EXPECT_EQ(e.new_value, 5.0);
+}
+
+TEST(RunTable, RunsKeepTheirMetricsAndNeverReachedOnesStayAbsent) {
+  Database db = seeded_memory_db();
+  RunTable runs(db);
+  ASSERT_TRUE(runs.insert({.path = "runs/move-1.csv", .recorded_ms = 1000, .controller = "pp-ffidz", .tuning_set_id = 1,
+                           .samples = 4000, .Ts = 0.005, .from_mm = 0.0, .to_mm = 50.0, .rise_s = 0.24,
+                           .settling_s = std::nullopt, .ess_mm = 0.9, .overshoot_pct = 1.5}));
+  ASSERT_TRUE(runs.insert({.path = "runs/move-2.csv", .recorded_ms = 2000, .controller = "pp"}));
+  auto recent = runs.recent(10);
+  ASSERT_EQ(recent->size(), 2u);
+  const auto& first = recent->back();
+  EXPECT_EQ(first.path, "runs/move-1.csv");
+  EXPECT_EQ(first.tuning_set_id, 1);
+  EXPECT_EQ(first.rise_s, 0.24);
+  EXPECT_FALSE(first.settling_s);
+  EXPECT_EQ(first.samples, 4000);
+}
+
+TEST(RetainedPoints, ALaterValueReplacesAnEarlierOne) {
+  Database db = seeded_memory_db();
+  RetainedPoints retained(db);
+  ASSERT_TRUE(retained.put("setpoint_mm", 100.0, 1000));
+  ASSERT_TRUE(retained.put("setpoint_mm", 120.0, 2000));
+  auto all = retained.all();
+  ASSERT_EQ(all->size(), 1u);
+  EXPECT_EQ(all->at("setpoint_mm"), 120.0);
+}
+
+TEST(Transaction, ATransactionNotCommittedLeavesNothingBehind) {
+  Database db = seeded_memory_db();
+  {
+    auto tx = Transaction::begin(db);
+    ASSERT_TRUE(tx);
+    ASSERT_TRUE(AuditLog(db).append({1000, "cli", "m_r", 1.0, 2.0}));
+    ASSERT_TRUE(RetainedPoints(db).put("setpoint_mm", 1.0, 1000));
+  }  // no commit: rolled back
+  EXPECT_EQ(*AuditLog(db).count(), 0);
+  EXPECT_TRUE(RetainedPoints(db).all()->empty());
+}
+
+TEST(Database, ErrorsNameTheStatementAndSqlitesReason) {
+  Database db = seeded_memory_db();
+  auto bad = db.prepare("SELECT * FROM no_such_table");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("no_such_table"), std::string::npos) << bad.error().message;
+  auto missing = Database::open("/nonexistent-dir/epa.db", true);
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error().message.find("/nonexistent-dir/epa.db"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace epa::store

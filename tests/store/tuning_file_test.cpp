@@ -1,0 +1,86 @@
+#include "store/tuning_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include "store_fixture.hpp"
+
+namespace epa::store {
+namespace {
+
+using testing::paper_seed;
+
+TuningFile example() {
+  const StoreSeed seed = paper_seed();
+  TuningFile f{seed.tuning, seed.model};
+  f.set.name = "rig 2 \"after service\"";
+  f.set.source = "epa design --poles 0.9";
+  f.set.design_json = R"({"poles":[0.9,0.9]})";
+  f.set.controller = control::ControllerKind::kPpNgidz;
+  f.set.dead_zone.m_r = 1.0 / 3.0;  // not representable in few digits: must still round-trip exactly
+  f.model.fit_json = R"({"fit_pct":88.5})";
+  f.model.model.B = core::Polynomial({0.0, 1.0 / 7.0, -2.046, 1.029});
+  return f;
+}
+
+TEST(TuningFile, ExportThenImportGivesTheSameSetAndModel) {
+  const TuningFile f = example();
+  const std::string text = format_tuning_toml(f.set, f.model);
+  auto back = parse_tuning_toml(text, "x.toml");
+  ASSERT_TRUE(back) << back.error().message << "\n" << text;
+  EXPECT_EQ(back->set.name, f.set.name);
+  EXPECT_EQ(back->set.source, f.set.source);
+  EXPECT_EQ(back->set.design_json, f.set.design_json);
+  EXPECT_EQ(back->set.controller, f.set.controller);
+  EXPECT_EQ(back->set.F.coefficients(), f.set.F.coefficients());
+  EXPECT_EQ(back->set.G.coefficients(), f.set.G.coefficients());
+  EXPECT_EQ(back->set.H.coefficients(), f.set.H.coefficients());
+  EXPECT_EQ(back->set.dead_zone.m_r, f.set.dead_zone.m_r);
+  EXPECT_EQ(back->set.dead_zone.b_l, f.set.dead_zone.b_l);
+  EXPECT_EQ(back->set.lc_mm, f.set.lc_mm);
+  EXPECT_EQ(back->set.valve_limit_v, f.set.valve_limit_v);
+  EXPECT_EQ(back->model.name, f.model.name);
+  EXPECT_EQ(back->model.source, f.model.source);
+  EXPECT_EQ(back->model.fit_json, f.model.fit_json);
+  EXPECT_EQ(back->model.model.A.coefficients(), f.model.model.A.coefficients());
+  EXPECT_EQ(back->model.model.B.coefficients(), f.model.model.B.coefficients());
+  EXPECT_EQ(back->model.model.Ts, f.model.model.Ts);
+  EXPECT_EQ(format_tuning_toml(back->set, back->model), text);  // and the text is stable
+}
+
+TEST(TuningFile, ThePaperValuesAreWrittenAsPrinted) {
+  const std::string text = format_tuning_toml(paper_seed().tuning, paper_seed().model);
+  EXPECT_NE(text.find("F = [1.0, -1.778, 0.7828]"), std::string::npos) << text;
+  EXPECT_NE(text.find("[model.arx]"), std::string::npos) << text;
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return text.replace(at, from.size(), to);
+}
+
+TEST(TuningFile, BadFilesAreRefusedNamingWhatIsWrong) {
+  const TuningFile f = example();
+  const std::string good = format_tuning_toml(f.set, f.model);
+  struct Case {
+    std::string text, expected;
+  };
+  const Case cases[] = {
+      {replaced(good, "lc_mm = ", "lc_millimetres = "), "unknown key 'lc_millimetres'"},
+      {replaced(good, "schema = \"epa-tuning/1\"", "schema = \"epa-tuning/9\""), "epa-tuning/9"},
+      {replaced(good, "controller = \"pp-ngidz\"", "controller = \"pid\""), "controller"},
+      {replaced(good, "b_l = -1.722", "b_l = 3.0"), "b_l"},  // b_l > b_r: refused whole
+      {replaced(good, "[rst]\n", "[rst]\nX = [1.0]\n"), "[rst]: unknown key 'X'"},
+      {replaced(good, "lc_mm = 5.0", "lc_mm = \"five\""), "lc_mm must be a number"},
+      {replaced(good, "lc_mm = 5.0", "lc_mm = = 5"), "x.toml:"},
+      {good.substr(0, good.find("[model]")), "[model] is missing"},
+  };
+  for (const auto& c : cases) {
+    auto r = parse_tuning_toml(c.text, "x.toml");
+    ASSERT_FALSE(r) << c.expected;
+    EXPECT_NE(r.error().message.find(c.expected), std::string::npos) << r.error().message;
+  }
+}
+
+}  // namespace
+}  // namespace epa::store
