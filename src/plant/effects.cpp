@@ -1,0 +1,177 @@
+#include "plant/effects.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/format.hpp"
+
+namespace epa::plant {
+
+namespace {
+
+constexpr std::array<std::string_view, kEffectCount> kNames = {
+    "gain_change", "deadzone_shift", "input_delay", "valve_lag",
+    "static_friction", "flow_saturation", "position_dependent_gain", "sensor_quantization"};
+
+// Bounds are what a fit searches and what validate() accepts. Friction and the shift are in volts:
+// shift_* of the valve command (the break points), breakaway/coulomb of the drive u_d after the
+// dead zone (about valve volts beyond the break point times the slope, 1.1-1.8 here).
+constexpr ParamSpec kGain[] = {{"gain_ratio", 0.3, 3.0, 1.0, false, "drive (piston speed per volt beyond the break point) over the nominal"}};
+constexpr ParamSpec kShift[] = {{"shift_r_V", -1.0, 1.0, 0.0, false, "right break point b_r moved by"},
+                                {"shift_l_V", -1.0, 1.0, 0.0, false, "left break point b_l moved by"}};
+constexpr ParamSpec kDelay[] = {{"delay_samples", 0.0, 40.0, 0.0, true, "transport delay of the valve command, samples of Ts"}};
+constexpr ParamSpec kLag[] = {{"tau_s", 0.0, 0.2, 0.0, false, "time constant of the spool's first-order lag"}};
+constexpr ParamSpec kFriction[] = {
+    {"breakaway_V", 0.0, 2.0, 0.0, false, "drive u_d needed to start from rest (stiction)"},
+    {"coulomb_V", 0.0, 2.0, 0.0, false, "drive u_d lost while moving; below it the piston sticks"}};
+constexpr ParamSpec kSaturation[] = {{"ceiling_mm_s", 20.0, 5000.0, 5000.0, false, "largest piston speed (choked flow)"}};
+constexpr ParamSpec kPosition[] = {
+    {"slope_per_100mm", -0.8, 0.8, 0.0, false, "relative gain change per 100 mm from mid-stroke (250 mm)"}};
+constexpr ParamSpec kQuantization[] = {{"step_mm", 0.0, 10.0, 0.0, false, "position sensor resolution"}};
+
+constexpr double kMidStrokeMm = 250.0;
+constexpr double kMinPositionFactor = 0.05;  // the drive never reverses along the stroke
+
+}  // namespace
+
+std::string_view to_string(EffectKind kind) { return kNames[index(kind)]; }
+
+core::Result<EffectKind> parse_effect(std::string_view name) {
+  for (std::size_t i = 0; i < kEffectCount; ++i)
+    if (kNames[i] == name) return kAllEffects[i];
+  std::string all;
+  for (auto n : kNames) all += (all.empty() ? "" : ", ") + std::string(n);
+  return core::invalid_argument("unknown effect '" + std::string(name) + "' (expected one of: " + all + ")");
+}
+
+std::span<const ParamSpec> param_specs(EffectKind kind) {
+  switch (kind) {
+    case EffectKind::kGainChange: return kGain;
+    case EffectKind::kDeadzoneShift: return kShift;
+    case EffectKind::kInputDelay: return kDelay;
+    case EffectKind::kValveLag: return kLag;
+    case EffectKind::kStaticFriction: return kFriction;
+    case EffectKind::kFlowSaturation: return kSaturation;
+    case EffectKind::kPositionDependentGain: return kPosition;
+    case EffectKind::kSensorQuantization: return kQuantization;
+  }
+  return {};
+}
+
+void EffectSet::set(EffectKind kind, std::initializer_list<double> params) {
+  EffectParams p{};
+  const auto specs = param_specs(kind);
+  for (std::size_t i = 0; i < specs.size(); ++i) p[i] = i < params.size() ? params.begin()[i] : specs[i].neutral;
+  set(kind, p);
+}
+
+std::vector<EffectKind> EffectSet::kinds() const {
+  std::vector<EffectKind> k;
+  for (auto kind : kAllEffects)
+    if (on(kind)) k.push_back(kind);
+  return k;
+}
+
+core::Status EffectSet::validate() const {
+  for (auto kind : kinds()) {
+    const auto specs = param_specs(kind);
+    for (std::size_t i = 0; i < specs.size(); ++i) {
+      const double v = params(kind)[i];
+      if (!std::isfinite(v) || v < specs[i].lo || v > specs[i].hi)
+        return core::invalid_argument("effect " + std::string(to_string(kind)) + ": " + std::string(specs[i].name) + " = " +
+                                      core::format_number(v) + " lies outside [" + core::format_number(specs[i].lo) + ", " +
+                                      core::format_number(specs[i].hi) + "]");
+    }
+  }
+  return core::ok();
+}
+
+std::string EffectSet::describe() const {
+  std::string s;
+  for (auto kind : kinds()) {
+    s += (s.empty() ? "" : ", ") + std::string(to_string(kind)) + "(";
+    const auto specs = param_specs(kind);
+    for (std::size_t i = 0; i < specs.size(); ++i)
+      s += (i ? ", " : "") + std::string(specs[i].name) + "=" + core::format_number(params(kind)[i]);
+    s += ")";
+  }
+  return s.empty() ? "none" : s;
+}
+
+ValveEffects::ValveEffects(const EffectSet& e, double Ts) {
+  if (e.on(EffectKind::kInputDelay))
+    delay_ = std::min<std::size_t>(kMaxDelaySamples, static_cast<std::size_t>(std::llround(std::max(0.0, e.param(EffectKind::kInputDelay, 0)))));
+  if (e.on(EffectKind::kValveLag)) {
+    const double tau_s = e.param(EffectKind::kValveLag, 0);
+    lag_alpha_ = tau_s > 0.0 ? 1.0 - std::exp(-Ts / tau_s) : 1.0;
+  }
+}
+
+double ValveEffects::apply(double valve_v) noexcept {
+  double u = valve_v;
+  if (delay_ > 0) {
+    auto& s = state_;
+    s.past[s.head] = valve_v;
+    const std::size_t n = s.past.size();
+    u = s.past[(s.head + n - delay_) % n];
+    s.head = (s.head + 1) % n;
+  }
+  state_.spool_v += lag_alpha_ * (u - state_.spool_v);
+  return lag_alpha_ >= 1.0 ? u : state_.spool_v;
+}
+
+DriveEffects::DriveEffects(const EffectSet& e, const core::DeadZone& nominal, double speed_mm_s_per_V)
+    : dead_zone_(nominal) {
+  if (e.on(EffectKind::kDeadzoneShift)) {
+    dead_zone_.b_r += e.param(EffectKind::kDeadzoneShift, 0);
+    dead_zone_.b_l += e.param(EffectKind::kDeadzoneShift, 1);
+    if (dead_zone_.b_l > dead_zone_.b_r) dead_zone_.b_l = dead_zone_.b_r = 0.5 * (dead_zone_.b_l + dead_zone_.b_r);
+  }
+  if (e.on(EffectKind::kStaticFriction)) {
+    friction_ = true;
+    coulomb_ = e.param(EffectKind::kStaticFriction, 1);
+    breakaway_ = std::max(e.param(EffectKind::kStaticFriction, 0), coulomb_);  // stiction is never below Coulomb
+  }
+  if (e.on(EffectKind::kGainChange)) gain_ = e.param(EffectKind::kGainChange, 0);
+  if (e.on(EffectKind::kPositionDependentGain)) slope_per_mm_ = e.param(EffectKind::kPositionDependentGain, 0) / 100.0;
+  if (e.on(EffectKind::kFlowSaturation) && speed_mm_s_per_V > 0.0)
+    max_drive_ = e.param(EffectKind::kFlowSaturation, 0) / speed_mm_s_per_V;
+}
+
+double DriveEffects::drive_before_position(double spool_v) noexcept {
+  double d = dead_zone_.apply(spool_v);
+  if (friction_) {
+    // Stick-slip: from rest the drive must exceed breakaway; once moving, Coulomb friction takes
+    // coulomb off the drive, and a drive at or below it lets the piston stick again.
+    const double mag = std::abs(d);
+    if (state_.stuck ? mag > breakaway_ : mag > coulomb_) {
+      state_.stuck = false;
+      d = std::copysign(mag - coulomb_, d);
+    } else {
+      state_.stuck = true;
+      d = 0.0;
+    }
+  }
+  return d * gain_;
+}
+
+double DriveEffects::finish(double drive, double position_mm) const noexcept {
+  double d = drive;
+  if (slope_per_mm_ != 0.0) d *= std::max(kMinPositionFactor, 1.0 + slope_per_mm_ * (position_mm - kMidStrokeMm));
+  if (max_drive_ > 0.0) d = std::clamp(d, -max_drive_, max_drive_);
+  return d;
+}
+
+double quantize_mm(double position_mm, double step_mm) noexcept {
+  return step_mm > 0.0 ? step_mm * std::round(position_mm / step_mm) : position_mm;
+}
+
+double steady_speed_mm_s_per_V(std::span<const double> A, std::span<const double> B, double Ts, double mm_per_volt) {
+  double b1 = 0.0, a_prime_1 = 0.0;
+  for (double b : B) b1 += b;
+  for (std::size_t i = 1; i < A.size(); ++i) a_prime_1 -= static_cast<double>(i) * A[i];
+  if (a_prime_1 == 0.0) return 0.0;
+  return std::abs(b1 / a_prime_1) * mm_per_volt / Ts;
+}
+
+}  // namespace epa::plant

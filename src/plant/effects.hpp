@@ -1,0 +1,139 @@
+#pragma once
+// Unmodelled effects that can be switched on in the plant simulators and fitted by the sim-to-real
+// diagnosis (`epa diagnose`): each a small parametric model with 1-3 parameters in physical units,
+// named exactly as FORMATS.md (epa-gap-report/1) names them.
+//
+// Where each acts, in signal order (one sample, valve command u in V -> measured position):
+//   u -> input_delay -> valve_lag -> dead zone (+ deadzone_shift) -> static_friction
+//     -> gain_change -> position_dependent_gain -> flow_saturation -> ARX -> end stops
+//     -> sensor noise -> sensor_quantization
+// Everything before the ARX part except position_dependent_gain depends on the command history
+// alone, so a replay can compute it once per run; position_dependent_gain reads the position,
+// sensor_quantization the measurement.
+#include <array>
+#include <cstddef>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/dead_zone.hpp"
+#include "core/result.hpp"
+
+namespace epa::plant {
+
+enum class EffectKind {
+  kGainChange,             // gain_ratio: the drive u_d scaled (supply pressure, valve gain)
+  kDeadzoneShift,          // shift_r_V, shift_l_V: break points moved
+  kInputDelay,             // delay_samples: transport delay of the valve command
+  kValveLag,               // tau_s: first-order spool dynamics
+  kStaticFriction,         // breakaway_V, coulomb_V: stiction and Coulomb friction (stick-slip)
+  kFlowSaturation,         // ceiling_mm_s: choked flow, a velocity ceiling
+  kPositionDependentGain,  // slope_per_100mm: gain changes along the stroke (air compressibility)
+  kSensorQuantization,     // step_mm: a coarse position sensor
+};
+inline constexpr std::size_t kEffectCount = 8;
+inline constexpr std::array<EffectKind, kEffectCount> kAllEffects = {
+    EffectKind::kGainChange,     EffectKind::kDeadzoneShift,  EffectKind::kInputDelay,
+    EffectKind::kValveLag,       EffectKind::kStaticFriction, EffectKind::kFlowSaturation,
+    EffectKind::kPositionDependentGain, EffectKind::kSensorQuantization};
+
+std::string_view to_string(EffectKind kind);
+// The FORMATS.md name; the error lists the eight valid names.
+core::Result<EffectKind> parse_effect(std::string_view name);
+inline std::size_t index(EffectKind kind) { return static_cast<std::size_t>(kind); }
+
+// One parameter of an effect: name with unit (as in the report), bounds for fitting and for
+// validation, and the value at which the effect does nothing.
+struct ParamSpec {
+  std::string_view name;
+  double lo, hi;
+  double neutral;
+  bool integer = false;    // fitted on a grid of integers (delay)
+  std::string_view meaning;
+};
+std::span<const ParamSpec> param_specs(EffectKind kind);
+
+inline constexpr std::size_t kMaxEffectParams = 3;
+using EffectParams = std::array<double, kMaxEffectParams>;
+
+// Which effects are on, with their parameters. Default: none (the nominal model).
+class EffectSet {
+ public:
+  void set(EffectKind kind, const EffectParams& params) { on_[index(kind)] = true, params_[index(kind)] = params; }
+  void set(EffectKind kind, std::initializer_list<double> params);
+  void clear(EffectKind kind) { on_[index(kind)] = false; }
+  bool on(EffectKind kind) const { return on_[index(kind)]; }
+  const EffectParams& params(EffectKind kind) const { return params_[index(kind)]; }
+  double param(EffectKind kind, std::size_t i) const { return params_[index(kind)][i]; }
+  std::vector<EffectKind> kinds() const;  // switched on, in signal order
+  bool empty() const { return kinds().empty(); }
+  // Parameters within their bounds (the message names the effect and parameter), finite.
+  core::Status validate() const;
+  // "input_delay(delay_samples=4), valve_lag(tau_s=0.02)" or "none".
+  std::string describe() const;
+
+ private:
+  std::array<bool, kEffectCount> on_{};
+  std::array<EffectParams, kEffectCount> params_{};
+};
+
+// Effects on the valve command only (input_delay, valve_lag): what any plant with a step(valve_v)
+// can carry. Explicit state, restartable; the command before sample 0 is taken as 0 V (centred).
+class ValveEffects {
+ public:
+  static constexpr std::size_t kMaxDelaySamples = 63;
+  struct State {
+    std::array<double, kMaxDelaySamples + 1> past{};  // ring of past commands
+    std::size_t head = 0;
+    double spool_v = 0.0;  // the lag's output
+  };
+  ValveEffects() = default;
+  ValveEffects(const EffectSet& effects, double Ts);
+  // The command as the valve's spool sees it at this sample, V.
+  double apply(double valve_v) noexcept;
+  const State& state() const { return state_; }
+  void set_state(const State& s) { state_ = s; }
+
+ private:
+  std::size_t delay_ = 0;
+  double lag_alpha_ = 1.0;  // 1 - exp(-Ts/tau): 1 is no lag
+  State state_;
+};
+
+// Effects between the valve and the ARX part, on the drive u_d (V after the dead zone):
+// dead zone with deadzone_shift, static_friction, gain_change, position_dependent_gain,
+// flow_saturation. `speed_mm_s_per_V` is the nominal model's steady piston speed per volt of u_d,
+// which turns the velocity ceiling into a drive limit.
+class DriveEffects {
+ public:
+  struct State {
+    bool stuck = true;  // static friction: at rest until the drive exceeds the breakaway level
+  };
+  DriveEffects() = default;
+  DriveEffects(const EffectSet& effects, const core::DeadZone& nominal, double speed_mm_s_per_V);
+  // The drive before the position-dependent factor and the ceiling (history-dependent part).
+  double drive_before_position(double spool_v) noexcept;
+  // The position-dependent factor and the ceiling (memoryless part).
+  double finish(double drive, double position_mm) const noexcept;
+  double apply(double spool_v, double position_mm) noexcept { return finish(drive_before_position(spool_v), position_mm); }
+  const State& state() const { return state_; }
+  void set_state(const State& s) { state_ = s; }
+
+ private:
+  core::DeadZone dead_zone_;
+  bool friction_ = false;
+  double breakaway_ = 0, coulomb_ = 0;
+  double gain_ = 1.0, slope_per_mm_ = 0.0, max_drive_ = 0.0;  // max_drive_ 0: no ceiling
+  State state_;
+};
+
+// sensor_quantization: the reading rounded to the sensor's step (identity for step 0).
+double quantize_mm(double position_mm, double step_mm) noexcept;
+
+// Steady piston speed per volt of u_d for y = B/A u_d, y in sensor volts: B(1)/A'(1) with
+// A = (1 - q) A', in mm/s. A'(1) = -sum i a_i, which also holds approximately for a model whose
+// A has its integrating root only near 1.
+double steady_speed_mm_s_per_V(std::span<const double> A, std::span<const double> B, double Ts, double mm_per_volt);
+
+}  // namespace epa::plant

@@ -1,0 +1,106 @@
+// Each effect is the identity at its neutral parameters and changes the output in the expected
+// direction; the augmented plant with no effects is the Hammerstein plant.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/paper_reference.hpp"
+#include "plant/augmented_plant.hpp"
+#include "plant/effects.hpp"
+#include "plant/hammerstein_plant.hpp"
+
+namespace {
+
+using epa::plant::AugmentedPlant;
+using epa::plant::EffectKind;
+using epa::plant::EffectSet;
+
+// Position after `samples` of a constant command from mid-stroke.
+double travel_mm(const EffectSet& e, double valve_v, int samples = 100, double start_mm = 250.0) {
+  auto p = AugmentedPlant::make(epa::core::paper::model(), e, {.initial_position_mm = start_mm});
+  EXPECT_TRUE(p.has_value());
+  for (int k = 0; k < samples; ++k) p->step(valve_v);
+  return p->measured_mm() - start_mm;
+}
+
+TEST(Effects, NamesRoundTripAndUnknownNamesListTheValidOnes) {
+  for (auto kind : epa::plant::kAllEffects) {
+    auto parsed = epa::plant::parse_effect(epa::plant::to_string(kind));
+    ASSERT_TRUE(parsed.has_value());
+    EXPECT_EQ(*parsed, kind);
+    EXPECT_FALSE(epa::plant::param_specs(kind).empty());
+    EXPECT_LE(epa::plant::param_specs(kind).size(), epa::plant::kMaxEffectParams);
+  }
+  auto bad = epa::plant::parse_effect("friction");
+  ASSERT_FALSE(bad.has_value());
+  EXPECT_NE(bad.error().message.find("static_friction"), std::string::npos);
+}
+
+TEST(Effects, EveryEffectAtItsNeutralParametersIsTheNominalPlant) {
+  auto nominal = epa::plant::HammersteinPlant::make(epa::core::paper::model(), {.initial_position_mm = 250.0});
+  ASSERT_TRUE(nominal.has_value());
+  EffectSet all;
+  for (auto kind : epa::plant::kAllEffects) all.set(kind, {});  // every parameter at its neutral value
+  auto augmented = AugmentedPlant::make(epa::core::paper::model(), all, {.initial_position_mm = 250.0});
+  ASSERT_TRUE(augmented.has_value()) << augmented.error().message;
+  for (int k = 0; k < 600; ++k) {
+    const double u = 2.5 * std::sin(0.02 * k);
+    nominal->step(u), augmented->step(u);
+    ASSERT_NEAR(augmented->measured_mm(), nominal->measured_mm(), 1e-9) << "k = " << k;
+  }
+}
+
+TEST(Effects, EachEffectChangesTheMotionTheWayItShould) {
+  const double base = travel_mm({}, 2.5);
+  ASSERT_GT(base, 50.0);
+  auto with = [](EffectKind kind, std::initializer_list<double> p) { EffectSet e; e.set(kind, p); return e; };
+  EXPECT_GT(travel_mm(with(EffectKind::kGainChange, {1.3}), 2.5), 1.2 * base);
+  EXPECT_LT(travel_mm(with(EffectKind::kDeadzoneShift, {0.4, 0.0}), 2.5), 0.8 * base);
+  EXPECT_NEAR(travel_mm(with(EffectKind::kDeadzoneShift, {0.0, -0.5}), 2.5), base, 1e-9);  // the other side only
+  EXPECT_LT(travel_mm(with(EffectKind::kInputDelay, {10}), 2.5), base - 5.0);
+  EXPECT_LT(travel_mm(with(EffectKind::kValveLag, {0.05}), 2.5), base - 5.0);
+  EXPECT_LT(travel_mm(with(EffectKind::kStaticFriction, {0.8, 0.4}), 2.5), 0.85 * base);
+  EXPECT_LT(travel_mm(with(EffectKind::kFlowSaturation, {60.0}), 2.5), 0.5 * base);
+  // Extending from mid-stroke with a positive slope: the gain grows as the piston goes out.
+  EXPECT_GT(travel_mm(with(EffectKind::kPositionDependentGain, {0.3}), 2.5), base + 2.0);
+  const double q = travel_mm(with(EffectKind::kSensorQuantization, {5.0}), 2.5);
+  EXPECT_NEAR(std::fmod(q + 250.0, 5.0), 0.0, 1e-9);
+}
+
+TEST(Effects, StaticFrictionHoldsBelowBreakawayAndKeepsMovingAboveCoulomb) {
+  EffectSet e;
+  e.set(EffectKind::kStaticFriction, {1.0, 0.3});
+  // Drive u_d = m_r (u - b_r): 1.7627 * 0.4 = 0.71 V, below breakaway: the piston stays.
+  EXPECT_NEAR(travel_mm(e, 1.232 + 0.4), 0.0, 1e-9);
+  EXPECT_GT(travel_mm(e, 1.232 + 0.8), 5.0);
+}
+
+TEST(Effects, ValidateNamesTheEffectAndParameter) {
+  EffectSet e;
+  e.set(EffectKind::kValveLag, {5.0});
+  auto s = e.validate();
+  ASSERT_FALSE(s.has_value());
+  EXPECT_NE(s.error().message.find("valve_lag: tau_s"), std::string::npos) << s.error().message;
+}
+
+TEST(Effects, WrapperCarriesDelayAndQuantisationAroundAnyPlant) {
+  auto inner = epa::plant::HammersteinPlant::make(epa::core::paper::model(), {.initial_position_mm = 250.0});
+  ASSERT_TRUE(inner.has_value());
+  EffectSet e;
+  e.set(EffectKind::kInputDelay, {5});
+  e.set(EffectKind::kSensorQuantization, {2.0});
+  epa::plant::WithValveAndSensorEffects wrapped(*inner, e, 0.005);
+  for (int k = 0; k < 5; ++k) wrapped.step(3.0);
+  EXPECT_DOUBLE_EQ(wrapped.position_mm(), 250.0);  // the command has not arrived yet
+  for (int k = 0; k < 50; ++k) wrapped.step(3.0);
+  EXPECT_GT(wrapped.position_mm(), 260.0);
+  EXPECT_NEAR(std::fmod(wrapped.measured_mm(), 2.0), 0.0, 1e-9);
+}
+
+TEST(Effects, SteadySpeedPerVoltOfThePaperModel) {
+  const auto m = epa::core::paper::model();
+  // B(1) / A'(1) = 0.007 / 0.5702 V per sample per V, times 50 mm/V / 5 ms.
+  EXPECT_NEAR(epa::plant::steady_speed_mm_s_per_V(m.A.coefficients(), m.B.coefficients(), m.Ts, m.mm_per_volt), 122.76, 0.05);
+}
+
+}  // namespace
