@@ -1,6 +1,7 @@
 #include "hal/remote_io_simulator.hpp"
 
 #include "hal/realtime.hpp"
+#include "plant/plant_adapter.hpp"
 
 #include <arpa/inet.h>
 #include <fcntl.h>
@@ -57,7 +58,7 @@ timespec from_ns(std::int64_t ns) {
 }  // namespace
 
 struct RemoteIoSimulator::Impl {
-  Impl(const RemoteIoSimulatorConfig& c, plant::HammersteinPlant p) : config(c), plant(std::move(p)) {}
+  Impl(const RemoteIoSimulatorConfig& c, std::unique_ptr<plant::PlantSimulator> p) : config(c), plant(std::move(p)) {}
   ~Impl() {
     stop();
     if (mapping != nullptr) modbus_mapping_free(mapping);
@@ -65,7 +66,7 @@ struct RemoteIoSimulator::Impl {
   }
 
   RemoteIoSimulatorConfig config;
-  plant::HammersteinPlant plant;  // the plant thread's alone once started
+  std::unique_ptr<plant::PlantSimulator> plant;  // never null; the plant thread's alone once started
   modbus_t* ctx = nullptr;        // the server thread's alone once started
   modbus_mapping_t* mapping = nullptr;
   std::mutex mapping_mutex;       // guards the register values in mapping
@@ -172,7 +173,7 @@ bool RemoteIoSimulator::Impl::serve_request(int fd, std::uint8_t* query) noexcep
 }
 
 void RemoteIoSimulator::Impl::run_plant() noexcept {
-  const auto period_ns = static_cast<std::int64_t>(std::llround(config.model.Ts * 1e9));
+  const auto period_ns = static_cast<std::int64_t>(std::llround(plant->sample_period_s() * 1e9));
   const AnalogPoint& valve = config.layout.valve;
   const AnalogPoint& sensor = config.layout.sensor;
   timespec now{};
@@ -189,12 +190,12 @@ void RemoteIoSimulator::Impl::run_plant() noexcept {
       std::lock_guard lock(mapping_mutex);
       valve_v = decode_volts(valve, read_point(valve)).value_or(0.0);  // undecodable: centred valve
     }
-    plant.step(valve_v);
+    plant->step(valve_v);
     {
       std::lock_guard lock(mapping_mutex);
-      write_point(sensor, encode_volts(sensor, plant.measured_v()));
+      write_point(sensor, encode_volts(sensor, plant->measured_v()));
     }
-    position_mm.store(plant.position_mm());
+    position_mm.store(plant->position_mm());
     steps.fetch_add(1);
     clock_gettime(CLOCK_MONOTONIC, &now);
     if (to_ns(now) - next_ns > kMaxLagPeriods * period_ns) {
@@ -205,6 +206,17 @@ void RemoteIoSimulator::Impl::run_plant() noexcept {
 }
 
 core::Result<std::unique_ptr<RemoteIoSimulator>> RemoteIoSimulator::start(const RemoteIoSimulatorConfig& c) {
+  // The model's Ts is checked first, so a bad Ts is reported as such rather than as a plant error.
+  if (!(c.model.Ts >= kMinTs && c.model.Ts <= kMaxTs))
+    return core::invalid_argument("remote I/O simulator: Ts " + std::to_string(c.model.Ts) +
+                                  " s is outside the real-time range 0.0001..10 s");
+  auto plant = plant::make_hammerstein_simulator(c.model, c.plant);
+  if (!plant) return core::invalid_argument("remote I/O simulator: " + plant.error().message);
+  return start(c, std::move(*plant));
+}
+
+core::Result<std::unique_ptr<RemoteIoSimulator>> RemoteIoSimulator::start(const RemoteIoSimulatorConfig& c,
+                                                                          std::unique_ptr<plant::PlantSimulator> plant) {
   const std::string where = c.address + ":" + std::to_string(c.port);
   in_addr addr{};
   if (inet_pton(AF_INET, c.address.c_str(), &addr) != 1)
@@ -214,13 +226,13 @@ core::Result<std::unique_ptr<RemoteIoSimulator>> RemoteIoSimulator::start(const 
   if (c.unit_id < 0 || c.unit_id > 247)
     return core::invalid_argument("remote I/O simulator: unit id " + std::to_string(c.unit_id) + " is outside 0..247");
   if (auto s = validate(c.layout); !s) return s.error();
-  if (!(c.model.Ts >= kMinTs && c.model.Ts <= kMaxTs))
-    return core::invalid_argument("remote I/O simulator: Ts " + std::to_string(c.model.Ts) +
+  if (plant == nullptr) return core::invalid_argument("remote I/O simulator: no plant given");
+  const double Ts = plant->sample_period_s();
+  if (!(Ts >= kMinTs && Ts <= kMaxTs))
+    return core::invalid_argument("remote I/O simulator: Ts " + std::to_string(Ts) +
                                   " s is outside the real-time range 0.0001..10 s");
-  auto plant = plant::HammersteinPlant::make(c.model, c.plant);
-  if (!plant) return core::invalid_argument("remote I/O simulator: " + plant.error().message);
 
-  auto impl = std::make_unique<Impl>(c, std::move(*plant));
+  auto impl = std::make_unique<Impl>(c, std::move(plant));
   impl->ctx = modbus_new_tcp(c.address.c_str(), c.port);
   if (impl->ctx == nullptr)
     return core::io_error("remote I/O simulator: cannot create a Modbus TCP context for " + where + ": " +
@@ -248,8 +260,8 @@ core::Result<std::unique_ptr<RemoteIoSimulator>> RemoteIoSimulator::start(const 
     return core::io_error("remote I/O simulator: cannot allocate the register mapping: " +
                           std::string(modbus_strerror(errno)));
   impl->write_point(c.layout.valve, encode_volts(c.layout.valve, 0.0));
-  impl->write_point(c.layout.sensor, encode_volts(c.layout.sensor, impl->plant.measured_v()));
-  impl->position_mm.store(impl->plant.position_mm());
+  impl->write_point(c.layout.sensor, encode_volts(c.layout.sensor, impl->plant->measured_v()));
+  impl->position_mm.store(impl->plant->position_mm());
 
   impl->running.store(true);
   try {

@@ -1,7 +1,7 @@
 #pragma once
 // A stand-in for a remote analog I/O module with the plant behind it: a Modbus TCP server
-// (libmodbus) whose registers follow a RemoteIoLayout, and a plant thread that steps the paper's
-// Hammerstein plant in real time. `epa plant-server` runs it in its own process; the modbus-io
+// (libmodbus) whose registers follow a RemoteIoLayout, and a plant thread that steps a plant in
+// real time: the paper's Hammerstein plant, or any plant::PlantSimulator (the physics model). `epa plant-server` runs it in its own process; the modbus-io
 // tests run it in-process on a free port.
 //
 // Plant thread, every Ts (absolute deadlines, clock_nanosleep TIMER_ABSTIME on CLOCK_MONOTONIC):
@@ -27,6 +27,7 @@
 #include "core/result.hpp"
 #include "hal/remote_io_layout.hpp"
 #include "plant/hammerstein_plant.hpp"
+#include "plant/plant_simulator.hpp"
 
 namespace epa::hal {
 
@@ -36,7 +37,7 @@ struct RemoteIoSimulatorConfig {
   int unit_id = 1;                    // 0..247; others (except 0xFF) get exception 0x0B
   RemoteIoLayout layout = default_remote_io_layout();
   core::HammersteinModel model;       // its Ts is the real-time step period
-  plant::PlantOptions plant;
+  plant::PlantOptions plant;          // model and plant: for start(config) only
   int realtime_priority = 0;          // SCHED_FIFO for both threads, as a module's firmware answers in
                                       // bounded time; 0: normal priority (refusal is not an error)
 };
@@ -47,7 +48,11 @@ class RemoteIoSimulator {
 
   // Validates, binds and listens, then starts the server and plant threads. Errors name the
   // field, or the address:port and the system's reason when binding fails (e.g. in use).
+  // start(config) serves the Hammerstein plant of config.model and config.plant; start(config,
+  // plant) serves the given plant instead, stepped every plant->sample_period_s().
   static core::Result<std::unique_ptr<RemoteIoSimulator>> start(const RemoteIoSimulatorConfig& config);
+  static core::Result<std::unique_ptr<RemoteIoSimulator>> start(const RemoteIoSimulatorConfig& config,
+                                                                std::unique_ptr<plant::PlantSimulator> plant);
   ~RemoteIoSimulator();  // stop()
   RemoteIoSimulator(const RemoteIoSimulator&) = delete;
   RemoteIoSimulator& operator=(const RemoteIoSimulator&) = delete;

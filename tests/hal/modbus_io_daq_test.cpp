@@ -22,6 +22,7 @@
 
 #include "core/paper_reference.hpp"
 #include "hal/remote_io_simulator.hpp"
+#include "plant/plant_adapter.hpp"
 
 #include "../support/counting_new.hpp"  // the cycle calls must allocate nothing
 
@@ -560,6 +561,33 @@ TEST(RemoteIoSimulator, StepsInRealTimeAndStopsPromptly) {
   sim->stop();  // idempotent
   EXPECT_EQ(sim->steps(), steps);
   EXPECT_DOUBLE_EQ(sim->position_mm(), 100.0);  // valve at 0 V: at rest
+}
+
+// `epa plant-server` with the physics plant: the same Modbus face, a different plant behind it.
+TEST(RemoteIoSimulator, ServesThePhysicsPlant) {
+  auto plant = plant::make_pneumatic_simulator({}, {.initial_position_mm = 100.0, .Ts = 0.002, .substeps = 20});
+  ASSERT_TRUE(plant.has_value()) << plant.error().message;
+  auto started = RemoteIoSimulator::start(sim_config(), std::move(*plant));
+  ASSERT_TRUE(started.has_value()) << started.error().message;
+  auto& sim = *started;
+  ModbusIoDaq daq(daq_config(sim->port()));
+  ASSERT_TRUE(daq.open().has_value());
+  const SensorReading r = daq.read_sensor();
+  ASSERT_EQ(r.status, IoStatus::kOk);
+  EXPECT_NEAR(r.sensor_v, 2.0, kCountV);  // 100 mm of 500 mm over 0-10 V
+  const auto t0 = Clock::now();
+  ASSERT_TRUE(poll_until([&] { return sim->steps() >= 20; }));
+  EXPECT_GE(elapsed_ms(t0), 20 * 2.0 - 2.0);  // stepped at the plant's own Ts = 2 ms
+  EXPECT_DOUBLE_EQ(sim->position_mm(), 100.0);  // centred valve: at rest
+  ASSERT_EQ(daq.write_valve(4.0), IoStatus::kOk);
+  EXPECT_TRUE(poll_until([&] { return sim->position_mm() > 110.0; })) << sim->position_mm();
+  EXPECT_TRUE(poll_until([&] { auto s = daq.read_sensor(); return s.status == IoStatus::kOk && s.sensor_v > 2.2; }));
+}
+
+TEST(RemoteIoSimulator, RefusesANullPlant) {
+  auto sim = RemoteIoSimulator::start(sim_config(), nullptr);
+  ASSERT_FALSE(sim.has_value());
+  EXPECT_NE(sim.error().message.find("no plant"), std::string::npos) << sim.error().message;
 }
 
 }  // namespace
