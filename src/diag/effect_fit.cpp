@@ -1,0 +1,163 @@
+#include "diag/effect_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <nlopt.hpp>
+
+namespace epa::diag {
+
+namespace {
+
+using plant::EffectKind;
+
+// One free parameter: which effect and slot, and how it maps to [0, 1] for the optimiser
+// (logarithmic for the velocity ceiling, which spans two decades).
+struct Slot {
+  EffectKind kind;
+  std::size_t i;
+  plant::ParamSpec spec;
+  bool fresh = true;  // the effect was off in the base model: search its range from several starts
+  bool log_scale() const { return kind == EffectKind::kFlowSaturation; }
+  double to_unit(double v) const {
+    return log_scale() ? std::log(v / spec.lo) / std::log(spec.hi / spec.lo) : (v - spec.lo) / (spec.hi - spec.lo);
+  }
+  double from_unit(double x) const {
+    x = std::clamp(x, 0.0, 1.0);
+    return log_scale() ? spec.lo * std::pow(spec.hi / spec.lo, x) : spec.lo + x * (spec.hi - spec.lo);
+  }
+};
+
+struct Objective {
+  ReplayModel model;
+  std::span<const core::Run* const> runs;
+  std::size_t horizon;
+  std::size_t evaluations = 0;
+  double gap() {
+    ++evaluations;
+    GapSum s;
+    for (const auto* r : runs) s += windowed_sse(model, *r, horizon);
+    return s.rms_mm();
+  }
+};
+
+void put(ReplayModel& m, const Slot& s, double value) {
+  auto p = m.effects.params(s.kind);
+  p[s.i] = value;
+  m.effects.set(s.kind, p);
+}
+
+// Minimises over the continuous slots by BOBYQA from a few starts; leaves the best in obj.model.
+double local_fit(Objective& obj, const std::vector<Slot>& slots, const FitOptions& o) {
+  if (slots.empty()) return obj.gap();
+  const std::size_t n = slots.size();
+  std::vector<std::vector<double>> starts;
+  std::vector<double> neutral(n);
+  for (std::size_t i = 0; i < n; ++i) neutral[i] = slots[i].to_unit(obj.model.effects.params(slots[i].kind)[slots[i].i]);
+  starts.push_back(neutral);
+  // Parameters already fitted (the nominal ones, accepted effects) start where they are; a new
+  // effect's parameters from its neutral value and from two points across their range.
+  // Also with the fitted ones back at their neutral values: a re-fitted dead zone can have
+  // absorbed part of, say, friction, and the joint fit must be able to give it back.
+  for (bool reset : {false, true})
+    for (double f : {0.3, 0.7}) {
+      auto x = neutral;
+      bool any = false;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (slots[i].fresh) x[i] = f, any = true;
+        else if (reset) x[i] = slots[i].to_unit(slots[i].spec.neutral);
+      }
+      if (any) starts.push_back(x);
+    }
+  double best = std::numeric_limits<double>::infinity();
+  std::vector<double> best_x = neutral;
+  for (auto x : starts) {
+    nlopt::opt opt(nlopt::LN_BOBYQA, static_cast<unsigned>(n));
+    opt.set_lower_bounds(std::vector<double>(n, 0.0));
+    opt.set_upper_bounds(std::vector<double>(n, 1.0));
+    opt.set_xtol_abs(1e-5);
+    opt.set_ftol_rel(1e-7);
+    opt.set_maxeval(static_cast<int>(o.max_evaluations_per_start));
+    opt.set_initial_step(0.1);
+    auto f = [](unsigned, const double* xs, double*, void* data) {
+      auto* c = static_cast<std::pair<Objective*, const std::vector<Slot>*>*>(data);
+      for (std::size_t i = 0; i < c->second->size(); ++i) put(c->first->model, (*c->second)[i], (*c->second)[i].from_unit(xs[i]));
+      return c->first->gap();
+    };
+    std::pair<Objective*, const std::vector<Slot>*> ctx{&obj, &slots};
+    opt.set_min_objective(f, &ctx);
+    double value = std::numeric_limits<double>::infinity();
+    try {
+      opt.optimize(x, value);
+    } catch (const std::exception&) {  // roundoff-limited or max-eval stops still leave x usable
+      for (std::size_t i = 0; i < n; ++i) put(obj.model, slots[i], slots[i].from_unit(x[i]));
+      value = obj.gap();
+    }
+    if (value < best) best = value, best_x = x;
+  }
+  for (std::size_t i = 0; i < n; ++i) put(obj.model, slots[i], slots[i].from_unit(best_x[i]));
+  return best;
+}
+
+// A grid over one slot with the continuous slots fitted at each value would be costly; the grid
+// slots (delay, sensor step) are fitted alone, the continuous ones afterwards at the best value.
+double grid_fit(Objective& obj, const Slot& s, const std::vector<double>& values) {
+  double best = std::numeric_limits<double>::infinity(), best_v = values.front();
+  for (double v : values) {
+    put(obj.model, s, v);
+    if (const double g = obj.gap(); g < best) best = g, best_v = v;
+  }
+  put(obj.model, s, best_v);
+  return best;
+}
+
+std::vector<double> quantization_grid(double lo, double hi, std::size_t n, bool with_zero) {
+  std::vector<double> v;
+  if (with_zero) v.push_back(0.0);
+  for (std::size_t i = 0; i < n; ++i) v.push_back(lo * std::pow(hi / lo, static_cast<double>(i) / static_cast<double>(n - 1)));
+  return v;
+}
+
+}  // namespace
+
+EffectFit fit_effects(const ReplayModel& base, std::span<const EffectKind> kinds, std::span<const core::Run* const> runs,
+                      const FitOptions& o) {
+  Objective obj{base, runs, o.horizon};
+  std::vector<Slot> continuous, grid;
+  for (auto kind : kinds) {
+    const bool fresh = !obj.model.effects.on(kind);
+    if (fresh) {
+      plant::EffectParams p{};
+      const auto specs = plant::param_specs(kind);
+      for (std::size_t i = 0; i < specs.size(); ++i) p[i] = specs[i].neutral;
+      obj.model.effects.set(kind, p);
+    }
+    const auto specs = plant::param_specs(kind);
+    for (std::size_t i = 0; i < specs.size(); ++i) {
+      const Slot s{kind, i, specs[i], fresh};
+      (specs[i].integer || kind == EffectKind::kSensorQuantization ? grid : continuous).push_back(s);
+    }
+  }
+  double gap = std::numeric_limits<double>::infinity();
+  for (const auto& s : grid) {
+    if (s.spec.integer) {
+      std::vector<double> values;
+      for (double v = s.spec.lo; v <= s.spec.hi; v += 1.0) values.push_back(v);
+      gap = grid_fit(obj, s, values);
+    } else {
+      gap = grid_fit(obj, s, quantization_grid(0.02, s.spec.hi, 60, true));
+      const double coarse = obj.model.effects.params(s.kind)[s.i];
+      if (coarse > 0.0) gap = grid_fit(obj, s, quantization_grid(coarse / 1.12, std::min(s.spec.hi, coarse * 1.12), 15, false));
+    }
+  }
+  if (!continuous.empty()) gap = local_fit(obj, continuous, o);
+  if (!std::isfinite(gap)) gap = obj.gap();
+  return {obj.model, gap, obj.evaluations};
+}
+
+EffectFit refit_nominal(const ReplayModel& base, std::span<const core::Run* const> runs, const FitOptions& o) {
+  const EffectKind kinds[] = {EffectKind::kGainChange, EffectKind::kDeadzoneShift};
+  return fit_effects(base, kinds, runs, o);
+}
+
+}  // namespace epa::diag

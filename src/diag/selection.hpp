@@ -1,0 +1,93 @@
+#pragma once
+// Which effect explains the gap, and how far it shrinks: the diagnosis.
+//
+//  1. Baseline: the nominal model's held-out windowed gap.
+//  2. Re-fit: the nominal model's own parameters (drive gain, both break points) fitted on the
+//     training runs and scored held out; they stay free in every later fit, since on a rig much of
+//     a gap is parameters that are off, and an effect fitted on wrong parameters is biased.
+//  3. Candidates: every structural effect (delay, lag, friction, ceiling, position dependence,
+//     quantisation) fitted with the nominal parameters on the training runs, scored held out.
+//  4. Forward selection: add the effect with the largest held-out reduction while that reduction
+//     beats its chance threshold (the reduction fitting that effect gives on effect-free data:
+//     chance_threshold.hpp), re-fitting on top of what is accepted; at most max_effects.
+//     input_delay and valve_lag explain much the same; when the runner-up comes within
+//     confusable_ratio of the winner's reduction, the pair is reported as confusable.
+//  5. gain_change and deadzone_shift are named when their parameters, fitted with the accepted
+//     effects, lie beyond tolerances calibrated on effect-free data from slightly perturbed models.
+//  6. Unexplained: a held-out gap left above unexplained_factor times the noise floor (the gap
+//     that sensor noise alone gives a perfect model, estimated from the runs at rest).
+// Without held-out runs, folds leave one training run out each (cross-validation by run).
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/run.hpp"
+#include "diag/effect_fit.hpp"
+#include "diag/windowed_gap.hpp"
+#include "plant/effects.hpp"
+
+namespace epa::diag {
+
+struct DiagnosisOptions {
+  std::size_t horizon = 10;
+  std::vector<plant::EffectKind> candidates{plant::kAllEffects.begin(), plant::kAllEffects.end()};
+  std::size_t max_effects = 3;
+  double threshold_scale = 1.0;    // multiplies every chance threshold
+  double confusable_ratio = 0.85;
+  double unexplained_factor = 1.6;
+  double refit_threshold_pct = 5.0;  // the re-fit must beat this reduction for gain/break points to be named
+  double gain_tolerance = 0.06;      // |gain_ratio - 1| beyond this names gain_change
+  double shift_tolerance_V = 0.06;   // a break point moved beyond this names deadzone_shift
+  std::function<void(const std::string&)> progress;  // one line per stage; empty: quiet
+};
+
+struct Fold {
+  std::vector<const core::Run*> train, test;
+};
+
+struct CandidateScore {
+  plant::EffectKind kind;
+  plant::EffectParams params{};   // fitted on all training runs, alone on the nominal model
+  double heldout_gap_mm = 0;
+  double reduction_pct = 0;       // against the baseline
+  double reduction_vs_refit_pct = 0;  // against the re-fitted nominal model (what acceptance uses)
+  double threshold_pct = 0;       // its chance threshold
+  bool accepted = false;          // in the verdict
+};
+
+struct SelectionStep {
+  plant::EffectKind kind;
+  double gap_before_mm = 0, gap_after_mm = 0, reduction_pct = 0, threshold_pct = 0;
+  bool accepted = false;
+};
+
+struct Diagnosis {
+  std::size_t horizon = 10;
+  ReplayModel nominal, refit, final_model;   // final: nominal with the accepted effects (all training runs)
+  double baseline_gap_mm = 0, refit_gap_mm = 0, final_gap_mm = 0;  // held-out (pooled over folds)
+  double train_gap_mm = 0;                   // nominal, on the training runs
+  std::vector<CandidateScore> candidates;    // best first
+  std::vector<SelectionStep> steps;          // the forward selection, in order
+  std::vector<plant::EffectKind> effects;    // accepted, in order
+  std::vector<std::pair<plant::EffectKind, plant::EffectKind>> confusable;
+  double noise_std_mm = 0, noise_floor_mm = 0;
+  bool unexplained = false;
+  bool cross_validated = false;
+  std::size_t evaluations = 0;
+};
+
+// Folds: one with `heldout` as test when it is non-empty, else leave-one-run-out over `train`
+// (which then needs at least 2 runs; checked by the caller).
+std::vector<Fold> make_folds(const std::vector<const core::Run*>& train, const std::vector<const core::Run*>& heldout);
+
+Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run*>& train,
+                   const std::vector<const core::Run*>& heldout, const DiagnosisOptions& options);
+
+// Sensor noise (mm, one standard deviation) from second differences of the position at rest
+// with the valve inside the dead band.
+double estimate_noise_std_mm(const std::vector<const core::Run*>& runs, const core::DeadZone& dead_zone);
+// RMS windowed gap that white sensor noise of `noise_std_mm` gives a perfect model.
+double noise_floor_mm(const core::HammersteinModel& model, double noise_std_mm, std::size_t horizon);
+
+}  // namespace epa::diag

@@ -1,0 +1,83 @@
+#include "diag/windowed_gap.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace epa::diag {
+
+double GapSum::rms_mm() const { return n ? std::sqrt(sse_mm2 / static_cast<double>(n)) : 0.0; }
+
+std::size_t first_window_start(const core::HammersteinModel& model) {
+  return std::max<std::size_t>({model.A.size(), model.B.size(), 2}) - 1;
+}
+
+namespace {
+
+// Calls on_prediction(k, predicted_mm, error_mm) for every prediction.
+template <typename OnPrediction>
+void replay(const ReplayModel& m, const core::Run& run, std::size_t horizon, OnPrediction&& on_prediction) {
+  const auto& model = m.model;
+  const std::size_t n = run.size();
+  const std::size_t start = first_window_start(model);
+  if (horizon == 0 || n <= start + 1) return;
+  const std::size_t na = model.A.size() - 1, nb = model.B.size() - 1;
+  std::array<double, core::kMaxModelOrder + 1> a{}, b{};
+  for (std::size_t i = 0; i <= na; ++i) a[i] = model.A[i];
+  for (std::size_t i = 0; i <= nb; ++i) b[i] = model.B[i];
+  const double mpv = model.mm_per_volt, max_v = m.stroke_mm / mpv;
+  const double step_mm = m.effects.on(plant::EffectKind::kSensorQuantization)
+                             ? m.effects.param(plant::EffectKind::kSensorQuantization, 0) : 0.0;
+
+  // The history-dependent input side, once over the whole run.
+  plant::ValveEffects valve(m.effects, model.Ts);
+  plant::DriveEffects drive(m.effects, model.dead_zone,
+                            plant::steady_speed_mm_s_per_V(model.A.coefficients(), model.B.coefficients(), model.Ts, mpv));
+  thread_local std::vector<double> pre;
+  pre.resize(n);
+  for (std::size_t k = 0; k < n; ++k) pre[k] = drive.drive_before_position(valve.apply(run.u_V[k]));
+
+  std::array<double, core::kMaxModelOrder + 1> y{}, ud{};  // y(k), y(k-1), ...; u_d(k), u_d(k-1), ...
+  for (std::size_t k0 = start; k0 + 1 < n; k0 += horizon) {
+    for (std::size_t i = 0; i < na && i <= k0; ++i) y[i] = run.y_mm[k0 - i] / mpv;
+    for (std::size_t i = 1; i < nb && i <= k0; ++i) ud[i] = drive.finish(pre[k0 - i], run.y_mm[k0 - i]);
+    const std::size_t end = std::min(n - 1, k0 + horizon);
+    for (std::size_t k = k0; k < end; ++k) {
+      ud[0] = drive.finish(pre[k], y[0] * mpv);
+      double next = 0.0;
+      for (std::size_t i = 1; i <= na; ++i) next -= a[i] * y[i - 1];
+      for (std::size_t i = 1; i <= nb; ++i) next += b[i] * ud[i - 1];
+      next = std::clamp(next, 0.0, max_v);
+      for (std::size_t i = core::kMaxModelOrder; i > 0; --i) y[i] = y[i - 1], ud[i] = ud[i - 1];
+      y[0] = next;
+      const double predicted_mm = plant::quantize_mm(next * mpv, step_mm);
+      on_prediction(k + 1, predicted_mm, predicted_mm - run.y_mm[k + 1]);
+    }
+  }
+}
+
+}  // namespace
+
+GapSum windowed_sse(const ReplayModel& model, const core::Run& run, std::size_t horizon) {
+  GapSum s;
+  replay(model, run, horizon, [&](std::size_t, double, double e) { s.sse_mm2 += e * e, ++s.n; });
+  return s;
+}
+
+WindowedReplay windowed_replay(const ReplayModel& model, const core::Run& run, std::size_t horizon) {
+  WindowedReplay r;
+  r.k.reserve(run.size()), r.predicted_mm.reserve(run.size()), r.error_mm.reserve(run.size());
+  replay(model, run, horizon, [&](std::size_t k, double p, double e) {
+    r.k.push_back(k), r.predicted_mm.push_back(p), r.error_mm.push_back(e);
+    r.sum.sse_mm2 += e * e, ++r.sum.n;
+  });
+  return r;
+}
+
+double windowed_gap_mm(const ReplayModel& model, std::span<const core::Run* const> runs, std::size_t horizon) {
+  GapSum s;
+  for (const auto* run : runs) s += windowed_sse(model, *run, horizon);
+  return s.rms_mm();
+}
+
+}  // namespace epa::diag

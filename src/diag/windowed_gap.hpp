@@ -1,0 +1,53 @@
+#pragma once
+// The gap between a model and a recorded run: the windowed prediction error. Every `horizon`
+// samples the model is restarted from the measured state (the ARX part's past outputs from the
+// measured position, its past inputs from the recorded valve command through the model's input
+// side) and run on the recorded valve command for `horizon` samples; each prediction is compared
+// with the measurement. A plain open-loop replay would drift away, because the plant integrates.
+//
+// Effects that depend on the command history alone (delay, lag, dead zone, friction, gain,
+// ceiling) are computed over the whole run, so they carry their state across restarts as the real
+// valve would; position_dependent_gain reads the model's own position inside a window;
+// sensor_quantization rounds the prediction as the sensor would round the truth.
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "core/hammerstein_model.hpp"
+#include "core/run.hpp"
+#include "plant/effects.hpp"
+
+namespace epa::diag {
+
+// A model to replay: the nominal Hammerstein model with effects switched on.
+struct ReplayModel {
+  core::HammersteinModel model;
+  plant::EffectSet effects;
+  double stroke_mm = 500.0;  // end stops at 0 and stroke_mm
+};
+
+// Sum of squared prediction errors and their count: pools over runs, folds and regimes.
+struct GapSum {
+  double sse_mm2 = 0.0;
+  std::size_t n = 0;
+  double rms_mm() const;
+  GapSum& operator+=(const GapSum& o) { sse_mm2 += o.sse_mm2, n += o.n; return *this; }
+};
+
+// Every prediction of one run, in sample order.
+struct WindowedReplay {
+  std::vector<std::size_t> k;        // sample predicted
+  std::vector<double> predicted_mm;  // what the model says the sensor reads there
+  std::vector<double> error_mm;      // predicted - measured
+  GapSum sum;
+};
+
+// The first sample a window may start at: the ARX part needs that much measured past.
+std::size_t first_window_start(const core::HammersteinModel& model);
+
+GapSum windowed_sse(const ReplayModel& model, const core::Run& run, std::size_t horizon);
+WindowedReplay windowed_replay(const ReplayModel& model, const core::Run& run, std::size_t horizon);
+// Pooled RMS over the runs, mm.
+double windowed_gap_mm(const ReplayModel& model, std::span<const core::Run* const> runs, std::size_t horizon);
+
+}  // namespace epa::diag

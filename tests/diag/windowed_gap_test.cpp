@@ -1,0 +1,59 @@
+// The windowed gap: zero on noise-free data from the model itself (also with each effect on in
+// both), growing with the horizon when the model drifts from the plant.
+#include <gtest/gtest.h>
+
+#include "diag/windowed_gap.hpp"
+#include "diag_test_data.hpp"
+
+namespace {
+
+using epa::diag::ReplayModel;
+
+TEST(WindowedGap, IsZeroOnNoiseFreeDataFromTheModelItself) {
+  const auto model = epa::core::paper::model();
+  for (bool closed : {true, false}) {
+    const auto run = epa::testing::make_run(model, {}, {.closed_loop = closed, .duration_s = 8, .noise_std_mm = 0.0});
+    const std::vector<const epa::core::Run*> runs{&run};
+    for (std::size_t horizon : {1u, 10u, 100u}) EXPECT_LT(epa::diag::windowed_gap_mm({model, {}, 500}, runs, horizon), 1e-9);
+  }
+}
+
+TEST(WindowedGap, IsZeroWithTheHiddenEffectSwitchedOnInTheReplay) {
+  const auto model = epa::core::paper::model();
+  for (auto kind : epa::plant::kAllEffects) {
+    epa::testing::Hidden h{epa::testing::typical_effect(kind)};
+    const auto run = epa::testing::make_run(model, h, {.closed_loop = true, .duration_s = 10, .noise_std_mm = 0.0});
+    const std::vector<const epa::core::Run*> runs{&run};
+    const double with = epa::diag::windowed_gap_mm({model, h.effects, 500}, runs, 10);
+    const double without = epa::diag::windowed_gap_mm({model, {}, 500}, runs, 10);
+    EXPECT_GT(without, 0.05) << epa::plant::to_string(kind);
+    // A restart from a quantised reading cannot know the true position, so quantising the
+    // prediction does not bring it back to zero (why the self-check may call it unexplained).
+    if (kind != epa::plant::EffectKind::kSensorQuantization) { EXPECT_LT(with, 1e-9) << epa::plant::to_string(kind); }
+  }
+}
+
+TEST(WindowedGap, GrowsWithTheHorizonOnADriftingPlant) {
+  epa::testing::Hidden h;
+  h.effects.set(epa::plant::EffectKind::kGainChange, {0.8});
+  const auto run = epa::testing::make_run(epa::core::paper::model(), h, {.closed_loop = true, .duration_s = 8, .noise_std_mm = 0.0});
+  const std::vector<const epa::core::Run*> runs{&run};
+  const ReplayModel nominal{epa::core::paper::model(), {}, 500};
+  double last = 0.0;
+  for (std::size_t horizon : {1u, 5u, 20u, 80u}) {
+    const double gap = epa::diag::windowed_gap_mm(nominal, runs, horizon);
+    EXPECT_GT(gap, last) << "horizon " << horizon;
+    last = gap;
+  }
+}
+
+TEST(WindowedGap, ReplayListsEveryPredictionOnce) {
+  const auto model = epa::core::paper::model();
+  const auto run = epa::testing::make_run(model, {}, {.closed_loop = true, .duration_s = 2});
+  const auto r = epa::diag::windowed_replay({model, {}, 500}, run, 10);
+  ASSERT_EQ(r.k.size(), run.size() - 1 - epa::diag::first_window_start(model));
+  for (std::size_t i = 1; i < r.k.size(); ++i) EXPECT_EQ(r.k[i], r.k[i - 1] + 1);
+  EXPECT_EQ(r.sum.n, r.k.size());
+}
+
+}  // namespace
