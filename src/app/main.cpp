@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "app/design_command.hpp"
+#include "app/diagnose_command.hpp"
 #include "app/excite_command.hpp"
 #include "app/identify_command.hpp"
 #include "app/plant_server_command.hpp"
@@ -30,6 +31,8 @@ int main(int argc, char** argv) {
   epa::app::add_design_command(app, design);
   epa::app::add_excite_command(app, excite);
   epa::app::add_identify_command(app, identify);
+  epa::app::DiagnoseOptions diagnose;
+  epa::app::add_diagnose_command(app, diagnose);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -40,6 +43,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("design")) return epa::app::run_design(design, std::cout, std::cerr);
     if (app.got_subcommand("excite")) return epa::app::run_excite(excite, std::cout, std::cerr);
     if (app.got_subcommand("identify")) return epa::app::run_identify(identify, std::cout, std::cerr);
+    if (app.got_subcommand("diagnose")) return epa::app::run_diagnose(diagnose, std::cout, std::cerr);
     if (app.got_subcommand("serve")) return epa::app::run_serve(serve, std::cerr);
     if (app.got_subcommand("registers")) return epa::app::run_registers(registers, std::cout, std::cerr);
     if (app.got_subcommand("plant-server")) return epa::app::run_plant_server(plant_server, std::cout, std::cerr);

@@ -174,7 +174,9 @@ std::string verdict_text(const GapReport& r) {
     s = d.unexplained ? "Unexplained: no effect in the library reduces the held-out gap beyond chance, and a significant gap remains"
                       : "No effect: the held-out gap is at the level of sensor noise and the model's own rounding";
   } else {
-    s = "The gap is explained by " + d.final_model.effects.describe();
+    plant::EffectSet named;  // the named effects only: unnamed re-fitted parameters are the model's own
+    for (auto k : d.effects) named.set(k, d.final_model.effects.params(k));
+    s = "The gap is explained by " + named.describe();
     for (const auto& [a, b] : d.confusable)
       s += "; " + std::string(plant::to_string(a)) + " and " + std::string(plant::to_string(b)) +
            " are confusable on these runs (either explains it)";
