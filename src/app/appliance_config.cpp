@@ -225,6 +225,10 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   rec.number("move_window_s", r.move_window_s, kPositive, "> 0 s");
   rec.refuse_unknown_keys();
 
+  TableReader st(top.subtable("store"), "store", file, error);
+  st.text("path", c.store_path);
+  st.refuse_unknown_keys();
+
   TableReader log(top.subtable("log"), "log", file, error);
   log.number("status_interval_s", c.status_interval_s, kNonNegative, ">= 0 s (0: off)");
   log.refuse_unknown_keys();

@@ -2,9 +2,10 @@
 // config/epa.toml (epa-config/1): everything `epa serve` needs, read into the runtime's and the
 // backends' own config structs. Every key is optional (defaults as in config/epa.toml), every
 // value is type- and range-checked, and unknown keys are refused; messages name the file, the
-// line and the key. Relative paths of files the configuration names (model, design, register map)
-// (and the status page's static files) are resolved against the configuration file's folder; the recorder's directory against the
-// working directory (where the appliance keeps its data: /var/lib/epa under systemd).
+// line and the key. Relative paths of files the configuration names (model, design, register map,
+// the status page's static files) are resolved against the configuration file's folder; the
+// appliance's data (the store's database, the recorder's directory) against the working directory
+// (/var/lib/epa under systemd).
 #include <string>
 
 #include "hal/comedi_daq.hpp"
@@ -29,6 +30,7 @@ struct ApplianceConfig {
   double lc_mm = 5.0;
   double valve_limit_v = 5.0;
 
+  std::string store_path = "epa.db";  // the tuning store (SQLite), relative to the working directory
   std::string record_directory = "runs";
   bool record_per_move = true;
   double status_interval_s = 10.0;

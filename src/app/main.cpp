@@ -11,6 +11,7 @@
 #include "app/registers_command.hpp"
 #include "app/serve_command.hpp"
 #include "app/simulate_command.hpp"
+#include "app/tuning_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"epa: electro-pneumatic actuator controller appliance (pole placement with feed-forward "
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   epa::app::ServeOptions serve;
   epa::app::PlantServerOptions plant_server;
   epa::app::RegistersOptions registers;
+  epa::app::TuningOptions tuning;
   epa::app::add_serve_command(app, serve);
   epa::app::add_plant_server_command(app, plant_server);
   epa::app::add_registers_command(app, registers);
@@ -31,6 +33,7 @@ int main(int argc, char** argv) {
   epa::app::add_design_command(app, design);
   epa::app::add_excite_command(app, excite);
   epa::app::add_identify_command(app, identify);
+  epa::app::add_tuning_command(app, tuning);
   epa::app::DiagnoseOptions diagnose;
   epa::app::add_diagnose_command(app, diagnose);
   try {
@@ -46,6 +49,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("diagnose")) return epa::app::run_diagnose(diagnose, std::cout, std::cerr);
     if (app.got_subcommand("serve")) return epa::app::run_serve(serve, std::cerr);
     if (app.got_subcommand("registers")) return epa::app::run_registers(registers, std::cout, std::cerr);
+    if (app.got_subcommand("tuning")) return epa::app::run_tuning(app, tuning, std::cout, std::cerr);
     if (app.got_subcommand("plant-server")) return epa::app::run_plant_server(plant_server, std::cout, std::cerr);
   } catch (const std::exception& e) {  // third-party code (CLI11, JSON, filesystem) at the edge
     std::cerr << "epa: " << e.what() << "\n";

@@ -6,10 +6,13 @@
 #include <csignal>
 #include <ctime>
 #include <optional>
+#include <set>
 #include <thread>
 
 #include "app/daq_factory.hpp"
 #include "app/log_audit_sink.hpp"
+#include "app/run_history.hpp"
+#include "app/store_setup.hpp"
 #include "app/tuning_source.hpp"
 #include "core/format.hpp"
 #include "hal/realtime.hpp"
@@ -31,6 +34,7 @@ void add_serve_command(CLI::App& app, ServeOptions& o) {
   cmd->add_option("--mode", o.mode, "Mode at start-up: stop or run");
   cmd->add_option("--setpoint", o.setpoint_mm, "Setpoint at start-up, mm");
   cmd->add_option("--record-dir", o.record_dir, "Directory for recorded run files");
+  cmd->add_option("--db", o.db_path, "The tuning store's database file, overriding [store] path");
   cmd->add_option("--duration", o.duration_s, "Stop by itself after this many seconds (0: run until SIGTERM)");
 }
 
@@ -54,6 +58,7 @@ core::Status apply_overrides(const ServeOptions& o, ApplianceConfig& c) {
   }
   if (o.setpoint_mm >= 0.0) c.runtime.start_setpoint_mm = o.setpoint_mm;
   if (!o.record_dir.empty()) c.record_directory = o.record_dir;
+  if (!o.db_path.empty()) c.store_path = o.db_path;
   if (auto s = runtime::validate(c.runtime); !s) return s;
   if (c.backend == HalBackend::kModbusIo) return hal::validate(c.modbus_io);
   return core::ok();
@@ -68,41 +73,62 @@ std::string describe_snapshot(const runtime::Snapshot& s) {
   return buf;
 }
 
-// Everything the control law needs, from the configuration's model and design files.
+// Everything the control law needs: the active tuning set from the store (seeded from the
+// configuration's model and design files on first start), and the configuration's model for the
+// sim backend's plant.
 struct ControlSetup {
-  core::ModelFile model_file;
-  core::HammersteinModel model;
-  ControllerPolynomials polynomials;
+  core::ModelFile plant_model;            // the configuration's model: what the sim backend simulates
+  StoreStartup store;                     // the active tuning set, its model, the store thread
   control::ControllerConfig tuning_base;  // what tuning writes edit (Modbus)
   runtime::Tuning tuning;
 };
 
-core::Result<ControlSetup> prepare_control(ApplianceConfig& c) {
-  auto model_file = load_model(c.model_path);
-  if (!model_file) return model_file.error();
-  core::HammersteinModel model = model_file->model;
+// The points whose accepted values the store keeps: the register map's persisted column; without
+// Modbus, the setpoint (the only persisted point the web page can change).
+std::set<std::string> persisted_points(const std::optional<modbus::RegisterMap>& map) {
+  if (!map) return {"setpoint_mm"};
+  std::set<std::string> out;
+  for (const auto& e : map->entries())
+    if (e.persisted) out.insert(std::string(e.point->name));
+  return out;
+}
+
+core::Result<ControlSetup> prepare_control(ApplianceConfig& c, const std::optional<modbus::RegisterMap>& map, bool setpoint_given) {
+  auto plant_model = load_model(c.model_path);
+  if (!plant_model) return plant_model.error();
   // The paper does not print its Ts (NOTES.md), so its model takes the loop's period; an
   // identified model is only valid at the Ts it was identified at.
-  if (c.model_path.empty()) model.Ts = c.runtime.period_s;
-  if (std::abs(model.Ts - c.runtime.period_s) > 1e-12)
-    return core::invalid_argument("loop.period_s " + core::format_number(c.runtime.period_s) + " s differs from the model's Ts " +
-                                  core::format_number(model.Ts) + " s (" + c.model_path + ")");
-  c.runtime.mm_per_volt = model.mm_per_volt;
+  if (c.model_path.empty()) plant_model->model.Ts = c.runtime.period_s;
   auto polynomials = load_controller_polynomials(c.design_path);
   if (!polynomials) return polynomials.error();
-  const control::ControllerConfig base{.kind = c.runtime.controller, .F = polynomials->F, .G = polynomials->G,
-                                       .H = polynomials->H, .dead_zone = model.dead_zone,
-                                       .lc_v = c.lc_mm / model.mm_per_volt, .valve_limit_v = c.valve_limit_v,
-                                       .safe_valve_v = c.runtime.safe_valve_v};
+  const bool paper = c.model_path.empty() && c.design_path.empty();
+  const auto seed = make_seed(paper ? "paper" : "initial", *plant_model, *polynomials, c.runtime.controller, c.lc_mm, c.valve_limit_v);
+  auto store = open_tuning_store(c.store_path, seed, persisted_points(map));
+  if (!store) return store.error();
+
+  const core::HammersteinModel& model = store->model.model;
+  if (std::abs(model.Ts - c.runtime.period_s) > 1e-12)
+    return core::invalid_argument("loop.period_s " + core::format_number(c.runtime.period_s) + " s differs from Ts " +
+                                  core::format_number(model.Ts) + " s of model '" + store->model.name + "' of tuning set '" +
+                                  store->set.name + "' in " + c.store_path);
+  c.runtime.mm_per_volt = model.mm_per_volt;
+  c.runtime.controller = store->set.controller;
+  c.runtime.start_fault = store->start_fault;
+  if (store->retained_setpoint_mm && !setpoint_given) {
+    const double r = *store->retained_setpoint_mm;
+    if (r >= c.runtime.setpoint_min_mm && r <= c.runtime.setpoint_max_mm) c.runtime.start_setpoint_mm = r;
+    else store->warnings.push_back("store: retained setpoint " + core::format_number(r) + " mm is outside the configured limits: not used");
+  }
+  const control::ControllerConfig base = store::controller_config(store->set, model, c.runtime.safe_valve_v);
   auto tuning = runtime::make_tuning(base);
-  if (!tuning) return tuning.error();
-  return ControlSetup{std::move(*model_file), model, std::move(*polynomials), base, *tuning};
+  if (!tuning) return tuning.error();  // cannot happen: load_active_tuning validated the set
+  return ControlSetup{std::move(*plant_model), std::move(*store), base, *tuning};
 }
 
 core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const ApplianceConfig& c, const modbus::RegisterMap& map,
                                                                  const ControlSetup& control, runtime::LoopChannels& channels,
                                                                  core::AuditSink& audit) {
-  auto server = modbus::ModbusServer::start(c.modbus, map, control.tuning_base, control.model.mm_per_volt, channels, &audit,
+  auto server = modbus::ModbusServer::start(c.modbus, map, control.tuning_base, c.runtime.mm_per_volt, channels, &audit,
                                             [](const std::string& line) { spdlog::info("{}", line); });
   if (!server) return server.error();
   const auto& p = c.modbus.policy;
@@ -113,10 +139,17 @@ core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const Appliance
 }
 
 core::Result<std::unique_ptr<web::WebServer>> start_web(const ApplianceConfig& c, runtime::LoopChannels& channels,
-                                                        web::RecentAudit& audit, const modbus::ModbusServer* mb) {
-  auto server = web::WebServer::start(c.web, channels, c.runtime, &audit, [mb] {
+                                                        web::RecentAudit& audit, const modbus::ModbusServer* mb,
+                                                        const store::StoreWriter& store, const std::string& set_name) {
+  auto modbus_stats = [mb] {
     return mb ? web::ModbusStats{true, mb->clients(), mb->requests(), mb->exceptions()} : web::ModbusStats{};
-  });
+  };
+  auto store_stats = [&store, set_name] {
+    const auto counters = store.counters();
+    const auto health = store.health();
+    return web::StoreStats{true, health.ok, counters.accepted, counters.saved, health.last_error, set_name};
+  };
+  auto server = web::WebServer::start(c.web, channels, c.runtime, &audit, modbus_stats, store_stats);
   if (!server) return server.error();
   spdlog::info("web: listening on {}:{} (static files {}, commands {})", c.web.address, (*server)->port(), c.web.static_dir,
                c.web.token.empty() ? "disabled: no token configured" : "enabled with the token");
@@ -186,15 +219,18 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   if (!config) return fail(config.error());
   if (auto s = apply_overrides(o, *config); !s) return fail(s.error());
   ApplianceConfig& c = *config;
-  auto control = prepare_control(c);
-  if (!control) return fail(control.error());
   std::optional<modbus::RegisterMap> register_map;
   if (c.modbus_enabled) {
     auto map = modbus::RegisterMap::load(c.register_map_path);
     if (!map) return fail(map.error());
     register_map = std::move(*map);
   }
-  auto daq = make_daq(c, control->model);
+  auto control = prepare_control(c, register_map, o.setpoint_mm >= 0.0);
+  if (!control) return fail(control.error());
+  for (const auto& line : control->store.notes) spdlog::info("{}", line);
+  for (const auto& line : control->store.warnings) spdlog::warn("{}", line);
+  store::StoreWriter& store_writer = *control->store.writer;
+  auto daq = make_daq(c, control->plant_model.model);
   if (!daq) return fail(daq.error());
   spdlog::info("epa serve starting: config {}, DAQ {}", o.config_path, (*daq)->describe());
   if (auto s = (*daq)->open(); !s) {
@@ -202,9 +238,10 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
     return 1;
   }
   const DaqCloser closer{**daq};
-  spdlog::info("controller {} ({}), model {}, Ts {} s, start mode {}, setpoint {} mm",
-               control::to_string(c.runtime.controller), control->polynomials.source, control->model_file.source,
-               control->model.Ts, runtime::to_string(c.runtime.start_mode), c.runtime.start_setpoint_mm);
+  spdlog::info("controller {} (tuning set '{}': {}), model '{}', Ts {} s, start mode {}, setpoint {} mm",
+               control::to_string(c.runtime.controller), control->store.set.name, control->store.set.source,
+               control->store.model.name, control->store.model.model.Ts, runtime::to_string(c.runtime.start_mode),
+               c.runtime.start_setpoint_mm);
 
   // SIGTERM/SIGINT are taken synchronously by this thread; the threads below inherit the mask.
   sigset_t signals;
@@ -216,8 +253,9 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   runtime::LoopChannels channels(static_cast<std::size_t>(c.runtime.record_buffer_s / c.runtime.period_s));
   runtime::MonotonicClock clock;
   runtime::ScanCycle loop(c.runtime, control->tuning, **daq, clock, channels);
-  LogAuditSink log_audit;
-  web::RecentAudit audit(&log_audit);  // the log, plus the last entries for the status page
+  store_writer.start();
+  LogAuditSink log_audit(&store_writer);
+  web::RecentAudit audit(&log_audit);  // the last entries for the status page, the log, the store
   std::unique_ptr<modbus::ModbusServer> modbus_server;
   if (register_map) {
     auto server = start_modbus(c, *register_map, *control, channels, audit);
@@ -226,13 +264,14 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   }
   std::unique_ptr<web::WebServer> web_server;
   if (c.web_enabled) {
-    auto server = start_web(c, channels, audit, modbus_server.get());
+    auto server = start_web(c, channels, audit, modbus_server.get(), store_writer, control->store.set.name);
     if (!server) return spdlog::error("{}", server.error().message), 1;
     web_server = std::move(*server);
   }
-  runtime::Recorder recorder({.directory = c.record_directory, .per_move = c.record_per_move, .Ts = control->model.Ts,
+  runtime::Recorder recorder({.directory = c.record_directory, .per_move = c.record_per_move, .Ts = c.runtime.period_s,
                               .source = std::string("appliance/") + to_string(c.backend)},
-                             channels, [](const std::string& line) { spdlog::info("{}", line); });
+                             channels, [](const std::string& line) { spdlog::info("{}", line); },
+                             [&store_writer](const std::string& path, const core::Run& run) { store_writer.record_run(to_run_record(path, run)); });
   recorder.start();
 
   std::atomic<bool> stop{false};
@@ -250,7 +289,9 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   stop = true;
   loop_thread.join();  // the loop's last act: valve to its safe command
   recorder.stop();     // writes what is pending; the DAQ closes on the way out
-  spdlog::info("stopped: {}", describe_snapshot(channels.snapshot.read()));
+  store_writer.stop(); // every accepted change and run on disk (or logged as not saved)
+  const auto saved = store_writer.counters();
+  spdlog::info("stopped: {}; {} of {} changes saved", describe_snapshot(channels.snapshot.read()), saved.saved, saved.accepted);
   return 0;
 }
 

@@ -18,6 +18,7 @@ struct ServeOptions {
   std::string mode;           // overrides [startup] mode
   double setpoint_mm = -1.0;  // overrides [startup] setpoint_mm (< 0: not given)
   std::string record_dir;     // overrides [recorder] directory
+  std::string db_path;        // overrides [store] path
   double duration_s = 0.0;    // > 0: stop by itself after this long (tests, demos)
 };
 

@@ -1,24 +1,36 @@
 #pragma once
 // Every accepted change to the appliance (Modbus write, web command, command line) is handed to
-// an AuditSink: who changed which point from what to what, and when. The store (SQLite) keeps
-// them append-only; until it is configured, the log does.
+// an AuditSink as one group: who changed which points from what to what, and when. The store
+// (SQLite) keeps them append-only and applies the persisted ones; its counters tell clients
+// how many accepted changes are on disk.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace epa::core {
 
 struct AuditEntry {
   std::int64_t unix_time_ms = 0;
-  std::string source;  // "modbus 127.0.0.1:50312", "web", "cli"
+  std::string source;  // "modbus 127.0.0.1:50312", "web 127.0.0.1", "cli"
   std::string point;   // register map point name
   double old_value = 0.0;
   double new_value = 0.0;
 };
 
+// Accepted changes since start, and how many of them are durable (on disk). A client that
+// reads saved >= the accepted count it saw after its write knows its write survives a crash.
+struct ChangeCounters {
+  std::uint64_t accepted = 0;
+  std::uint64_t saved = 0;
+};
+
 class AuditSink {
  public:
   virtual ~AuditSink() = default;
-  virtual void record(const AuditEntry& entry) = 0;  // must not block for long: called from I/O threads
+  // One accepted change: the entries of one request, applied together. Called from I/O threads,
+  // so it must not block for long (the store queues it).
+  virtual void record(const std::vector<AuditEntry>& change) = 0;
+  virtual ChangeCounters counters() const { return {}; }  // a sink that keeps nothing saves nothing
 };
 
 }  // namespace epa::core

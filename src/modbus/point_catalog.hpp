@@ -14,7 +14,8 @@ namespace epa::modbus {
 
 // What the Modbus server itself knows, for the points that describe it.
 struct ServerStatus {
-  std::uint32_t change_counter = 0;  // accepted write requests
+  std::uint32_t change_counter = 0;  // accepted changes since start, every interface
+  std::uint32_t saved_counter = 0;   // how many of them are on disk
   std::uint64_t requests = 0;
   int clients = 0;
   bool locked = true;                // tuning registers refuse writes

@@ -37,7 +37,9 @@ RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, int u
       mm_per_volt_(mm_per_volt), channels_(channels), audit_(audit) {}
 
 ServerStatus RequestHandler::status(std::int64_t now_ns) const {
-  return {change_counter_, requests_, clients_, now_ns >= unlocked_until_ns_};
+  const core::ChangeCounters changes = audit_ ? audit_->counters() : core::ChangeCounters{};
+  return {static_cast<std::uint32_t>(changes.accepted), static_cast<std::uint32_t>(changes.saved), requests_, clients_,
+          now_ns >= unlocked_until_ns_};
 }
 
 std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, const std::string& client, std::int64_t now_ns,
@@ -208,18 +210,23 @@ std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, cons
     commands.push_back(runtime::tuning_command(*t));
   }
   if (!commands.empty() && !channels_.commands.try_push_all(commands.data(), commands.size())) return kBusy;
-  // 4. Accepted: the lock, the tuning base, the counter and the audit trail follow.
+  // 4. Accepted: the lock and the tuning base follow, and the change goes to the audit trail
+  // (and so to the store) as one group. Not audited: the key (never logged) and the heartbeat
+  // (a keep-alive every second, not a change anyone needs to trace).
   unlocked_until_ns_ = unlock_until;
   if (tuning_changed) tuning_base_ = tuning;
-  ++change_counter_;
   if (audit_) {
     const ServerStatus server = status(now_ns);
     const PointContext ctx{snap, server};
+    std::vector<core::AuditEntry> change;
+    const std::int64_t time_ms = unix_time_ms();
     for (const auto& w : writes) {
-      if (w.entry->point->write == WriteEffect::kUnlock) continue;  // never log the key
-      audit_->record({unix_time_ms(), "modbus " + client, std::string(w.entry->point->name),
-                      w.entry->point->read(ctx, w.entry->point->index), w.value});
+      const WriteEffect effect = w.entry->point->write;
+      if (effect == WriteEffect::kUnlock || effect == WriteEffect::kHeartbeat) continue;
+      change.push_back({time_ms, "modbus " + client, std::string(w.entry->point->name),
+                        w.entry->point->read(ctx, w.entry->point->index), w.value});
     }
+    if (!change.empty()) audit_->record(change);
   }
   return 0;
 }

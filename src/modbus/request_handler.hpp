@@ -65,7 +65,6 @@ class RequestHandler {
   runtime::LoopChannels& channels_;
   core::AuditSink* audit_;
   std::int64_t unlocked_until_ns_ = 0;
-  std::uint32_t change_counter_ = 0;
   std::uint64_t requests_ = 0;
   int clients_ = 0;
 };

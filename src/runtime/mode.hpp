@@ -25,6 +25,7 @@ enum class FaultCode : std::uint8_t {
   kFollowingError = 6,    // |setpoint - position| too large for too long in RUN
   kHeartbeatLost = 7,     // the supervising client stopped incrementing the heartbeat
   kControllerFault = 8,   // the control law reported a non-finite result
+  kStoreDamaged = 9,      // the tuning database was damaged: moved aside, started from defaults
 };
 
 std::string_view to_string(Mode mode);

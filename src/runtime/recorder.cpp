@@ -10,8 +10,8 @@
 
 namespace epa::runtime {
 
-Recorder::Recorder(RecorderConfig config, LoopChannels& channels, Log log)
-    : config_(std::move(config)), ch_(channels), log_(std::move(log)) {}
+Recorder::Recorder(RecorderConfig config, LoopChannels& channels, Log log, Written written)
+    : config_(std::move(config)), ch_(channels), log_(std::move(log)), written_(std::move(written)) {}
 
 Recorder::~Recorder() { stop(); }
 
@@ -87,6 +87,7 @@ void Recorder::write(const RecordRequest& request) {
   }
   ++files_written_;
   if (log_) log_("recorder: wrote " + path + " (" + std::to_string(run.size()) + " samples)");
+  if (written_) written_(path, run);
 }
 
 }  // namespace epa::runtime

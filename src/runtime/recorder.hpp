@@ -9,6 +9,7 @@
 #include <string>
 #include <thread>
 
+#include "core/run.hpp"
 #include "runtime/scan_cycle.hpp"
 
 namespace epa::runtime {
@@ -23,7 +24,8 @@ struct RecorderConfig {
 class Recorder {
  public:
   using Log = std::function<void(const std::string&)>;
-  Recorder(RecorderConfig config, LoopChannels& channels, Log log = {});
+  using Written = std::function<void(const std::string& path, const core::Run& run)>;  // e.g. into the run history
+  Recorder(RecorderConfig config, LoopChannels& channels, Log log = {}, Written written = {});
   ~Recorder();
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
@@ -44,6 +46,7 @@ class Recorder {
   RecorderConfig config_;
   LoopChannels& ch_;
   Log log_;
+  Written written_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
   std::atomic<std::uint64_t> files_written_{0};

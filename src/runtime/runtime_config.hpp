@@ -27,6 +27,7 @@ struct RuntimeConfig {
   control::ControllerKind controller = control::ControllerKind::kPpFfidz;
   Mode start_mode = Mode::kStop;
   double start_setpoint_mm = 0.0;
+  FaultCode start_fault = FaultCode::kNone;  // latched from the first cycle (e.g. a damaged store)
 
   double move_window_s = 5.0;       // online metrics: each move is measured over this window
   double record_buffer_s = 60.0;    // recorder ring: seconds of history kept in memory

@@ -23,7 +23,11 @@ ScanCycle::ScanCycle(const RuntimeConfig& config, const Tuning& tuning, hal::Daq
       manual_valve_v_(config.safe_valve_v),
       valve_v_(config.safe_valve_v),
       moves_(config.move_window_s, config.period_s) {
-  if (config.start_mode == Mode::kRun) {
+  if (config.start_fault != FaultCode::kNone) {
+    mode_ = Mode::kFault;  // before any start mode: a fault found before the start is latched
+    fault_ = config.start_fault;
+    faults_ = 1;
+  } else if (config.start_mode == Mode::kRun) {
     mode_ = Mode::kRun;
     init_state_on_next_read_ = true;  // the position is known only after the first read
   }

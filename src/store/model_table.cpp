@@ -49,6 +49,26 @@ core::Result<std::int64_t> ModelTable::insert(const ModelRecord& r) {
   return db_.last_insert_id();
 }
 
+core::Result<std::int64_t> ModelTable::find_or_insert(ModelRecord record) {
+  auto models = all();
+  if (!models) return models.error();
+  const auto& m = record.model;
+  for (const auto& other : *models) {
+    const auto& o = other.model;
+    if (o.A.coefficients() == m.A.coefficients() && o.B.coefficients() == m.B.coefficients() && o.Ts == m.Ts &&
+        o.mm_per_volt == m.mm_per_volt && o.dead_zone.m_r == m.dead_zone.m_r && o.dead_zone.m_l == m.dead_zone.m_l &&
+        o.dead_zone.b_r == m.dead_zone.b_r && o.dead_zone.b_l == m.dead_zone.b_l)
+      return other.id;
+  }
+  const std::string base = record.name;
+  for (int n = 2;; ++n) {
+    bool taken = false;
+    for (const auto& other : *models) taken = taken || other.name == record.name;
+    if (!taken) return insert(record);
+    record.name = base + " #" + std::to_string(n);
+  }
+}
+
 core::Result<ModelRecord> ModelTable::get(std::int64_t id) {
   auto stmt = db_.prepare(std::string("SELECT ") + kColumns + " FROM models WHERE id = ?");
   if (!stmt) return stmt.error();

@@ -98,6 +98,16 @@ core::Status seed_if_empty(Database& db, const StoreSeed& seed, std::int64_t now
   return core::ok();
 }
 
+core::Result<Database> open_existing_store(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return core::io_error("no database at " + path + " (epa serve creates it on its first start)");
+  auto db = Database::open(path, false);
+  if (!db) return db.error();
+  if (auto s = configure_connection(*db); !s) return s.error();
+  if (auto from = migrate(*db); !from) return from.error();
+  return db;
+}
+
 core::Result<OpenedStore> open_store(const std::string& path, const StoreSeed& seed, std::int64_t now_ms) {
   std::error_code ec;
   const bool existed = path != ":memory:" && fs::exists(path, ec) && fs::file_size(path, ec) > 0;

@@ -35,6 +35,10 @@ core::Result<OpenedStore> open_store(const std::string& path, const StoreSeed& s
 // Seeds an empty database (no tuning sets) in one transaction: the model, the set, active.
 core::Status seed_if_empty(Database& db, const StoreSeed& seed, std::int64_t now_ms, bool* seeded = nullptr);
 
+// An existing database for the command line (`epa tuning`): never created, migrated when older,
+// refused when newer or damaged.
+core::Result<Database> open_existing_store(const std::string& path);
+
 // "<path>.corrupt-20261121T101500Z"
 std::string moved_aside_name(const std::string& path, std::int64_t now_ms);
 

@@ -30,7 +30,7 @@ json poly(const std::array<double, control::kMaxLawOrder + 1>& c, std::size_t n)
 
 }  // namespace
 
-std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled) {
+std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled, const StoreStats& store) {
   const bool faulted = s.mode == runtime::Mode::kFault;
   json j = {
       {"cycle", s.cycle},
@@ -64,6 +64,10 @@ std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, b
       {"modbus",
        {{"enabled", modbus.enabled}, {"clients", modbus.clients}, {"requests", modbus.requests},
         {"exceptions", modbus.exceptions}}},
+      {"store",
+       {{"enabled", store.enabled}, {"ok", store.ok}, {"accepted", store.accepted}, {"saved", store.saved},
+        {"last_error", store.last_error.empty() ? json(nullptr) : json(store.last_error)},
+        {"tuning_set", store.enabled ? json(store.tuning_set) : json(nullptr)}}},
       {"commands_enabled", commands_enabled},
   };
   return j.dump();

@@ -18,7 +18,18 @@ struct ModbusStats {
   std::uint64_t requests = 0, exceptions = 0;
 };
 
-std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled);
+// What the tuning store reports (enabled = false when the appliance runs without one).
+struct StoreStats {
+  bool enabled = false;
+  bool ok = true;                // the last write succeeded
+  std::uint64_t accepted = 0;    // accepted changes since start
+  std::uint64_t saved = 0;       // ... of which on disk
+  std::string last_error;        // of the last failed write
+  std::string tuning_set;        // the running set's name
+};
+
+std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled,
+                        const StoreStats& store = {});
 std::string trend_json(const std::vector<TrendPoint>& points, const runtime::Snapshot& s);
 std::string moves_json(const std::vector<MoveRecord>& moves);
 std::string tuning_json(const runtime::Snapshot& s);

@@ -13,14 +13,15 @@ class RecentAudit final : public core::AuditSink {
  public:
   explicit RecentAudit(core::AuditSink* next = nullptr, std::size_t capacity = 100) : next_(next), capacity_(capacity) {}
 
-  void record(const core::AuditEntry& entry) override {
+  void record(const std::vector<core::AuditEntry>& change) override {
     {
       std::lock_guard lock(mutex_);
-      entries_.push_back(entry);
+      entries_.insert(entries_.end(), change.begin(), change.end());
       while (entries_.size() > capacity_) entries_.pop_front();
     }
-    if (next_) next_->record(entry);
+    if (next_) next_->record(change);
   }
+  core::ChangeCounters counters() const override { return next_ ? next_->counters() : core::ChangeCounters{}; }
 
   // Oldest first.
   std::vector<core::AuditEntry> entries() const {

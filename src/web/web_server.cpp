@@ -50,6 +50,7 @@ struct WebServer::Impl {
   runtime::RuntimeConfig limits;
   RecentAudit* audit;
   ModbusStatsFn modbus_stats;
+  StoreStatsFn store_stats;
   httplib::Server server;
   TrendBuffer trend;
   std::string chart_js;
@@ -62,10 +63,12 @@ struct WebServer::Impl {
   bool stopping = false;
   std::thread listener, sampler;
 
-  Impl(const WebConfig& c, runtime::LoopChannels& ch, const runtime::RuntimeConfig& l, RecentAudit* a, ModbusStatsFn m)
-      : config(c), channels(ch), limits(l), audit(a), modbus_stats(std::move(m)) {}
+  Impl(const WebConfig& c, runtime::LoopChannels& ch, const runtime::RuntimeConfig& l, RecentAudit* a, ModbusStatsFn m,
+       StoreStatsFn st)
+      : config(c), channels(ch), limits(l), audit(a), modbus_stats(std::move(m)), store_stats(std::move(st)) {}
 
   ModbusStats modbus() const { return modbus_stats ? modbus_stats() : ModbusStats{}; }
+  StoreStats store() const { return store_stats ? store_stats() : StoreStats{}; }
   bool commands_enabled() const { return !config.token.empty(); }
 
   void sample_until_stopped() {
@@ -102,8 +105,11 @@ struct WebServer::Impl {
     if (!channels.commands.try_push_all(d.commands.data(), d.commands.size()))
       return send_error(res, 503, "the command queue is full: try again");
     const std::string source = "web " + req.remote_addr;
-    if (audit)
-      for (const auto& c : d.changes) audit->record({unix_time_ms(), source, c.point, c.old_value, c.new_value});
+    if (audit) {
+      std::vector<core::AuditEntry> change;
+      for (const auto& c : d.changes) change.push_back({unix_time_ms(), source, c.point, c.old_value, c.new_value});
+      audit->record(change);
+    }
     res.set_content(R"({"accepted":true})", kJson);
   }
 
@@ -115,7 +121,7 @@ struct WebServer::Impl {
       return httplib::Server::HandlerResponse::Unhandled;
     });
     s.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
-      res.set_content(status_json(channels.snapshot.read(), modbus(), commands_enabled()), kJson);
+      res.set_content(status_json(channels.snapshot.read(), modbus(), commands_enabled(), store()), kJson);
     });
     s.Get("/api/trend", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(trend_json(trend.points(), channels.snapshot.read()), kJson);
@@ -170,9 +176,9 @@ struct WebServer::Impl {
 
 core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& config, runtime::LoopChannels& channels,
                                                           const runtime::RuntimeConfig& limits, RecentAudit* audit,
-                                                          ModbusStatsFn modbus_stats) {
+                                                          ModbusStatsFn modbus_stats, StoreStatsFn store_stats) {
   if (config.worker_threads < 1) return core::invalid_argument("web: worker_threads must be >= 1");
-  auto impl = std::make_unique<Impl>(config, channels, limits, audit, std::move(modbus_stats));
+  auto impl = std::make_unique<Impl>(config, channels, limits, audit, std::move(modbus_stats), std::move(store_stats));
   if (!std::filesystem::is_directory(config.static_dir))
     return core::io_error("web: static_dir '" + config.static_dir + "' is not a folder (it holds index.html, app.js, style.css)");
   {

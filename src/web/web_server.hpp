@@ -31,11 +31,12 @@ class RecentAudit;
 class WebServer {
  public:
   using ModbusStatsFn = std::function<ModbusStats()>;
+  using StoreStatsFn = std::function<StoreStats()>;
   // Binds, then serves on its own thread. channels, limits and audit must outlive the server.
   // `audit` may be null; when it is a RecentAudit, /api/audit shows its entries.
   static core::Result<std::unique_ptr<WebServer>> start(const WebConfig& config, runtime::LoopChannels& channels,
                                                         const runtime::RuntimeConfig& limits, RecentAudit* audit,
-                                                        ModbusStatsFn modbus_stats = {});
+                                                        ModbusStatsFn modbus_stats = {}, StoreStatsFn store_stats = {});
   ~WebServer();
   WebServer(const WebServer&) = delete;
   WebServer& operator=(const WebServer&) = delete;

@@ -114,7 +114,7 @@ TEST_F(EpaCli, ServeOnTheSimPlantMovesRecordsAndStopsCleanly) {
                                     << "[modbus]\nport = 0\nregister_map = \"" << EPA_SOURCE_DIR << "/registers/epa.csv\"\n"
                                     << "[web]\naddress = \"127.0.0.1\"\nport = 0\nstatic_dir = \"" << EPA_SOURCE_DIR << "/web\"\n";
   const auto o = run_epa("serve --config " + path("fast.toml") + " --mode run --setpoint 100 --duration 1.5 --record-dir " +
-                         path("runs"));
+                         path("runs") + " --db " + path("epa.db"));
   ASSERT_EQ(o.exit_code, 0) << o.output;
   EXPECT_NE(o.output.find("DAQ sim"), std::string::npos) << o.output;
   EXPECT_NE(o.output.find("move 1 0.0 -> 100.0 mm"), std::string::npos) << o.output;
@@ -125,7 +125,8 @@ TEST_F(EpaCli, ServeOnTheSimPlantMovesRecordsAndStopsCleanly) {
 }
 
 TEST_F(EpaCli, ServeRefusesAModbusIoModuleThatIsNotThere) {
-  const auto o = run_epa("serve --config " + std::string(EPA_SOURCE_DIR) + "/config/epa.toml --hal modbus-io --modbus-io-port 9");
+  const auto o = run_epa("serve --config " + std::string(EPA_SOURCE_DIR) + "/config/epa.toml --hal modbus-io --modbus-io-port 9 --db " +
+                         path("epa.db"));
   EXPECT_EQ(o.exit_code, 1);
   EXPECT_NE(o.output.find("127.0.0.1:9"), std::string::npos) << o.output;
 }

@@ -63,7 +63,7 @@ status_interval_s = 0
 [recorder]
 directory = "$tmp/runs"
 EOF2
-"$epa" serve --config "$tmp/epa.toml" --mode run --setpoint 50 >"$tmp/epa.log" 2>&1 &
+"$epa" serve --config "$tmp/epa.toml" --db "$tmp/epa.db" --mode run --setpoint 50 >"$tmp/epa.log" 2>&1 &
 pid=$!
 url="http://$host:$web_port/"
 echo "appliance pid $pid: web $url, modbus $host:$modbus_port"

@@ -45,7 +45,7 @@ TEST(HardwareInTheLoop, PlantServerAndServeCompleteAFiftyMillimetreMove) {
 
   testing::ChildProcess serve({epa, "serve", "--config", std::string(EPA_SOURCE_DIR) + "/config/epa.toml", "--hal",
                                "modbus-io", "--modbus-io-port", std::to_string(port), "--modbus-port", "0", "--web-port", "0", "--mode", "run", "--setpoint",
-                               "50", "--record-dir", (dir / "runs").string()},
+                               "50", "--record-dir", (dir / "runs").string(), "--db", (dir / "epa.db").string()},
                               (dir / "serve.log").string());
   ASSERT_GT(serve.pid(), 0);
 

@@ -57,7 +57,7 @@ status_interval_s = 0
 [recorder]
 directory = "$tmp/runs"
 EOF
-"$epa" serve --config "$tmp/epa.toml" --mode stop >"$tmp/epa.log" 2>&1 &
+"$epa" serve --config "$tmp/epa.toml" --db "$tmp/epa.db" --mode stop >"$tmp/epa.log" 2>&1 &
 pid=$!
 echo "appliance pid $pid on $host:$port (config $tmp/epa.toml)"
 

@@ -16,40 +16,16 @@ PID (terminate, kill after 5 s):
 Floats are decoded here with struct in an explicit word order, not with pymodbus' payload helpers.
 Exit 0 when every test passes, 1 otherwise (unittest prints "Ran N tests ... OK/FAILED").
 """
+import math
 import os
 import sys
-
-# CMake calls `python3`; on a machine where another python3 (pyenv, a venv) comes first in PATH,
-# Debian's python3-pymodbus lives only under /usr/bin/python3: run there instead.
-try:
-    import pymodbus  # noqa: F401
-except ImportError:
-    debian_python = "/usr/bin/python3"
-    if os.path.realpath(sys.executable) != os.path.realpath(debian_python) and os.path.exists(debian_python) \
-            and not os.environ.get("EPA_INTEROP_REEXEC"):
-        os.environ["EPA_INTEROP_REEXEC"] = "1"
-        os.execv(debian_python, [debian_python, os.path.abspath(__file__)] + sys.argv[1:])
-    sys.exit("FAIL: pymodbus is not importable by %s; install python3-pymodbus and python3-serial-asyncio "
-             "(scripts/install-deps.sh)" % sys.executable)
-
-import ctypes
-import math
-import shutil
-import signal
-import socket
-import struct
-import subprocess
-import tempfile
 import time
 import unittest
 
-import pymodbus
-from pymodbus.client import ModbusTcpClient
-from pymodbus.pdu import ExceptionResponse
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from epa_appliance import (UNIT, UNLOCK_KEY, Appliance, f32_value, f32_words, i16_value, pymodbus,  # noqa: E402
+                           u32_value, u32_words)
 
-HOST = "127.0.0.1"
-UNIT = 1
-UNLOCK_KEY = 4321
 VERSION = (0, 2, 0)  # src/modbus/point_catalog.hpp kVersionMajor/Minor/Patch
 MM_PER_VOLT = 50.0   # the paper's position sensor scale (config/paper-model.toml)
 HEARTBEAT_TIMEOUT_S = 5.0  # [limits] heartbeat_timeout_s of the epa.csv appliance: generous, so a test
@@ -61,129 +37,6 @@ EPA = None  # the binary and the source dir, from the command line
 SRC = None
 
 
-# ---- float32 encoding with an explicit word order ----
-def f32_words(value, order):
-    hi, lo = struct.unpack(">HH", struct.pack(">f", value))
-    return [hi, lo] if order == "ABCD" else [lo, hi]
-
-
-def f32_value(words, order):
-    hi, lo = (words[0], words[1]) if order == "ABCD" else (words[1], words[0])
-    return struct.unpack(">f", struct.pack(">HH", hi, lo))[0]
-
-
-def u32_words(value):
-    return [(value >> 16) & 0xFFFF, value & 0xFFFF]
-
-
-def u32_value(words):
-    return (words[0] << 16) | words[1]
-
-
-def i16_value(word):
-    return word - 0x10000 if word & 0x8000 else word
-
-
-# ---- the appliance as a child process ----
-def free_port():
-    with socket.socket() as s:
-        s.bind((HOST, 0))
-        return s.getsockname()[1]
-
-
-def _die_with_parent():
-    # If this test is killed (ctest timeout), the kernel sends the appliance SIGTERM.
-    try:
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
-    except Exception:
-        pass
-
-
-class Appliance:
-    """`epa serve` on a free loopback port with the given register map and extra config."""
-
-    def __init__(self, register_map, extra_config=""):
-        self.dir = tempfile.mkdtemp(prefix="epa-pymodbus.")
-        self.port = free_port()
-        self.config = os.path.join(self.dir, "epa.toml")
-        self.log_path = os.path.join(self.dir, "epa.log")
-        with open(self.config, "w") as f:
-            f.write("# written by tests/interop/pymodbus_test.py\n"
-                    "[modbus]\n"
-                    'address = "127.0.0.1"\n'
-                    f"port = {self.port}\n"
-                    f'register_map = "{register_map}"\n'
-                    f"unlock_key = {UNLOCK_KEY}\n"
-                    "[web]\n"
-                    "enabled = false\n"
-                    "[log]\n"
-                    "status_interval_s = 0\n"
-                    "[recorder]\n"
-                    f'directory = "{os.path.join(self.dir, "runs")}"\n' + extra_config)
-        self.log = open(self.log_path, "w")
-        self.proc = subprocess.Popen([EPA, "serve", "--config", self.config, "--mode", "stop"], stdout=self.log,
-                                     stderr=subprocess.STDOUT, preexec_fn=_die_with_parent)
-        self.client = None
-        try:
-            self._wait_ready(10.0)
-        except BaseException:
-            self.stop()
-            self.remove()
-            raise
-
-    def _wait_ready(self, timeout_s):
-        """Polls (bounded) until a TCP connect succeeds and a Modbus read answers."""
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
-            if self.proc.poll() is not None:
-                raise RuntimeError(f"epa serve exited with status {self.proc.returncode} during start-up:\n{self.log_text()}")
-            try:
-                with socket.create_connection((HOST, self.port), timeout=0.2):
-                    pass
-                break
-            except OSError:
-                time.sleep(0.05)
-        else:
-            raise RuntimeError(f"epa serve did not accept connections on {HOST}:{self.port} within {timeout_s} s:\n"
-                               f"{self.log_text()}")
-        self.client = ModbusTcpClient(HOST, port=self.port, timeout=2, retries=1)
-        if not self.client.connect():
-            raise RuntimeError(f"pymodbus could not connect to {HOST}:{self.port}")
-        while time.monotonic() < deadline:
-            # Any Modbus answer will do (a map may have nothing at input 0: exception 02 is an answer).
-            rr = self.client.read_input_registers(0, 1, slave=UNIT)
-            if not rr.isError() or isinstance(rr, ExceptionResponse):
-                return
-            time.sleep(0.05)
-        raise RuntimeError(f"epa serve did not answer Modbus reads within {timeout_s} s:\n{self.log_text()}")
-
-    def stop(self):
-        """Stops by PID: SIGTERM, SIGKILL after 5 s. Returns the exit status."""
-        if self.client is not None:
-            self.client.close()
-            self.client = None
-        status = self.proc.poll()
-        if status is None:
-            self.proc.terminate()
-            try:
-                status = self.proc.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                print(f"epa serve (pid {self.proc.pid}) ignored SIGTERM for 5 s: SIGKILL", file=sys.stderr)
-                self.proc.kill()
-                status = self.proc.wait(timeout=5)
-        self.log.close()
-        return status
-
-    def log_text(self):
-        if not self.log.closed:
-            self.log.flush()
-        with open(self.log_path) as f:
-            return f.read()
-
-    def remove(self):
-        shutil.rmtree(self.dir, ignore_errors=True)
-
-
 # ---- common test machinery ----
 class ApplianceTest(unittest.TestCase):
     REGISTER_MAP = None  # relative to the source dir
@@ -192,7 +45,7 @@ class ApplianceTest(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        cls.app = Appliance(os.path.join(SRC, cls.REGISTER_MAP), cls.EXTRA_CONFIG)
+        cls.app = Appliance(EPA, os.path.join(SRC, cls.REGISTER_MAP), cls.EXTRA_CONFIG)
         cls.c = cls.app.client
         cls.failed = False
 

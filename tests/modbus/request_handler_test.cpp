@@ -19,9 +19,15 @@ Bytes adu(const Bytes& pdu, std::uint8_t unit = 1) {
   return a;
 }
 
+// Records every change, and says it saved the first `saved_limit` of them.
 struct RecordingSink final : core::AuditSink {
   std::vector<core::AuditEntry> entries;
-  void record(const core::AuditEntry& e) override { entries.push_back(e); }
+  std::uint64_t changes = 0, saved_limit = 1000;
+  void record(const std::vector<core::AuditEntry>& change) override {
+    entries.insert(entries.end(), change.begin(), change.end());
+    ++changes;
+  }
+  core::ChangeCounters counters() const override { return {changes, std::min(changes, saved_limit)}; }
 };
 
 class Handler : public ::testing::Test {
@@ -100,6 +106,20 @@ TEST_F(Handler, SetpointWriteQueuesOneCommandAndIsAudited) {
   EXPECT_EQ(sink_.entries[0].old_value, 100.0);
   EXPECT_EQ(sink_.entries[0].new_value, 50.0);
   EXPECT_EQ(sink_.entries[0].source, "modbus 127.0.0.1");
+}
+
+TEST_F(Handler, TheCountersSayHowManyChangesAreAcceptedAndHowManyAreOnDisk) {
+  sink_.saved_limit = 1;  // the store has written the first change only
+  EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x42, 0x48, 0x00, 0x00}), 0);  // setpoint 50.0f
+  EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x42, 0x70, 0x00, 0x00}), 0);  // setpoint 60.0f
+  EXPECT_EQ(send({0x10, 0x00, 0x06, 0x00, 0x02, 0x04, 0x00, 0x00, 0x00, 0x07}), 0);  // heartbeat 7: not a change
+  EXPECT_EQ(sink_.changes, 2u);
+  EXPECT_EQ(send({0x04, 0x00, 0x7A, 0x00, 0x02}), 0);  // input registers 122..123
+  EXPECT_EQ(send({0x04, 0x00, 0x80, 0x00, 0x02}), 0);  // input registers 128..129
+  EXPECT_EQ(image_->tab_input_registers[122], 0);
+  EXPECT_EQ(image_->tab_input_registers[123], 2);  // change_counter
+  EXPECT_EQ(image_->tab_input_registers[128], 0);
+  EXPECT_EQ(image_->tab_input_registers[129], 1);  // saved_counter
 }
 
 TEST_F(Handler, HalfAFloatIsRefusedAndNothingIsQueued) {

@@ -29,8 +29,13 @@ using epa::runtime::CommandKind;
 
 class Collecting : public epa::core::AuditSink {
  public:
-  void record(const epa::core::AuditEntry& e) override { entries.push_back(e); }
+  void record(const std::vector<epa::core::AuditEntry>& change) override {
+    entries.insert(entries.end(), change.begin(), change.end());
+    ++changes;
+  }
+  epa::core::ChangeCounters counters() const override { return {changes, changes}; }
   std::vector<epa::core::AuditEntry> entries;
+  std::uint64_t changes = 0;
 };
 
 class WebServerTest : public ::testing::Test {
@@ -165,7 +170,7 @@ TEST_F(WebServerTest, TrendMovesTuningAndAuditHaveTheirShapes) {
   EXPECT_DOUBLE_EQ(u["lc_mm"].get<double>(), 5.0);
   EXPECT_DOUBLE_EQ(u["Ts"].get<double>(), 0.005);
 
-  audit_.record({1000, "modbus 127.0.0.1:5000", "setpoint_mm", 0.0, 50.0});
+  audit_.record({{1000, "modbus 127.0.0.1:5000", "setpoint_mm", 0.0, 50.0}});
   const json a = get_json("/api/audit");
   ASSERT_EQ(a["entries"].size(), 1u);
   EXPECT_EQ(a["entries"][0]["source"], "modbus 127.0.0.1:5000");

@@ -1,0 +1,68 @@
+#include "app/store_setup.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+
+#include "store/active_tuning.hpp"
+#include "store/retained_points.hpp"
+#include "store/schema.hpp"
+
+namespace epa::app {
+
+namespace {
+std::int64_t unix_time_ms() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
+store::StoreSeed make_seed(const std::string& name, const core::ModelFile& model, const ControllerPolynomials& polynomials,
+                           control::ControllerKind controller, double lc_mm, double valve_limit_v) {
+  store::StoreSeed seed;
+  seed.model.name = name;
+  seed.model.source = model.source.empty() ? "the configuration's model" : model.source;
+  seed.model.model = model.model;
+  seed.tuning.name = name;
+  seed.tuning.source = "seeded from the configuration: " + polynomials.source;
+  seed.tuning.controller = controller;
+  seed.tuning.F = polynomials.F;
+  seed.tuning.G = polynomials.G;
+  seed.tuning.H = polynomials.H;
+  seed.tuning.dead_zone = model.model.dead_zone;
+  seed.tuning.lc_mm = lc_mm;
+  seed.tuning.valve_limit_v = valve_limit_v;
+  return seed;
+}
+
+core::Result<StoreStartup> open_tuning_store(const std::string& path, const store::StoreSeed& seed,
+                                             std::set<std::string> persisted_points) {
+  auto opened = store::open_store(path, seed, unix_time_ms());
+  if (!opened) return core::Error{opened.error().code, "store: " + opened.error().message};
+  StoreStartup out;
+  if (!opened->moved_aside.empty()) {
+    out.start_fault = runtime::FaultCode::kStoreDamaged;
+    out.warnings.push_back("store: " + path + " was damaged (" + opened->damage + "): moved aside to " + opened->moved_aside +
+                           "; a new one was seeded from the configuration; starting in FAULT until reset");
+  } else if (opened->created) {
+    out.notes.push_back("store: created " + path + " and seeded it from the configuration");
+  } else if (opened->migrated_from != store::kSchemaVersion) {
+    out.notes.push_back("store: migrated " + path + " from schema version " + std::to_string(opened->migrated_from) +
+                           " to " + std::to_string(store::kSchemaVersion));
+  }
+  auto loaded = store::load_active_tuning(opened->db);
+  if (!loaded) return core::Error{loaded.error().code, "store: " + loaded.error().message};
+  for (const auto& refusal : loaded->refused) out.warnings.push_back("store: refused " + refusal + "; using the next good set");
+  auto retained = store::RetainedPoints(opened->db).all();
+  if (!retained) return core::Error{retained.error().code, "store: " + retained.error().message};
+  if (auto it = retained->find("setpoint_mm"); it != retained->end()) out.retained_setpoint_mm = it->second;
+
+  out.set = loaded->set;
+  out.model = loaded->model;
+  out.notes.push_back("store: tuning set '" + out.set.name + "' (id " + std::to_string(out.set.id) + ", model '" +
+                         out.model.name + "') from " + path);
+  out.writer = std::make_unique<store::StoreWriter>(std::move(opened->db), out.set, std::move(persisted_points),
+                                                    [](const std::string& line) { spdlog::warn("{}", line); });
+  return out;
+}
+
+}  // namespace epa::app

@@ -1,0 +1,42 @@
+#pragma once
+// What `epa serve` takes from the tuning store at start: the database opened whatever state it
+// was in (created and seeded from the configuration's model and design on first start; moved
+// aside and replaced when damaged; refused when newer), the active tuning set loaded and
+// validated (a refused set falls back to the last good one), the retained setpoint, and the
+// store thread that keeps every accepted change from then on.
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "app/tuning_source.hpp"
+#include "core/model_file.hpp"
+#include "runtime/mode.hpp"
+#include "store/model_record.hpp"
+#include "store/store_file.hpp"
+#include "store/store_writer.hpp"
+#include "store/tuning_set.hpp"
+
+namespace epa::app {
+
+struct StoreStartup {
+  std::unique_ptr<store::StoreWriter> writer;
+  store::TuningSet set;
+  store::ModelRecord model;
+  std::optional<double> retained_setpoint_mm;
+  runtime::FaultCode start_fault = runtime::FaultCode::kNone;  // kStoreDamaged when moved aside
+  std::vector<std::string> notes;     // for the log: what happened at start
+  std::vector<std::string> warnings;  // ... and what an operator must look at
+};
+
+// The seed of a new database: the configuration's model and controller polynomials, named
+// `name` ("paper" when they are the paper's).
+store::StoreSeed make_seed(const std::string& name, const core::ModelFile& model, const ControllerPolynomials& polynomials,
+                           control::ControllerKind controller, double lc_mm, double valve_limit_v);
+
+// Errors: a database from a newer epa, a file that cannot be created, no valid tuning set.
+core::Result<StoreStartup> open_tuning_store(const std::string& path, const store::StoreSeed& seed,
+                                             std::set<std::string> persisted_points);
+
+}  // namespace epa::app

@@ -1,0 +1,287 @@
+#include "app/tuning_command.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "app/output_file.hpp"
+#include "core/format.hpp"
+#include "store/audit_log.hpp"
+#include "store/model_table.hpp"
+#include "store/run_table.hpp"
+#include "store/store_file.hpp"
+#include "store/transaction.hpp"
+#include "store/tuning_file.hpp"
+#include "store/tuning_set_table.hpp"
+
+namespace epa::app {
+
+void add_tuning_command(CLI::App& app, TuningOptions& o) {
+  auto* cmd = app.add_subcommand("tuning", "The tuning store: list, show, diff, activate, export, import, audit, runs");
+  cmd->require_subcommand(1);
+  cmd->add_option("--db", o.db_path, "The store's database file (epa serve's [store] path)")->capture_default_str();
+  cmd->add_subcommand("list", "Tuning sets, the active one marked with *");
+  cmd->add_subcommand("show", "One tuning set with its model")->add_option("set", o.set, "Id or name")->required();
+  auto* diff = cmd->add_subcommand("diff", "What differs between two tuning sets");
+  diff->add_option("a", o.set, "Id or name")->required();
+  diff->add_option("b", o.other, "Id or name")->required();
+  cmd->add_subcommand("activate", "Make a set the active one (used from the appliance's next start)")
+      ->add_option("set", o.set, "Id or name")->required();
+  auto* exp = cmd->add_subcommand("export", "Write a set and its model as an epa-tuning/1 TOML file");
+  exp->add_option("set", o.set, "Id or name")->required();
+  exp->add_option("--out", o.file, "File to write ('-': standard output)")->required();
+  auto* imp = cmd->add_subcommand("import", "Read an epa-tuning/1 TOML file into the store as a new set");
+  imp->add_option("file", o.file, "epa-tuning/1 file")->required()->check(CLI::ExistingFile);
+  imp->add_option("--name", o.name, "Name of the new set (default: the file's)");
+  imp->add_flag("--activate", o.activate, "Make it the active set");
+  auto* audit = cmd->add_subcommand("audit", "The audit log, newest first");
+  audit->add_option("--since", o.since, "From this time on: 2026-11-21, 2026-11-21T10:00:00Z or unix ms");
+  audit->add_option("--until", o.until, "Up to this time (same forms)");
+  audit->add_option("--source", o.source, "Only sources containing this text (modbus, web, cli, an address)");
+  audit->add_option("--point", o.point, "Only this point (setpoint_mm, m_r, ...)");
+  audit->add_option("--limit", o.limit, "At most this many entries (0: all)")->capture_default_str();
+  audit->add_flag("--json", o.json, "JSON lines instead of a table");
+  cmd->add_subcommand("runs", "The run history, newest first")->add_option("--limit", o.limit, "At most this many")->capture_default_str();
+}
+
+namespace {
+
+std::int64_t now_ms() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+std::string iso_time(std::int64_t ms) {
+  const std::time_t t = static_cast<std::time_t>(ms / 1000);
+  std::tm utc{};
+  gmtime_r(&t, &utc);
+  char buf[40];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &utc);
+  char out[48];
+  std::snprintf(out, sizeof out, "%s.%03dZ", buf, static_cast<int>(ms % 1000));
+  return out;
+}
+
+// "2026-11-21", "2026-11-21T10:00:00Z" (UTC) or unix milliseconds.
+core::Result<std::int64_t> parse_time(const std::string& text, const char* option) {
+  if (!text.empty() && text.find_first_not_of("0123456789") == std::string::npos) return std::stoll(text);
+  std::tm tm{};
+  const char* end = strptime(text.c_str(), "%Y-%m-%dT%H:%M:%S", &tm);
+  if (!end) {
+    tm = {};
+    end = strptime(text.c_str(), "%Y-%m-%d", &tm);
+  }
+  if (!end || !(*end == '\0' || (end[0] == 'Z' && end[1] == '\0')))
+    return core::invalid_argument(std::string(option) + " '" + text + "' is not a time: use 2026-11-21, 2026-11-21T10:00:00Z or unix ms");
+  return static_cast<std::int64_t>(timegm(&tm)) * 1000;
+}
+
+std::string poly_text(const core::Polynomial& p) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < p.size(); ++i) s += (i ? ", " : "") + core::format_number(p[i]);
+  return s + "]";
+}
+
+// Field name and value, in the order `show` prints and `diff` compares them.
+std::vector<std::pair<std::string, std::string>> fields(const store::TuningSet& t, const store::ModelRecord& m) {
+  return {{"name", t.name},
+          {"source", t.source},
+          {"created", iso_time(t.created_ms)},
+          {"modified", iso_time(t.modified_ms)},
+          {"controller", std::string(control::to_string(t.controller))},
+          {"F", poly_text(t.F)},
+          {"G", poly_text(t.G)},
+          {"H", poly_text(t.H)},
+          {"dead_zone m_r", core::format_number(t.dead_zone.m_r)},
+          {"dead_zone m_l", core::format_number(t.dead_zone.m_l)},
+          {"dead_zone b_r V", core::format_number(t.dead_zone.b_r)},
+          {"dead_zone b_l V", core::format_number(t.dead_zone.b_l)},
+          {"lc_mm", core::format_number(t.lc_mm)},
+          {"valve_limit_v", core::format_number(t.valve_limit_v)},
+          {"design", t.design_json},
+          {"model", m.name + " (id " + std::to_string(m.id) + ")"},
+          {"model source", m.source},
+          {"model A", poly_text(m.model.A)},
+          {"model B", poly_text(m.model.B)},
+          {"model Ts s", core::format_number(m.model.Ts)},
+          {"model mm_per_volt", core::format_number(m.model.mm_per_volt)},
+          {"model fit", m.fit_json}};
+}
+
+struct SetWithModel {
+  store::TuningSet set;
+  store::ModelRecord model;
+};
+
+core::Result<SetWithModel> find_set(store::Database& db, const std::string& key) {
+  auto set = store::TuningSetTable(db).find(key);
+  if (!set) return set.error();
+  auto model = store::ModelTable(db).get(set->model_id);
+  if (!model) return model.error();
+  return SetWithModel{std::move(*set), std::move(*model)};
+}
+
+std::string number_or_dash(const std::optional<double>& v) { return v ? core::format_number(*v) : "-"; }
+
+int list(store::Database& db, std::ostream& out) {
+  auto sets = store::TuningSetTable(db).all();
+  if (!sets) throw std::runtime_error(sets.error().message);
+  auto active = store::TuningSetTable(db).active_id();
+  if (!active) throw std::runtime_error(active.error().message);
+  out << "   id  name                  controller  modified                   source\n";
+  for (const auto& t : *sets) {
+    char line[512];
+    std::snprintf(line, sizeof line, "%s %3lld  %-20s  %-10s  %-25s  %s\n", *active && **active == t.id ? "*" : " ",
+                  static_cast<long long>(t.id), t.name.c_str(), std::string(control::to_string(t.controller)).c_str(),
+                  iso_time(t.modified_ms).c_str(), t.source.c_str());
+    out << line;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::ostream& err) {
+  auto fail = [&err](const std::string& message) { return err << "epa tuning: " << message << "\n", 1; };
+  auto* cmd = app.get_subcommand("tuning");
+  auto db = store::open_existing_store(o.db_path);
+  if (!db) return fail(db.error().message);
+  try {
+    if (cmd->got_subcommand("list")) return list(*db, out);
+
+    if (cmd->got_subcommand("show")) {
+      auto s = find_set(*db, o.set);
+      if (!s) return fail(s.error().message);
+      auto active = store::TuningSetTable(*db).active_id();
+      out << "tuning set " << s->set.id << (active && *active && **active == s->set.id ? " (active)" : "") << "\n";
+      for (const auto& [k, v] : fields(s->set, s->model)) out << "  " << k << ": " << v << "\n";
+      return 0;
+    }
+
+    if (cmd->got_subcommand("diff")) {
+      auto a = find_set(*db, o.set);
+      if (!a) return fail(a.error().message);
+      auto b = find_set(*db, o.other);
+      if (!b) return fail(b.error().message);
+      const auto fa = fields(a->set, a->model), fb = fields(b->set, b->model);
+      int differences = 0;
+      for (std::size_t i = 0; i < fa.size(); ++i) {
+        if (fa[i].first == "created" || fa[i].first == "modified" || fa[i].second == fb[i].second) continue;
+        out << fa[i].first << ":\n  " << a->set.name << ": " << fa[i].second << "\n  " << b->set.name << ": " << fb[i].second << "\n";
+        ++differences;
+      }
+      if (differences == 0) out << "'" << a->set.name << "' and '" << b->set.name << "' have the same values\n";
+      return 0;
+    }
+
+    if (cmd->got_subcommand("activate")) {
+      auto s = find_set(*db, o.set);
+      if (!s) return fail(s.error().message);
+      store::TuningSetTable sets(*db);
+      auto before = sets.active_id();
+      if (!before) return fail(before.error().message);
+      auto tx = store::Transaction::begin(*db);
+      if (!tx) return fail(tx.error().message);
+      if (auto st = sets.activate(s->set.id); !st) return fail(st.error().message);
+      const double old_id = *before ? static_cast<double>(**before) : std::nan("");
+      if (auto st = store::AuditLog(*db).append({now_ms(), "cli", "active_tuning_set", old_id, static_cast<double>(s->set.id)}); !st)
+        return fail(st.error().message);
+      if (auto st = tx->commit(); !st) return fail(st.error().message);
+      out << "tuning set '" << s->set.name << "' (id " << s->set.id << ") is active: a running appliance uses it from its next start\n";
+      return 0;
+    }
+
+    if (cmd->got_subcommand("export")) {
+      auto s = find_set(*db, o.set);
+      if (!s) return fail(s.error().message);
+      if (auto st = write_output(o.file, store::format_tuning_toml(s->set, s->model), out); !st) return fail(st.error().message);
+      if (o.file != "-") out << "tuning set '" << s->set.name << "' written to " << o.file << "\n";
+      return 0;
+    }
+
+    if (cmd->got_subcommand("import")) {
+      std::ifstream in(o.file);
+      std::stringstream text;
+      text << in.rdbuf();
+      auto file = store::parse_tuning_toml(text.str(), o.file);
+      if (!file) return fail(file.error().message);
+      if (!o.name.empty()) file->set.name = o.name;
+      auto tx = store::Transaction::begin(*db);
+      if (!tx) return fail(tx.error().message);
+      file->model.created_ms = now_ms();
+      auto model_id = store::ModelTable(*db).find_or_insert(file->model);
+      if (!model_id) return fail(model_id.error().message);
+      file->set.model_id = *model_id;
+      file->set.created_ms = file->set.modified_ms = now_ms();
+      file->set.source = "imported from " + o.file + (file->set.source.empty() ? "" : " (" + file->set.source + ")");
+      store::TuningSetTable sets(*db);
+      auto id = sets.insert(file->set);
+      if (!id) return fail(id.error().message + (o.name.empty() ? " (give another with --name)" : ""));
+      if (auto st = store::AuditLog(*db).append({now_ms(), "cli", "import_tuning_set", std::nan(""), static_cast<double>(*id)}); !st)
+        return fail(st.error().message);
+      if (o.activate) {
+        auto before = sets.active_id();
+        if (!before) return fail(before.error().message);
+        if (auto st = sets.activate(*id); !st) return fail(st.error().message);
+        const double old_id = *before ? static_cast<double>(**before) : std::nan("");
+        if (auto st = store::AuditLog(*db).append({now_ms(), "cli", "active_tuning_set", old_id, static_cast<double>(*id)}); !st)
+          return fail(st.error().message);
+      }
+      if (auto st = tx->commit(); !st) return fail(st.error().message);
+      out << "imported tuning set '" << file->set.name << "' (id " << *id << ")" << (o.activate ? ", active from the appliance's next start" : "") << "\n";
+      return 0;
+    }
+
+    if (cmd->got_subcommand("audit")) {
+      store::AuditFilter f;
+      if (!o.since.empty()) {
+        auto t = parse_time(o.since, "--since");
+        if (!t) return fail(t.error().message);
+        f.since_ms = *t;
+      }
+      if (!o.until.empty()) {
+        auto t = parse_time(o.until, "--until");
+        if (!t) return fail(t.error().message);
+        f.until_ms = *t;
+      }
+      f.source = o.source;
+      f.point = o.point;
+      f.limit = o.limit;
+      auto rows = store::AuditLog(*db).query(f);
+      if (!rows) return fail(rows.error().message);
+      for (const auto& r : *rows) {
+        const auto& e = r.entry;
+        if (o.json) {
+          auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+          out << nlohmann::json{{"id", r.id}, {"time", iso_time(e.unix_time_ms)}, {"unix_time_ms", e.unix_time_ms},
+                                {"source", e.source}, {"point", e.point}, {"old", num(e.old_value)}, {"new", num(e.new_value)}}
+                     .dump()
+              << "\n";
+        } else {
+          out << iso_time(e.unix_time_ms) << "  " << e.source << "  " << e.point << "  " << core::format_number(e.old_value)
+              << " -> " << core::format_number(e.new_value) << "\n";
+        }
+      }
+      if (!o.json && rows->empty()) out << "no audit entries match\n";
+      return 0;
+    }
+
+    if (cmd->got_subcommand("runs")) {
+      auto runs = store::RunTable(*db).recent(o.limit);
+      if (!runs) return fail(runs.error().message);
+      for (const auto& r : *runs)
+        out << iso_time(r.recorded_ms) << "  " << r.controller << "  " << number_or_dash(r.from_mm) << " -> "
+            << number_or_dash(r.to_mm) << " mm  rise " << number_or_dash(r.rise_s) << " s  settling "
+            << number_or_dash(r.settling_s) << " s  e_ss " << number_or_dash(r.ess_mm) << " mm  " << r.path << "\n";
+      if (runs->empty()) out << "no runs recorded\n";
+      return 0;
+    }
+  } catch (const std::exception& e) {
+    return fail(e.what());
+  }
+  return fail("unknown subcommand");
+}
+
+}  // namespace epa::app

@@ -1,0 +1,184 @@
+"""Shared by the Python tests that run the appliance as a process: Debian's pymodbus (re-executing
+under /usr/bin/python3 when another python3 comes first in PATH), float/uint32 encoding with an
+explicit word order, a free loopback port, and `epa serve` as a child process that is stopped by
+its PID (SIGTERM, SIGKILL after 5 s) or killed outright, and can be started again on the same
+folder, port and database.
+"""
+import os
+import sys
+
+# CMake calls `python3`; on a machine where another python3 (pyenv, a venv) comes first in PATH,
+# Debian's python3-pymodbus lives only under /usr/bin/python3: run there instead.
+try:
+    import pymodbus  # noqa: F401
+except ImportError:
+    debian_python = "/usr/bin/python3"
+    if os.path.realpath(sys.executable) != os.path.realpath(debian_python) and os.path.exists(debian_python) \
+            and not os.environ.get("EPA_INTEROP_REEXEC"):
+        os.environ["EPA_INTEROP_REEXEC"] = "1"
+        os.execv(debian_python, [debian_python, os.path.abspath(sys.argv[0])] + sys.argv[1:])  # the test script
+    sys.exit("FAIL: pymodbus is not importable by %s; install python3-pymodbus and python3-serial-asyncio "
+             "(scripts/install-deps.sh)" % sys.executable)
+
+import ctypes
+import shutil
+import signal
+import socket
+import struct
+import subprocess
+import tempfile
+import time
+
+from pymodbus.client import ModbusTcpClient
+from pymodbus.pdu import ExceptionResponse
+
+HOST = "127.0.0.1"
+UNIT = 1
+UNLOCK_KEY = 4321
+
+
+# ---- float32 encoding with an explicit word order ----
+def f32_words(value, order):
+    hi, lo = struct.unpack(">HH", struct.pack(">f", value))
+    return [hi, lo] if order == "ABCD" else [lo, hi]
+
+
+def f32_value(words, order):
+    hi, lo = (words[0], words[1]) if order == "ABCD" else (words[1], words[0])
+    return struct.unpack(">f", struct.pack(">HH", hi, lo))[0]
+
+
+def u32_words(value):
+    return [(value >> 16) & 0xFFFF, value & 0xFFFF]
+
+
+def u32_value(words):
+    return (words[0] << 16) | words[1]
+
+
+def i16_value(word):
+    return word - 0x10000 if word & 0x8000 else word
+
+
+# ---- the appliance as a child process ----
+def free_port():
+    with socket.socket() as s:
+        s.bind((HOST, 0))
+        return s.getsockname()[1]
+
+
+def _die_with_parent():
+    # If this test is killed (ctest timeout), the kernel sends the appliance SIGTERM.
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+    except Exception:
+        pass
+
+
+class Appliance:
+    """`epa serve` on a free loopback port with the given register map and extra config, its data
+    (database, runs, log) in a fresh temporary folder."""
+
+    def __init__(self, epa, register_map, extra_config="", start=True):
+        self.epa = epa
+        self.dir = tempfile.mkdtemp(prefix="epa-test.")
+        self.port = free_port()
+        self.config = os.path.join(self.dir, "epa.toml")
+        self.db = os.path.join(self.dir, "epa.db")
+        self.log_path = os.path.join(self.dir, "epa.log")
+        self.proc = None
+        self.log = None
+        self.client = None
+        with open(self.config, "w") as f:
+            f.write("# written by tests/support/epa_appliance.py\n"
+                    "[modbus]\n"
+                    'address = "127.0.0.1"\n'
+                    f"port = {self.port}\n"
+                    f'register_map = "{register_map}"\n'
+                    f"unlock_key = {UNLOCK_KEY}\n"
+                    "[web]\n"
+                    "enabled = false\n"
+                    "[log]\n"
+                    "status_interval_s = 0\n"
+                    "[recorder]\n"
+                    f'directory = "{os.path.join(self.dir, "runs")}"\n'
+                    "[store]\n"
+                    f'path = "{self.db}"\n' + extra_config)
+        if start:
+            self.start()
+
+    def start(self):
+        """Starts `epa serve` (again) and waits until it answers Modbus reads."""
+        self.log = open(self.log_path, "a")
+        self.proc = subprocess.Popen([self.epa, "serve", "--config", self.config, "--mode", "stop"], stdout=self.log,
+                                     stderr=subprocess.STDOUT, preexec_fn=_die_with_parent)
+        self.client = None
+        try:
+            self._wait_ready(10.0)
+        except BaseException:
+            self.stop()
+            self.remove()
+            raise
+
+    def _wait_ready(self, timeout_s):
+        """Polls (bounded) until a TCP connect succeeds and a Modbus read answers."""
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                raise RuntimeError(f"epa serve exited with status {self.proc.returncode} during start-up:\n{self.log_text()}")
+            try:
+                with socket.create_connection((HOST, self.port), timeout=0.2):
+                    pass
+                break
+            except OSError:
+                time.sleep(0.05)
+        else:
+            raise RuntimeError(f"epa serve did not accept connections on {HOST}:{self.port} within {timeout_s} s:\n"
+                               f"{self.log_text()}")
+        self.client = ModbusTcpClient(HOST, port=self.port, timeout=2, retries=1)
+        if not self.client.connect():
+            raise RuntimeError(f"pymodbus could not connect to {HOST}:{self.port}")
+        while time.monotonic() < deadline:
+            # Any Modbus answer will do (a map may have nothing at input 0: exception 02 is an answer).
+            rr = self.client.read_input_registers(0, 1, slave=UNIT)
+            if not rr.isError() or isinstance(rr, ExceptionResponse):
+                return
+            time.sleep(0.05)
+        raise RuntimeError(f"epa serve did not answer Modbus reads within {timeout_s} s:\n{self.log_text()}")
+
+    def stop(self):
+        """Stops by PID: SIGTERM, SIGKILL after 5 s. Returns the exit status."""
+        if self.client is not None:
+            self.client.close()
+            self.client = None
+        status = self.proc.poll()
+        if status is None:
+            self.proc.terminate()
+            try:
+                status = self.proc.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                print(f"epa serve (pid {self.proc.pid}) ignored SIGTERM for 5 s: SIGKILL", file=sys.stderr)
+                self.proc.kill()
+                status = self.proc.wait(timeout=5)
+        self.log.close()
+        return status
+
+    def kill(self):
+        """SIGKILL: no shutdown code runs, as in a crash or a power cut of the process."""
+        if self.client is not None:
+            self.client.close()
+            self.client = None
+        self.proc.kill()
+        self.proc.wait(timeout=5)
+        self.log.close()
+
+    def log_text(self):
+        if not self.log.closed:
+            self.log.flush()
+        with open(self.log_path) as f:
+            return f.read()
+
+    def remove(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+
