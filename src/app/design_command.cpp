@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "app/output_file.hpp"
+#include "app/store_save.hpp"
 #include "app/tuning_source.hpp"
 #include "control/diophantine.hpp"
 #include "control/pole_placement_design.hpp"
@@ -25,6 +27,8 @@ void add_design_command(CLI::App& app, DesignOptions& o) {
   cmd->add_option("--observer-pole", o.observer_pole, "Spec design: z-location of the other poles")->capture_default_str();
   cmd->add_option("--input-decimals", o.input_decimals, "Decimals the A, B, T coefficients were printed with")->capture_default_str();
   cmd->add_option("--json", o.json_path, "Write the design as epa-design/1 JSON");
+  cmd->add_option("--save", o.save_name, "Save the design as a tuning set of this name into the tuning store (not activated)");
+  cmd->add_option("--db", o.db_path, "The tuning store for --save")->capture_default_str();
 }
 
 namespace {
@@ -183,6 +187,27 @@ int run_design(const DesignOptions& o, std::ostream& out, std::ostream& err) {
                                   {"jury_stable", b.jury.verdict == control::Stability::kStable}});
     if (auto s = write_output(o.json_path, j.dump(1) + "\n", out); !s) return err << "epa design: " << s.error().message << "\n", 1;
     out << "\ndesign written to " << o.json_path << "\n";
+  }
+  if (!o.save_name.empty()) {
+    store::ModelRecord model{.id = 0, .name = paper_model ? "paper" : std::filesystem::path(o.model_path).stem().string(),
+                             .created_ms = 0, .source = model_file->source, .model = m, .fit_json = "{}"};
+    store::TuningSet set;
+    set.name = o.save_name;
+    set.source = "epa design" + std::string(spec_given ? " from a spec" : o.design_path.empty() ? "" : " of " + o.design_path) +
+                 (paper_model ? " on the paper's model" : " on " + o.model_path);
+    set.F = F;
+    set.G = G;
+    set.H = H;
+    nlohmann::json spec = {{"T", T.coefficients()}, {"condition_number", cond}};
+    if (spec_given) spec.update({{"overshoot_pct", o.overshoot_pct}, {"settling_s", o.settling_s}, {"observer_pole", o.observer_pole}});
+    set.design_json = spec.dump();
+    set.dead_zone = m.dead_zone;
+    set.lc_mm = core::paper::kLcDefaultMm;
+    set.valve_limit_v = core::paper::kValveLimitV;
+    auto id = save_tuning_set(o.db_path, model, set);
+    if (!id) return err << "epa design: --save: " << id.error().message << "\n", 1;
+    out << "saved as tuning set '" << o.save_name << "' (id " << *id << ") in " << o.db_path
+        << "; epa tuning activate " << *id << " makes it active\n";
   }
   return 0;
 }

@@ -18,6 +18,8 @@ struct DesignOptions {
   double observer_pole = 0.0;
   int input_decimals = 4;          // decimals A, B, T were printed with (for the conditioning warning)
   std::string json_path;
+  std::string save_name;           // non-empty: save as a tuning set of this name into db_path
+  std::string db_path = "epa.db";
 };
 
 void add_design_command(CLI::App& app, DesignOptions& options);

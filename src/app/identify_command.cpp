@@ -2,10 +2,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "app/identify_report.hpp"
 #include "app/output_file.hpp"
+#include "app/store_save.hpp"
 #include "core/format.hpp"
 #include "core/model_file.hpp"
 #include "core/paper_reference.hpp"
@@ -27,6 +29,8 @@ void add_identify_command(CLI::App& app, IdentifyOptions& o) {
   cmd->add_option("--nb", o.nb, "Number of B coefficients: n or lo:hi")->capture_default_str();
   cmd->add_option("--nk", o.nk, "Input delay in samples (>= 1): n or lo:hi")->capture_default_str();
   cmd->add_option("--out", o.out_path, "Write the identified model (epa-model/1 TOML) for epa design/simulate --model");
+  cmd->add_option("--save", o.save_name, "Save the model under this name into the tuning store, with its fit figures");
+  cmd->add_option("--db", o.db_path, "The tuning store for --save")->capture_default_str();
   cmd->add_option("--plot", o.plot_path, "Draw measured vs model output of the validation runs as an SVG picture");
   cmd->add_option("--seed", o.seed, "Seed of the particle swarm (same seed, same data: same model)")->capture_default_str();
   cmd->add_option("--particles", o.particles, "Particles in the swarm")->capture_default_str()->check(CLI::Range(2u, 10000u));
@@ -182,6 +186,19 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   if (!o.out_path.empty()) {
     if (auto s = core::write_model_file(o.out_path, {model, source}); !s) return fail(s.error().message);
     out << "\nmodel written to " << o.out_path << "\n";
+  }
+  if (!o.save_name.empty()) {
+    const nlohmann::json fit_json = {
+        {"orders", chosen.to_string()}, {"runs", o.runs}, {"validation_runs", o.validate},
+        {"estimation", {{"one_step_pct", summary.estimation.one_step_pct}, {"simulation_pct", summary.estimation.simulation_pct}}},
+        {"validation", summary.validated ? nlohmann::json{{"one_step_pct", summary.validation.one_step_pct},
+                                                          {"simulation_pct", summary.validation.simulation_pct}}
+                                         : nlohmann::json(nullptr)},
+        {"pso_seed", o.seed}};
+    auto id = save_model(o.db_path, {.id = 0, .name = o.save_name, .created_ms = 0, .source = source, .model = model,
+                                     .fit_json = fit_json.dump()});
+    if (!id) return fail("--save: " + id.error().message);
+    out << "model saved as '" << o.save_name << "' (id " << *id << ") in " << o.db_path << "\n";
   }
   if (!o.plot_path.empty()) {
     const auto& shown = val->empty() ? *est : *val;

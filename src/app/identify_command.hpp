@@ -18,6 +18,8 @@ struct IdentifyOptions {
   std::vector<std::string> validate;  // validation runs (not used for estimation)
   std::string na = "1:4", nb = "1:4", nk = "1:2";  // an order or an inclusive range
   std::string out_path;               // epa-model/1; empty: none
+  std::string save_name;              // non-empty: save the model under this name into db_path
+  std::string db_path = "epa.db";
   std::string plot_path;              // SVG; empty: none
   std::uint64_t seed = 1;
   unsigned particles = 30;

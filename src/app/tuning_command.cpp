@@ -168,7 +168,8 @@ int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::os
       const auto fa = fields(a->set, a->model), fb = fields(b->set, b->model);
       int differences = 0;
       for (std::size_t i = 0; i < fa.size(); ++i) {
-        if (fa[i].first == "created" || fa[i].first == "modified" || fa[i].second == fb[i].second) continue;
+        const std::string& key = fa[i].first;  // identity and history are not values
+        if (key == "name" || key == "source" || key == "created" || key == "modified" || fa[i].second == fb[i].second) continue;
         out << fa[i].first << ":\n  " << a->set.name << ": " << fa[i].second << "\n  " << b->set.name << ": " << fb[i].second << "\n";
         ++differences;
       }

@@ -66,10 +66,15 @@ TEST_F(IdentifyCli, ExciteRefusesAnAmplitudeBeyondTheValve) {
 // with the same qualitative Table 1 behaviour as the paper's model designed the same way.
 TEST_F(IdentifyCli, ThreeCommandsTakeRunFilesToAStepTable) {
   const auto est = excite("est.csv", 1, 60), val = excite("val.csv", 2, 60);
-
-  auto o = run_epa("identify " + est + " --validate " + val + " --out " + path("model.toml") + " --plot " +
-                   path("fit.svg") + kSmallBudget);
+  // An appliance's store to save into (created and seeded by its first start).
+  auto o = run_epa("serve --config " + std::string(EPA_SOURCE_DIR) + "/config/epa.toml --modbus-port 0 --web-port 0 " +
+                   "--duration 0.2 --db " + path("epa.db") + " --record-dir " + path("runs"));
   ASSERT_EQ(o.exit_code, 0) << o.output;
+
+  o = run_epa("identify " + est + " --validate " + val + " --out " + path("model.toml") + " --plot " + path("fit.svg") +
+              " --save rig-1 --db " + path("epa.db") + kSmallBudget);
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  EXPECT_NE(o.output.find("model saved as 'rig-1'"), std::string::npos) << o.output;
   EXPECT_NE(o.output.find("Order selection"), std::string::npos);
   EXPECT_NE(o.output.find("<- recommended"), std::string::npos);
   EXPECT_NE(o.output.find("Recommended na="), std::string::npos);
@@ -91,7 +96,8 @@ TEST_F(IdentifyCli, ThreeCommandsTakeRunFilesToAStepTable) {
   std::map<std::string, nlohmann::json> table;  // "identified"/"paper" -> epa-sim/1 results
   for (const std::string which : {"identified", "paper"}) {
     const std::string model_option = which == "paper" ? "" : " --model " + path("model.toml");
-    o = run_epa("design" + model_option + kDesignT + " --json " + path(which + "-design.json"));
+    o = run_epa("design" + model_option + kDesignT + " --json " + path(which + "-design.json") + " --save designed-on-" + which +
+                " --db " + path("epa.db"));
     ASSERT_EQ(o.exit_code, 0) << o.output;
     o = run_epa("simulate" + model_option + " --design " + path(which + "-design.json") + " --json " +
                 path(which + "-sim.json"));
@@ -117,6 +123,12 @@ TEST_F(IdentifyCli, ThreeCommandsTakeRunFilesToAStepTable) {
     }
     EXPECT_EQ(result("identified", "pp", step)["rise_s"].is_null(), result("paper", "pp", step)["rise_s"].is_null());
   }
+  // The store holds the identified model with its fit figures, and a set designed on it.
+  o = run_epa("tuning --db " + path("epa.db") + " show designed-on-identified");
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  EXPECT_NE(o.output.find("model: rig-1 (id 2)"), std::string::npos) << o.output;  // the saved model, reused
+  EXPECT_NE(o.output.find("\"simulation_pct\""), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("model source: epa identify"), std::string::npos) << o.output;
 }
 
 TEST_F(IdentifyCli, TheSameSeedGivesTheSameModelFile) {
