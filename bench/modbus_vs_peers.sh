@@ -82,6 +82,8 @@ lock_memory = true
 cpu_dma_latency_us = 0
 [recorder]
 directory = "$out/runs"
+[store]
+path = "$out/epa.db"
 [log]
 status_interval_s = 0
 [modbus]

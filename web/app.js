@@ -70,6 +70,9 @@ function showStatus(s) {
   setText("s-commands", `${s.counters.commands_applied} / ${s.counters.commands_rejected}`);
   setText("s-heartbeat", String(s.heartbeat));
   setText("s-modbus", s.modbus.enabled ? `${s.modbus.clients} / ${s.modbus.requests}` : "off");
+  setText("s-store", !s.store.enabled ? "off"
+    : `${s.store.saved} / ${s.store.accepted}` + (s.store.ok ? "" : ` \u2014 NOT SAVING: ${s.store.last_error}`));
+  setText("s-tuning-set", s.store.enabled ? s.store.tuning_set : "\u2013");
   setText("s-web", s.commands_enabled ? "enabled (token)" : "read-only");
   const m = s.last_move;
   setText("last-move-head", m ? `#${m.number}: ${num(m.from_mm, 1)} → ${num(m.to_mm, 1)} mm` : "none yet");

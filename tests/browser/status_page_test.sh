@@ -113,6 +113,14 @@ else
 fi
 http_get "${url}api/audit" | grep -q '"point":"setpoint_mm"' && pass "(2) the Modbus write is in /api/audit" \
   || fail "(2) /api/audit does not show the Modbus setpoint write"
+saved=$(dump_dom | grep -o 'id="s-store">[^<]*' | sed 's/.*>//')
+if [[ $saved =~ ^([0-9]+)\ /\ ([0-9]+)$ ]] && [ "${BASH_REMATCH[1]}" -ge 1 ] && [ "${BASH_REMATCH[1]}" = "${BASH_REMATCH[2]}" ]; then
+  pass "(2) the page shows the write saved: $saved"
+else
+  fail "(2) id=s-store: expected 'N / N' with N >= 1 (the Modbus write on disk), got '$saved'"
+fi
+dump_dom | grep -q 'id="s-tuning-set">paper<' && pass "(2) the page names the tuning set 'paper'" \
+  || fail "(2) id=s-tuning-set does not name the tuning set 'paper'"
 
 # ---- (3) screenshots ----
 rm -f "$artifacts/status_page.png" "$artifacts/status_page_phone.png"
