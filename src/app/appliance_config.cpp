@@ -265,6 +265,13 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   int seed = static_cast<int>(c.sim.seed);
   sim.integer("seed", seed, 0, 2147483647);
   c.sim.seed = static_cast<std::uint64_t>(seed);
+  sim.choice<std::string>("plant", c.sim_plant, [](std::string_view v) -> core::Result<std::string> {
+    if (v == "hammerstein" || v == "physics") return std::string(v);
+    return core::invalid_argument("'" + std::string(v) + "' is not hammerstein or physics");
+  });
+  sim.text("physics_config", c.physics_config);
+  sim.integer("sensor_bits", c.sim_sensor_bits, 0, 24);
+  sim.number("initial_pressure_bar", c.sim_initial_pressure_bar, kNonNegative, ">= 0 bar");
   sim.refuse_unknown_keys();
   TableReader mb(hal_table.subtable("modbus_io"), "hal.modbus_io", file, error);
   mb.text("host", c.modbus_io.host);
@@ -301,7 +308,7 @@ core::Result<ApplianceConfig> read_appliance_config(const std::string& path) {
   if (!c) return c;
   // Files the configuration names are found next to it, wherever the appliance is started from.
   const auto folder = std::filesystem::path(path).parent_path();
-  for (std::string* p : {&c->model_path, &c->design_path, &c->register_map_path, &c->web.static_dir})
+  for (std::string* p : {&c->model_path, &c->design_path, &c->register_map_path, &c->web.static_dir, &c->physics_config})
     if (!p->empty() && std::filesystem::path(*p).is_relative()) *p = (folder / *p).lexically_normal().string();
   return c;
 }

@@ -44,6 +44,10 @@ struct ApplianceConfig {
 
   HalBackend backend = HalBackend::kSim;
   plant::PlantOptions sim;
+  std::string sim_plant = "hammerstein";  // [hal.sim] plant: "hammerstein" (the model) or "physics"
+  std::string physics_config;             // [hal.sim] physics_config: epa-pneumatic/1; "": the defaults
+  int sim_sensor_bits = 0;                // [hal.sim] sensor_bits (physics): ADC resolution, 0: none
+  double sim_initial_pressure_bar = 3.0;  // [hal.sim] initial_pressure_bar (physics)
   hal::ModbusIoConfig modbus_io;
   hal::ComediConfig comedi;
 };

@@ -3,12 +3,43 @@
 #include "hal/comedi_daq.hpp"
 #include "hal/modbus_io_daq.hpp"
 #include "hal/sim_daq.hpp"
+#include "plant/plant_adapter.hpp"
+#include "plant/pneumatic_params.hpp"
 
 namespace epa::app {
+
+core::Result<std::unique_ptr<plant::PlantSimulator>> make_physics_plant(const std::string& params_path, const PhysicsPlantOptions& o) {
+  plant::PneumaticParams params;  // the defaults, sized like the paper's rig
+  if (!params_path.empty()) {
+    auto p = plant::read_pneumatic_file(params_path);
+    if (!p) return p.error();
+    params = *p;
+  }
+  plant::PneumaticOptions options;
+  options.initial_position_mm = o.initial_position_mm;
+  options.initial_pressure_bar = o.initial_pressure_bar;
+  options.noise_std_mm = o.noise_std_mm;
+  options.seed = o.seed;
+  options.sensor_bits = o.sensor_bits;
+  options.Ts = o.Ts;
+  return plant::make_pneumatic_simulator(params, options);
+}
 
 core::Result<std::unique_ptr<hal::Daq>> make_daq(const ApplianceConfig& config, const core::HammersteinModel& model) {
   switch (config.backend) {
     case HalBackend::kSim: {
+      if (config.sim_plant == "physics") {
+        // Stepped once per scan cycle, so its sample period is the loop's.
+        auto plant = make_physics_plant(config.physics_config,
+                                        {.initial_position_mm = config.sim.initial_position_mm,
+                                         .initial_pressure_bar = config.sim_initial_pressure_bar,
+                                         .noise_std_mm = config.sim.noise_std_mm, .seed = config.sim.seed,
+                                         .sensor_bits = config.sim_sensor_bits, .Ts = config.runtime.period_s});
+        if (!plant) return core::invalid_argument("[hal.sim] " + plant.error().message);
+        auto daq = hal::SimDaq::make(std::move(*plant));
+        if (!daq) return core::invalid_argument("[hal.sim] " + daq.error().message);
+        return std::unique_ptr<hal::Daq>(std::make_unique<hal::SimDaq>(std::move(*daq)));
+      }
       auto daq = hal::SimDaq::make(model, config.sim);
       if (!daq) return core::invalid_argument("[hal.sim] " + daq.error().message);
       return std::unique_ptr<hal::Daq>(std::make_unique<hal::SimDaq>(std::move(*daq)));

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <ostream>
 
+#include "app/daq_factory.hpp"
 #include "app/tuning_source.hpp"
 #include "core/format.hpp"
 #include "hal/remote_io_simulator.hpp"
@@ -24,6 +25,12 @@ void add_plant_server_command(CLI::App& app, PlantServerOptions& o) {
       ->capture_default_str()->check(CLI::Range(0, 247));
   cmd->add_option("--model", o.model_path, "Model file (epa-model/1 TOML); default: the paper's eq 9-10")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--plant", o.plant, "hammerstein (the model) or physics (pneumatic cylinder and valve)")
+      ->capture_default_str()->check(CLI::IsMember({"hammerstein", "physics"}));
+  cmd->add_option("--physics-config", o.physics_config, "Physics plant parameters (epa-pneumatic/1 TOML); default: built in")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--sensor-bits", o.sensor_bits, "Physics plant: ADC resolution over 0-10 V (0: none)")
+      ->capture_default_str()->check(CLI::Range(0, 24));
   cmd->add_option("--initial-position", o.initial_position_mm, "Piston position at start, mm")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_option("--noise", o.noise_mm, "Sensor noise standard deviation, mm")
@@ -86,12 +93,24 @@ int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostrea
 
   BlockedStopSignals signals;  // before start(): the simulator's threads must not take the signals
   if (!signals.ok()) return err << "epa plant-server: cannot block SIGINT/SIGTERM: " << std::strerror(errno) << "\n", 1;
-  auto sim = hal::RemoteIoSimulator::start(config);
+  core::Result<std::unique_ptr<hal::RemoteIoSimulator>> sim = core::invalid_argument("not started");
+  if (o.plant == "physics") {
+    auto plant = make_physics_plant(o.physics_config, {.initial_position_mm = o.initial_position_mm, .initial_pressure_bar = 3.0,
+                                                        .noise_std_mm = o.noise_mm, .seed = o.seed,
+                                                        .sensor_bits = o.sensor_bits, .Ts = config.model.Ts});
+    if (!plant) return err << "epa plant-server: " << plant.error().message << "\n", 1;
+    sim = hal::RemoteIoSimulator::start(config, std::move(*plant));
+  } else {
+    sim = hal::RemoteIoSimulator::start(config);
+  }
   if (!sim) return err << "epa plant-server: " << sim.error().message << "\n", 1;
 
   out << "plant-server listening on " << o.address << ":" << (*sim)->port() << " (unit " << o.unit_id << ", Ts "
       << core::format_number(config.model.Ts) << " s)" << std::endl;
-  out << "model: " << (o.model_path.empty() ? std::string("paper eq 9-10") : o.model_path) << "; initial position "
+  const std::string plant_text = o.plant == "physics"
+                                     ? "physics plant (" + (o.physics_config.empty() ? std::string("built-in parameters") : o.physics_config) + ")"
+                                     : "model: " + (o.model_path.empty() ? std::string("paper eq 9-10") : o.model_path);
+  out << plant_text << "; initial position "
       << core::format_number(o.initial_position_mm) << " mm; sensor noise " << core::format_number(o.noise_mm)
       << " mm; stop with SIGINT or SIGTERM" << std::endl;
 

@@ -16,6 +16,9 @@ struct PlantServerOptions {
   int port = 1502;               // 0: a free port, printed in the "listening" line
   int unit_id = 1;
   std::string model_path;        // empty: the paper's model
+  std::string plant = "hammerstein";  // or "physics"
+  std::string physics_config;    // epa-pneumatic/1 for --plant physics; empty: the defaults
+  int sensor_bits = 0;           // physics: ADC resolution over 0-10 V (0: none)
   double initial_position_mm = 0.0;
   double noise_mm = 0.0;
   std::uint64_t seed = 1;

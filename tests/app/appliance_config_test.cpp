@@ -31,6 +31,20 @@ TEST(ApplianceConfig, ShippedFileParsesToTheDocumentedDefaults) {
   EXPECT_TRUE(c->modbus_enabled);
   EXPECT_EQ(c->modbus.port, 502);
   EXPECT_EQ(c->modbus.policy.unlock_key, 0);  // no default key: tuning stays locked until one is set
+  EXPECT_EQ(c->store_path, "epa.db");          // the appliance's data: relative to the working directory
+  EXPECT_EQ(c->sim_plant, "hammerstein");
+  EXPECT_EQ(c->physics_config, "");
+}
+
+TEST(ApplianceConfig, ThePhysicsPlantIsChosenWithItsParameterFileNextToTheConfiguration) {
+  auto c = parse_appliance_config("[hal.sim]\nplant = \"physics\"\nsensor_bits = 12\ninitial_pressure_bar = 2.5\n", "x.toml");
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  EXPECT_EQ(c->sim_plant, "physics");
+  EXPECT_EQ(c->sim_sensor_bits, 12);
+  EXPECT_EQ(c->sim_initial_pressure_bar, 2.5);
+  EXPECT_NE(error_of("[hal.sim]\nplant = \"cfd\"\n").find("hal.sim.plant"), std::string::npos);
+  EXPECT_NE(error_of("[hal.sim]\nsensor_bits = 40\n").find("hal.sim.sensor_bits"), std::string::npos);
+  EXPECT_NE(error_of("[store]\nfile = \"x.db\"\n").find("store.file"), std::string::npos);
 }
 
 TEST(ApplianceConfig, EmptyFileGivesTheDefaults) {

@@ -124,6 +124,35 @@ TEST_F(EpaCli, ServeOnTheSimPlantMovesRecordsAndStopsCleanly) {
   EXPECT_EQ(run->size(), 100u);
 }
 
+TEST_F(EpaCli, ServeOnThePhysicsPlantMovesAndRecords) {
+  std::ofstream(path("phys.toml")) << "[recorder]\nmove_window_s = 1.0\n[log]\nstatus_interval_s = 0\n[modbus]\nenabled = false\n"
+                                    << "[web]\nenabled = false\n[hal.sim]\nplant = \"physics\"\nphysics_config = \""
+                                    << EPA_SOURCE_DIR << "/config/pneumatic-plant.toml\"\n";
+  const auto o = run_epa("serve --config " + path("phys.toml") + " --mode run --setpoint 100 --duration 2 --record-dir " +
+                         path("runs") + " --db " + path("epa.db"));
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  EXPECT_NE(o.output.find("DAQ sim (in-process physics plant)"), std::string::npos) << o.output;
+  auto run = epa::core::read_run_file(path("runs/move-0001-pp-ffidz-0to100mm.csv"), 0.005);
+  ASSERT_TRUE(run.has_value()) << run.error().message << "\n" << o.output;
+  EXPECT_NEAR(run->y_mm.back(), 100.0, 5.0);  // within l_c of the target (the physics plant's FF-IDZ finish)
+  const auto bad = run_epa("serve --config " + path("phys.toml") + " --db " + path("epa.db") + " --duration 0.1 --hal sim");
+  EXPECT_EQ(bad.exit_code, 0) << bad.output;
+  std::ofstream(path("bad.toml")) << "[modbus]\nenabled = false\n[web]\nenabled = false\n[hal.sim]\nplant = \"physics\"\n"
+                                  << "physics_config = \"" << path("nope.toml") << "\"\n";
+  const auto missing = run_epa("serve --config " + path("bad.toml") + " --db " + path("epa.db") + " --duration 0.1");
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.output.find("[hal.sim]"), std::string::npos) << missing.output;
+  EXPECT_NE(missing.output.find("nope.toml"), std::string::npos) << missing.output;
+}
+
+TEST_F(EpaCli, PlantServerRunsThePhysicsPlant) {
+  const auto o = run_epa("plant-server --plant physics --port 0 --help");
+  EXPECT_EQ(o.exit_code, 0);
+  EXPECT_NE(o.output.find("--physics-config"), std::string::npos) << o.output;
+  const auto bad = run_epa("plant-server --plant cfd --port 0");
+  EXPECT_NE(bad.exit_code, 0);
+}
+
 TEST_F(EpaCli, ServeRefusesAModbusIoModuleThatIsNotThere) {
   const auto o = run_epa("serve --config " + std::string(EPA_SOURCE_DIR) + "/config/epa.toml --hal modbus-io --modbus-io-port 9 --db " +
                          path("epa.db"));
