@@ -12,6 +12,8 @@
 #include <map>
 #include <sstream>
 
+#include "core/format.hpp"
+#include "diag/chance_threshold.hpp"
 #include "diag/selection.hpp"
 #include "diag_test_data.hpp"
 
@@ -25,6 +27,7 @@ struct Outcome {
   std::string truth, named;  // named: the effect, "none" or "unexplained"
   std::vector<std::string> all_named;
   double before_mm = 0, after_mm = 0;
+  std::vector<epa::diag::CandidateScore> candidates;  // every candidate's held-out reduction and threshold
 };
 
 std::string label(const epa::diag::Diagnosis& d, const std::string& truth) {
@@ -50,7 +53,7 @@ std::vector<Outcome> run_all() {
       }
       const auto c = epa::testing::make_case(h, static_cast<std::uint64_t>(seed));
       const auto d = epa::diag::diagnose(nominal, epa::testing::pointers(c.train), epa::testing::pointers(c.heldout), {});
-      Outcome o{truth, label(d, truth), {}, d.baseline_gap_mm, d.final_gap_mm};
+      Outcome o{truth, label(d, truth), {}, d.baseline_gap_mm, d.final_gap_mm, d.candidates};
       for (auto k : d.effects) o.all_named.emplace_back(epa::plant::to_string(k));
       out.push_back(o);
     }
@@ -89,6 +92,17 @@ TEST(SelfCheck, WritesTheConfusionMatrix) {
     for (const auto& c : cols) md << " " << (m.count({r, c}) ? std::to_string(m[{r, c}]) : "") << " |";
     md << "\n";
   }
+  // The chance distribution: what fitting each effect gains on effect-free data.
+  std::map<std::string, double> chance_max;
+  for (const auto& o : outcomes())
+    if (o.truth == "none")
+      for (const auto& c : o.candidates) {
+        auto& largest = chance_max[std::string(epa::plant::to_string(c.kind))];
+        largest = std::max(largest, c.reduction_vs_refit_pct);
+      }
+  md << "\nChance: the largest held-out reduction (%, against the re-fitted model) that fitting each effect gave on "
+     << "the effect-free cases, against its acceptance threshold:";
+  for (const auto& [k, v] : chance_max) md << " " << k << " " << epa::core::format_number(v) << " (" << epa::core::format_number(epa::diag::chance_threshold_pct(epa::plant::parse_effect(k).value())) << ")";
   md << "\nFalse blame on effect-free data: " << false_blame << " of " << effect_free << " cases. Cases where a second "
      << "effect was named beside the hidden one: " << co_blamed << ".\n";
   const auto dir = std::filesystem::path(EPA_ARTIFACTS_DIR);
@@ -100,6 +114,17 @@ TEST(SelfCheck, WritesTheConfusionMatrix) {
 TEST(SelfCheck, BlamesNothingOnEffectFreeData) {
   for (const auto& o : outcomes())
     if (o.truth == "none") { EXPECT_TRUE(o.all_named.empty()) << o.named; }
+}
+
+// The thresholds in chance_threshold.hpp are what chance gives, with room: on effect-free data
+// (the perturbed model's own rounding, noise) no candidate comes within 80 % of its threshold.
+TEST(SelfCheck, ChanceThresholdsStayAboveWhatFittingGivesOnEffectFreeData) {
+  for (const auto& o : outcomes()) {
+    if (o.truth != "none") continue;
+    ASSERT_FALSE(o.candidates.empty());
+    for (const auto& c : o.candidates)
+      EXPECT_LT(c.reduction_vs_refit_pct, 0.8 * epa::diag::chance_threshold_pct(c.kind)) << epa::plant::to_string(c.kind);
+  }
 }
 
 TEST(SelfCheck, SaysUnexplainedForADisturbanceOutsideTheLibrary) {

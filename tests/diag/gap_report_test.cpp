@@ -1,0 +1,133 @@
+// The epa-gap-report/1 JSON against FORMATS.md, the regime breakdown's shares, and `epa diagnose`
+// run as a user would: on run files with an effect hidden in them, and on bad input.
+#include "diag/gap_report.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "../support/run_epa.hpp"
+#include "core/run_file.hpp"
+#include "diag_test_data.hpp"
+
+namespace {
+
+using nlohmann::json;
+
+struct Fixture {
+  epa::testing::CaseData data;
+  epa::diag::GapReport report;
+  json j;
+};
+
+// A small case: valve lag hidden, 2 training and 1 held-out run of 8 s.
+const Fixture& fixture() {
+  static const Fixture f = [] {
+    Fixture x;
+    epa::testing::Hidden h;
+    h.effects = epa::testing::typical_effect(epa::plant::EffectKind::kValveLag);
+    x.data = epa::testing::make_case(h, 5, 2, 1, 8.0);
+    const epa::diag::ReplayModel nominal{epa::core::paper::model(), {}, 500.0};
+    const auto d = epa::diag::diagnose(nominal, epa::testing::pointers(x.data.train), epa::testing::pointers(x.data.heldout), {});
+    x.report = epa::diag::build_report(d, {{"a.csv", &x.data.train[0]}, {"b.csv", &x.data.train[1]}}, {{"c.csv", &x.data.heldout[0]}});
+    x.j = json::parse(epa::diag::to_json(x.report));
+    return x;
+  }();
+  return f;
+}
+
+TEST(GapReport, TheJsonHasEveryKeyOfFormatsMdWithItsType) {
+  const json& j = fixture().j;
+  EXPECT_EQ(j.at("schema"), "epa-gap-report/1");
+  EXPECT_EQ(j.at("horizon_samples"), 10);
+  EXPECT_EQ(j.at("runs").at("train"), json::array({"a.csv", "b.csv"}));
+  EXPECT_EQ(j.at("runs").at("heldout"), json::array({"c.csv"}));
+  EXPECT_TRUE(j.at("baseline").at("heldout_gap_mm").is_number());
+  ASSERT_FALSE(j.at("where").empty());
+  for (const auto& w : j.at("where")) {
+    EXPECT_TRUE(w.at("regime").is_string());
+    EXPECT_TRUE(w.at("time_share_pct").is_number());
+    EXPECT_TRUE(w.at("gap_share_pct").is_number());
+  }
+  const std::set<std::string> names = {"gain_change", "deadzone_shift", "input_delay", "valve_lag", "static_friction",
+                                       "flow_saturation", "position_dependent_gain", "sensor_quantization"};
+  ASSERT_FALSE(j.at("candidates").empty());
+  double previous = 0;
+  for (const auto& c : j.at("candidates")) {
+    EXPECT_TRUE(names.contains(c.at("effect").get<std::string>())) << c.at("effect");
+    EXPECT_TRUE(c.at("params").is_object());
+    EXPECT_TRUE(c.at("accepted").is_boolean());
+    EXPECT_TRUE(c.at("reduction_pct").is_number());
+    EXPECT_GE(c.at("heldout_gap_mm").get<double>(), previous);  // best first
+    previous = c.at("heldout_gap_mm").get<double>();
+  }
+  const json& v = j.at("verdict");
+  EXPECT_TRUE(v.at("effects").is_array());
+  EXPECT_TRUE(v.at("unexplained").is_boolean());
+  EXPECT_EQ(v.at("heldout_gap_before_mm"), j.at("baseline").at("heldout_gap_mm"));
+  const double before = v.at("heldout_gap_before_mm"), after = v.at("heldout_gap_after_mm");
+  EXPECT_NEAR(v.at("reduction_pct").get<double>(), 100.0 * (before - after) / before, 0.05);
+  EXPECT_EQ(v.at("effects"), json::array({"valve_lag"}));
+}
+
+TEST(GapReport, EachDimensionsTimeSharesAndGapSharesSumToAHundred) {
+  std::map<std::string, std::pair<double, double>> sums;
+  for (const auto& w : fixture().j.at("where")) {
+    auto& s = sums[w.at("dimension").get<std::string>()];
+    s.first += w.at("time_share_pct").get<double>();
+    s.second += w.at("gap_share_pct").get<double>();
+  }
+  EXPECT_EQ(sums.size(), epa::diag::kDimensions);
+  for (const auto& [dimension, s] : sums) {
+    EXPECT_NEAR(s.first, 100.0, 0.01) << dimension;
+    EXPECT_NEAR(s.second, 100.0, 0.01) << dimension;
+  }
+}
+
+class DiagnoseCli : public epa::testing::ScratchDirTest {
+ protected:
+  std::string write(const epa::core::Run& run, const std::string& name) {
+    EXPECT_TRUE(epa::core::write_run_file(path(name), run));
+    return path(name);
+  }
+};
+
+TEST_F(DiagnoseCli, NamesTheHiddenEffectAndWritesTheJsonAndTheReport) {
+  const auto& d = fixture().data;
+  const std::string runs = write(d.train[0], "a.csv") + " " + write(d.train[1], "b.csv");
+  const auto o = epa::testing::run_epa("diagnose " + runs + " --holdout " + write(d.heldout[0], "c.csv") + " --json " +
+                                       path("gap.json") + " --report " + path("gap.html"));
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  std::ifstream in(path("gap.json"));
+  const json j = json::parse(in);
+  EXPECT_EQ(j.at("verdict").at("effects"), json::array({"valve_lag"})) << j.dump(1);
+  std::ifstream html(path("gap.html"));
+  std::stringstream h;
+  h << html.rdbuf();
+  EXPECT_NE(h.str().find("<svg"), std::string::npos);
+  EXPECT_NE(h.str().find("valve_lag"), std::string::npos);
+}
+
+TEST_F(DiagnoseCli, BadInputIsNamed) {
+  const auto& d = fixture().data;
+  const std::string a = write(d.train[0], "a.csv");
+  auto o = epa::testing::run_epa("diagnose " + a + " --json -");
+  EXPECT_EQ(o.exit_code, 1);
+  EXPECT_NE(o.output.find("give at least 2 runs, or --holdout"), std::string::npos) << o.output;
+  o = epa::testing::run_epa("diagnose " + a + " --holdout " + a + " --effects valve_lag,wind --json -");
+  EXPECT_EQ(o.exit_code, 1);
+  EXPECT_NE(o.output.find("wind"), std::string::npos) << o.output;
+  epa::core::Run other = d.train[1];
+  other.Ts = 0.01;
+  for (std::size_t k = 0; k < other.size(); ++k) other.t_s[k] = 0.01 * static_cast<double>(k);
+  o = epa::testing::run_epa("diagnose " + a + " --holdout " + write(other, "slow.csv") + " --json -");
+  EXPECT_EQ(o.exit_code, 1);
+  EXPECT_NE(o.output.find("slow.csv"), std::string::npos) << o.output;
+}
+
+}  // namespace
