@@ -1,5 +1,8 @@
 #include "app/diagnose_report.hpp"
 
+#include <algorithm>
+#include <cstdio>
+
 #include <cstdio>
 
 #include "app/svg_chart.hpp"
@@ -53,23 +56,22 @@ std::string render_diagnosis_html(const diag::GapReport& r) {
     u.bands.push_back({d.nominal.model.dead_zone.b_l, d.nominal.model.dead_zone.b_r, "dead band"});
     h += inline_svg(render_svg("Recorded vs nominal vs augmented model", {p, u}, 1, 1100, 320));
   }
-  h += "<h2>Where: gap per regime</h2><table><tr><th>regime</th><th>dimension</th><th>time %</th><th>gap % (nominal)</th>"
-       "<th>gap mm nominal</th><th>after re-fit</th><th>with effects</th></tr>\n";
+  // Share of the gap against share of the time as two bars per regime: a regime whose red bar
+  // outgrows its grey one is where the model is wrong.
+  h += "<h2>Where: gap per regime</h2><table><tr><th>dimension</th><th>regime</th><th>time % vs gap % (nominal)</th>"
+       "<th>time %</th><th>gap %</th><th>gap mm nominal</th><th>after re-fit</th><th>with effects</th></tr>\n";
+  auto bar = [](double pct, const char* color) {
+    char b[160];
+    std::snprintf(b, sizeof b, "<div style=\"background:%s;height:7px;margin:1px 0;width:%.1f%%\"></div>", color,
+                  std::clamp(pct, 0.0, 100.0));
+    return std::string(b);
+  };
   for (const auto& w : r.where)
-    h += "<tr><td>" + escape(w.before.regime) + "</td><td>" + escape(w.before.dimension) + "</td><td>" + num(w.before.time_share_pct, "%.1f") +
-         "</td><td>" + num(w.before.gap_share_pct, "%.1f") + "</td><td>" + num(w.before.gap_mm) + "</td><td>" + num(w.refit_gap_mm) +
-         "</td><td>" + num(w.after_gap_mm) + "</td></tr>\n";
-  h += "</table>\n";
-  {
-    Panel bars{"gap share vs time share per regime (nominal model)", "regime #", "%", {}, {}, {}, {}, {}, {}};
-    Series t{"time share", "#7f7f7f", {}, {}, false}, g{"gap share", "#d62728", {}, {}, false};
-    for (std::size_t i = 0; i < r.where.size(); ++i) {
-      t.x.push_back(static_cast<double>(i)), t.y.push_back(r.where[i].before.time_share_pct);
-      g.x.push_back(static_cast<double>(i)), g.y.push_back(r.where[i].before.gap_share_pct);
-    }
-    bars.series = {t, g};
-    h += inline_svg(render_svg("Where the gap lies (regime # = row of the table above, from 0)", {bars}, 1, 1100, 300));
-  }
+    h += "<tr><td>" + escape(w.before.dimension) + "</td><td>" + escape(w.before.regime) + "</td><td style=\"width:220px\">" +
+         bar(w.before.time_share_pct, "#9e9e9e") + bar(w.before.gap_share_pct, "#d62728") + "</td><td>" +
+         num(w.before.time_share_pct, "%.1f") + "</td><td>" + num(w.before.gap_share_pct, "%.1f") + "</td><td>" + num(w.before.gap_mm) +
+         "</td><td>" + num(w.refit_gap_mm) + "</td><td>" + num(w.after_gap_mm) + "</td></tr>\n";
+  h += "</table><p>Grey: share of the time; red: share of the gap (nominal model).</p>\n";
   h += "<h2>Which: candidates (held out)</h2><table><tr><th>effect</th><th>parameters</th><th>gap mm</th><th>reduction %</th>"
        "<th>vs re-fit %</th><th>chance %</th><th>accepted</th></tr>\n";
   for (const auto& c : d.candidates) {
