@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "diag/chance_threshold.hpp"
+#include "diag/sensor_resolution.hpp"
 
 namespace epa::diag {
 
@@ -203,6 +204,22 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
   d.noise_std_mm = estimate_noise_std_mm(all_runs, nominal.model.dead_zone);
   d.noise_floor_mm = noise_floor_mm(nominal.model, d.noise_std_mm, o.horizon);
   d.unexplained = d.final_gap_mm > o.unexplained_factor * d.noise_floor_mm;
+  // 4. The sensor's resolution: readings on a grid whose rounding error (step / sqrt(12)) is at
+  // least the noise are a coarse sensor. A replay cannot predict the rounding, so this raises the
+  // floor the gap can reach rather than shrinking the gap; the verdict uses that floor.
+  const bool quantization_candidate =
+      std::find(o.candidates.begin(), o.candidates.end(), EffectKind::kSensorQuantization) != o.candidates.end();
+  if (const auto step = reading_resolution_mm(all_runs); step && quantization_candidate && *step / std::sqrt(12.0) >= d.noise_std_mm) {
+    d.noise_floor_mm = noise_floor_mm(nominal.model, std::hypot(d.noise_std_mm, *step / std::sqrt(12.0)), o.horizon);
+    std::snprintf(buf, sizeof buf, "readings lie on a %.4g mm grid, coarser than the noise: with its rounding the floor is %.3f mm",
+                  *step, d.noise_floor_mm);
+    say(buf);
+    d.effects.push_back(EffectKind::kSensorQuantization);
+    d.final_model.effects.set(EffectKind::kSensorQuantization, plant::EffectParams{*step, 0.0, 0.0});
+    d.unexplained = d.final_gap_mm > o.unexplained_factor * d.noise_floor_mm;
+    for (auto& c : d.candidates)
+      if (c.kind == EffectKind::kSensorQuantization) c.params = plant::EffectParams{*step, 0.0, 0.0}, c.accepted = true;
+  }
   std::snprintf(buf, sizeof buf, "verdict: %s; held-out gap %.3f -> %.3f mm; noise floor %.3f mm (sensor noise %.3f mm)%s",
                 d.effects.empty() ? "no effect accepted" : names(d.effects).c_str(), d.baseline_gap_mm,
                 d.final_gap_mm, d.noise_floor_mm, d.noise_std_mm, d.unexplained ? "; a significant gap remains unexplained" : "");
