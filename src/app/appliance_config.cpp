@@ -1,5 +1,7 @@
 #include "app/appliance_config.hpp"
 
+#include "plant/effects.hpp"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -272,6 +274,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   sim.text("physics_config", c.physics_config);
   sim.integer("sensor_bits", c.sim_sensor_bits, 0, 24);
   sim.number("initial_pressure_bar", c.sim_initial_pressure_bar, kNonNegative, ">= 0 bar");
+  sim.text_list("effects", c.sim_effects);
   sim.refuse_unknown_keys();
   TableReader mb(hal_table.subtable("modbus_io"), "hal.modbus_io", file, error);
   mb.text("host", c.modbus_io.host);
@@ -291,6 +294,10 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   if (error) return *error;
 
   // Cross-field rules, in the runtime's and backends' own validators.
+  if (!c.sim_effects.empty()) {
+    if (c.sim_plant != "hammerstein") return core::invalid_argument(file + ": [hal.sim] effects apply to the hammerstein plant only");
+    if (auto e = plant::parse_effect_specs(c.sim_effects); !e) return core::invalid_argument(file + ": [hal.sim] effects: " + e.error().message);
+  }
   if (auto s = runtime::validate(r); !s) return core::invalid_argument(file + ": " + s.error().message);
   if (c.backend == HalBackend::kModbusIo)
     if (auto s = hal::validate(c.modbus_io); !s) return core::invalid_argument(file + ": [hal.modbus_io] " + s.error().message);

@@ -48,6 +48,8 @@ struct ApplianceConfig {
   std::string physics_config;             // [hal.sim] physics_config: epa-pneumatic/1; "": the defaults
   int sim_sensor_bits = 0;                // [hal.sim] sensor_bits (physics): ADC resolution, 0: none
   double sim_initial_pressure_bar = 3.0;  // [hal.sim] initial_pressure_bar (physics)
+  std::vector<std::string> sim_effects;   // [hal.sim] effects hidden in the hammerstein plant: "valve_lag=0.02"
+
   hal::ModbusIoConfig modbus_io;
   hal::ComediConfig comedi;
 };

@@ -40,6 +40,15 @@ core::Result<std::unique_ptr<hal::Daq>> make_daq(const ApplianceConfig& config, 
         if (!daq) return core::invalid_argument("[hal.sim] " + daq.error().message);
         return std::unique_ptr<hal::Daq>(std::make_unique<hal::SimDaq>(std::move(*daq)));
       }
+      if (!config.sim_effects.empty()) {  // the model with effects hidden in it (test data for epa diagnose)
+        auto effects = plant::parse_effect_specs(config.sim_effects);
+        if (!effects) return core::invalid_argument("[hal.sim] effects: " + effects.error().message);
+        auto plant = plant::make_augmented_simulator(model, *effects, config.sim);
+        if (!plant) return core::invalid_argument("[hal.sim] " + plant.error().message);
+        auto daq = hal::SimDaq::make(std::move(*plant));
+        if (!daq) return core::invalid_argument("[hal.sim] " + daq.error().message);
+        return std::unique_ptr<hal::Daq>(std::make_unique<hal::SimDaq>(std::move(*daq)));
+      }
       auto daq = hal::SimDaq::make(model, config.sim);
       if (!daq) return core::invalid_argument("[hal.sim] " + daq.error().message);
       return std::unique_ptr<hal::Daq>(std::make_unique<hal::SimDaq>(std::move(*daq)));

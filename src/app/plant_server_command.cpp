@@ -12,6 +12,7 @@
 #include "app/tuning_source.hpp"
 #include "core/format.hpp"
 #include "hal/remote_io_simulator.hpp"
+#include "plant/plant_adapter.hpp"
 
 namespace epa::app {
 
@@ -31,6 +32,8 @@ void add_plant_server_command(CLI::App& app, PlantServerOptions& o) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--sensor-bits", o.sensor_bits, "Physics plant: ADC resolution over 0-10 V (0: none)")
       ->capture_default_str()->check(CLI::Range(0, 24));
+  cmd->add_option("--effect", o.effects, "Hammerstein plant: hide an effect in it, e.g. valve_lag=0.02 or static_friction=0.6,0.3 "
+                                         "(repeatable; names and parameters as epa diagnose reports them)");
   cmd->add_option("--initial-position", o.initial_position_mm, "Piston position at start, mm")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_option("--noise", o.noise_mm, "Sensor noise standard deviation, mm")
@@ -94,10 +97,18 @@ int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostrea
   BlockedStopSignals signals;  // before start(): the simulator's threads must not take the signals
   if (!signals.ok()) return err << "epa plant-server: cannot block SIGINT/SIGTERM: " << std::strerror(errno) << "\n", 1;
   core::Result<std::unique_ptr<hal::RemoteIoSimulator>> sim = core::invalid_argument("not started");
+  if (o.plant == "physics" && !o.effects.empty())
+    return err << "epa plant-server: --effect applies to the hammerstein plant only\n", 1;
   if (o.plant == "physics") {
     auto plant = make_physics_plant(o.physics_config, {.initial_position_mm = o.initial_position_mm, .initial_pressure_bar = 3.0,
                                                         .noise_std_mm = o.noise_mm, .seed = o.seed,
                                                         .sensor_bits = o.sensor_bits, .Ts = config.model.Ts});
+    if (!plant) return err << "epa plant-server: " << plant.error().message << "\n", 1;
+    sim = hal::RemoteIoSimulator::start(config, std::move(*plant));
+  } else if (!o.effects.empty()) {
+    auto effects = plant::parse_effect_specs(o.effects);
+    if (!effects) return err << "epa plant-server: --effect: " << effects.error().message << "\n", 1;
+    auto plant = plant::make_augmented_simulator(config.model, *effects, config.plant);
     if (!plant) return err << "epa plant-server: " << plant.error().message << "\n", 1;
     sim = hal::RemoteIoSimulator::start(config, std::move(*plant));
   } else {
@@ -109,7 +120,8 @@ int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostrea
       << core::format_number(config.model.Ts) << " s)" << std::endl;
   const std::string plant_text = o.plant == "physics"
                                      ? "physics plant (" + (o.physics_config.empty() ? std::string("built-in parameters") : o.physics_config) + ")"
-                                     : "model: " + (o.model_path.empty() ? std::string("paper eq 9-10") : o.model_path);
+                                     : "model: " + (o.model_path.empty() ? std::string("paper eq 9-10") : o.model_path) +
+                                           (o.effects.empty() ? "" : " with hidden effects");
   out << plant_text << "; initial position "
       << core::format_number(o.initial_position_mm) << " mm; sensor noise " << core::format_number(o.noise_mm)
       << " mm; stop with SIGINT or SIGTERM" << std::endl;

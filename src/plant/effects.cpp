@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include "core/format.hpp"
 
@@ -172,6 +173,41 @@ double steady_speed_mm_s_per_V(std::span<const double> A, std::span<const double
   for (std::size_t i = 1; i < A.size(); ++i) a_prime_1 -= static_cast<double>(i) * A[i];
   if (a_prime_1 == 0.0) return 0.0;
   return std::abs(b1 / a_prime_1) * mm_per_volt / Ts;
+}
+
+core::Result<EffectSet> parse_effect_specs(const std::vector<std::string>& specs) {
+  EffectSet set;
+  for (const auto& spec : specs) {
+    const auto eq = spec.find('=');
+    if (eq == std::string::npos) return core::invalid_argument("effect '" + spec + "': write name=value[,value...]");
+    auto kind = parse_effect(spec.substr(0, eq));
+    if (!kind) return core::invalid_argument("effect '" + spec + "': " + kind.error().message);
+    const auto params = param_specs(*kind);
+    std::vector<double> values;
+    std::string rest = spec.substr(eq + 1);
+    for (std::size_t start = 0; start <= rest.size();) {
+      const auto comma = rest.find(',', start);
+      const std::string item = rest.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      char* end = nullptr;
+      const double v = std::strtod(item.c_str(), &end);
+      if (item.empty() || end != item.c_str() + item.size())
+        return core::invalid_argument("effect '" + spec + "': '" + item + "' is not a number");
+      values.push_back(v);
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+    if (values.size() != params.size()) {
+      std::string names;
+      for (const auto& p : params) names += (names.empty() ? "" : ",") + std::string(p.name);
+      return core::invalid_argument("effect '" + spec + "': " + std::string(to_string(*kind)) + " takes " +
+                                    std::to_string(params.size()) + " value(s): " + names);
+    }
+    EffectParams p{};
+    std::copy(values.begin(), values.end(), p.begin());
+    set.set(*kind, p);
+  }
+  if (auto s = set.validate(); !s) return s.error();
+  return set;
 }
 
 }  // namespace epa::plant

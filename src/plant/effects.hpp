@@ -78,6 +78,11 @@ class EffectSet {
   std::array<EffectParams, kEffectCount> params_{};
 };
 
+// Effects from text, as the simulators' options give them: "valve_lag=0.02",
+// "static_friction=0.6,0.3" (the parameters in param_specs order, all of them). Validated; the
+// error names the spec and what is wrong.
+core::Result<EffectSet> parse_effect_specs(const std::vector<std::string>& specs);
+
 // Effects on the valve command only (input_delay, valve_lag): what any plant with a step(valve_v)
 // can carry. Explicit state, restartable; the command before sample 0 is taken as 0 V (centred).
 class ValveEffects {

@@ -6,6 +6,7 @@
 
 #include "core/hammerstein_model.hpp"
 #include "core/result.hpp"
+#include "plant/augmented_plant.hpp"
 #include "plant/hammerstein_plant.hpp"
 #include "plant/plant_simulator.hpp"
 #include "plant/pneumatic_plant.hpp"
@@ -36,6 +37,10 @@ class PlantAdapter final : public PlantSimulator {
 // The paper's Hammerstein plant; Ts is the model's. Errors as HammersteinPlant::make.
 core::Result<std::unique_ptr<PlantSimulator>> make_hammerstein_simulator(const core::HammersteinModel& model,
                                                                          const PlantOptions& options);
+// The Hammerstein plant with effects switched on (plant::AugmentedPlant): data with an effect the
+// diagnosis is not told about. Errors as AugmentedPlant::make.
+core::Result<std::unique_ptr<PlantSimulator>> make_augmented_simulator(const core::HammersteinModel& model, const EffectSet& effects,
+                                                                       const PlantOptions& options);
 // The physics plant; Ts is options.Ts. Errors as PneumaticPlant::make.
 core::Result<std::unique_ptr<PlantSimulator>> make_pneumatic_simulator(const PneumaticParams& params,
                                                                        const PneumaticOptions& options);

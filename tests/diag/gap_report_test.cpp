@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -111,6 +112,30 @@ TEST_F(DiagnoseCli, NamesTheHiddenEffectAndWritesTheJsonAndTheReport) {
   h << html.rdbuf();
   EXPECT_NE(h.str().find("<svg"), std::string::npos);
   EXPECT_NE(h.str().find("valve_lag"), std::string::npos);
+}
+
+// The whole loop as a commissioning engineer would run it: the appliance on a sim plant with a
+// spool lag hidden in it records three moves; epa diagnose, not told, names the lag.
+TEST_F(DiagnoseCli, RunsRecordedByTheApplianceWithAHiddenLagAreDiagnosed) {
+  std::ofstream(path("hidden.toml")) << "[hal.sim]\neffects = [\"valve_lag=0.015\"]\nnoise_mm = 0.1\n[modbus]\nenabled = false\n"
+                                     << "[web]\nenabled = false\n[log]\nstatus_interval_s = 0\n[recorder]\nmove_window_s = 2.0\n";
+  std::vector<std::string> files;
+  for (const int setpoint : {60, 150, 250}) {
+    const auto o = epa::testing::run_epa("serve --config " + path("hidden.toml") + " --db " + path("epa.db") + " --mode run --setpoint " +
+                                         std::to_string(setpoint) + " --duration 2.3 --record-dir " + path("runs" + std::to_string(setpoint)));
+    ASSERT_EQ(o.exit_code, 0) << o.output;
+    ASSERT_NE(o.output.find("with effects"), std::string::npos) << o.output;
+    for (const auto& e : std::filesystem::directory_iterator(path("runs" + std::to_string(setpoint)))) files.push_back(e.path().string());
+  }
+  ASSERT_EQ(files.size(), 3u);
+  const auto o = epa::testing::run_epa("diagnose " + files[0] + " " + files[1] + " --holdout " + files[2] + " --json " + path("gap.json"));
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  std::ifstream in(path("gap.json"));
+  const json j = json::parse(in);
+  EXPECT_EQ(j.at("verdict").at("effects"), json::array({"valve_lag"})) << o.output;
+  for (const auto& c : j.at("candidates")) {
+    if (c.at("effect") == "valve_lag") { EXPECT_NEAR(c.at("params").at("tau_s").get<double>(), 0.015, 0.003); }
+  }
 }
 
 TEST_F(DiagnoseCli, BadInputIsNamed) {

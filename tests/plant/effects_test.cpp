@@ -104,3 +104,28 @@ TEST(Effects, SteadySpeedPerVoltOfThePaperModel) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(EffectSpecs, TextSpecsSwitchEffectsOnAndBadOnesAreNamed) {
+  auto set = epa::plant::parse_effect_specs({"valve_lag=0.02", "static_friction=0.6,0.3"});
+  ASSERT_TRUE(set) << set.error().message;
+  EXPECT_TRUE(set->on(epa::plant::EffectKind::kValveLag));
+  EXPECT_EQ(set->param(epa::plant::EffectKind::kValveLag, 0), 0.02);
+  EXPECT_EQ(set->param(epa::plant::EffectKind::kStaticFriction, 1), 0.3);
+  EXPECT_FALSE(set->on(epa::plant::EffectKind::kInputDelay));
+  const std::pair<std::string, std::string> bad[] = {
+      {"valve_lag", "name=value"},
+      {"wind=3", "wind"},
+      {"static_friction=0.6", "takes 2 value(s): breakaway_V,coulomb_V"},
+      {"valve_lag=fast", "'fast' is not a number"},
+      {"valve_lag=-1", "valve_lag"},
+  };
+  for (const auto& [spec, expected] : bad) {
+    auto r = epa::plant::parse_effect_specs({spec});
+    ASSERT_FALSE(r) << spec;
+    EXPECT_NE(r.error().message.find(expected), std::string::npos) << spec << ": " << r.error().message;
+  }
+}
+
+}  // namespace
