@@ -114,6 +114,18 @@ TEST_F(DiagnoseCli, NamesTheHiddenEffectAndWritesTheJsonAndTheReport) {
   EXPECT_NE(h.str().find("valve_lag"), std::string::npos);
 }
 
+TEST_F(DiagnoseCli, WithoutHeldOutRunsItCrossValidatesByRun) {
+  const auto& d = fixture().data;
+  const auto o = epa::testing::run_epa("diagnose " + write(d.train[0], "a.csv") + " " + write(d.train[1], "b.csv") + " " +
+                                       write(d.heldout[0], "c.csv") + " --json " + path("cv.json"));
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  std::ifstream in(path("cv.json"));
+  const json j = json::parse(in);
+  EXPECT_EQ(j.at("cross_validated"), true);
+  EXPECT_EQ(j.at("runs").at("train").size(), 3u);
+  EXPECT_EQ(j.at("verdict").at("effects"), json::array({"valve_lag"})) << o.output;
+}
+
 // The whole loop as a commissioning engineer would run it: the appliance on a sim plant with a
 // spool lag hidden in it records three moves; epa diagnose, not told, names the lag.
 TEST_F(DiagnoseCli, RunsRecordedByTheApplianceWithAHiddenLagAreDiagnosed) {
