@@ -6,9 +6,11 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <ostream>
 
 #include "app/daq_factory.hpp"
+#include "app/module_fault_control.hpp"
 #include "app/tuning_source.hpp"
 #include "core/format.hpp"
 #include "hal/remote_io_simulator.hpp"
@@ -32,6 +34,9 @@ void add_plant_server_command(CLI::App& app, PlantServerOptions& o) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--sensor-bits", o.sensor_bits, "Physics plant: ADC resolution over 0-10 V (0: none)")
       ->capture_default_str()->check(CLI::Range(0, 24));
+  cmd->add_flag("--control-stdin", o.control_stdin,
+                "Fault injection for tests: read 'answers silent|garbage|late MS|normal', 'sensor nan|frozen|fixed V|normal' "
+                "and 'status' lines on standard input");
   cmd->add_option("--effect", o.effects, "Hammerstein plant: hide an effect in it, e.g. valve_lag=0.02 or static_friction=0.6,0.3 "
                                          "(repeatable; names and parameters as epa diagnose reports them)");
   cmd->add_option("--initial-position", o.initial_position_mm, "Piston position at start, mm")
@@ -126,7 +131,10 @@ int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostrea
       << core::format_number(o.initial_position_mm) << " mm; sensor noise " << core::format_number(o.noise_mm)
       << " mm; stop with SIGINT or SIGTERM" << std::endl;
 
+  std::optional<ModuleFaultControl> control;
+  if (o.control_stdin) control.emplace(**sim, out);
   const int signal_number = signals.wait();
+  if (control) control->stop();
   (*sim)->stop();
   out << "plant-server stopped by " << (signal_number == SIGINT ? "SIGINT" : "SIGTERM") << " after "
       << (*sim)->steps() << " steps (" << (*sim)->requests() << " requests, " << (*sim)->overruns()

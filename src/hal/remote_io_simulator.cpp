@@ -1,6 +1,7 @@
 #include "hal/remote_io_simulator.hpp"
 
 #include "hal/realtime.hpp"
+#include "core/word_order.hpp"
 #include "plant/plant_adapter.hpp"
 
 #include <arpa/inet.h>
@@ -16,9 +17,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <climits>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <exception>
 #include <thread>
@@ -76,6 +79,12 @@ struct RemoteIoSimulator::Impl {
   std::atomic<double> position_mm{0.0};
   std::atomic<std::uint64_t> steps{0}, overruns{0}, requests{0};
   std::atomic<int> clients{0};
+  std::atomic<double> last_valve_v{0.0};
+  // Injected faults (ModuleFaults), one atomic each so neither thread ever waits for the injector.
+  std::atomic<ModuleFaults::Answers> answers{ModuleFaults::Answers::kNormal};
+  std::atomic<int> late_ms{0};
+  std::atomic<ModuleFaults::Sensor> sensor_fault{ModuleFaults::Sensor::kNormal};
+  std::atomic<double> fixed_sensor_v{0.0};
   std::vector<int> client_fds;  // the server thread's; reserved in start(), so it never allocates
   std::thread server_thread, plant_thread;
 
@@ -157,6 +166,16 @@ bool RemoteIoSimulator::Impl::serve_request(int fd, std::uint8_t* query) noexcep
   const int length = modbus_receive(ctx, query);
   if (length == -1) return false;
   if (length == 0) return true;  // libmodbus ignored it
+  switch (answers.load()) {
+    case ModuleFaults::Answers::kNormal: break;
+    case ModuleFaults::Answers::kSilent: return true;  // read, never answered: the client times out
+    case ModuleFaults::Answers::kLate: std::this_thread::sleep_for(std::chrono::milliseconds(late_ms.load())); break;
+    case ModuleFaults::Answers::kGarbage: {
+      // A frame that is no answer to anything: wrong transaction id, protocol id and length.
+      static constexpr std::uint8_t kGarbage[] = {0xDE, 0xAD, 0xBE, 0xEF, 0x00, 0x03, 0x01, 0x83, 0x7F};
+      return ::send(fd, kGarbage, sizeof kGarbage, MSG_NOSIGNAL) == static_cast<ssize_t>(sizeof kGarbage);
+    }
+  }
   const int unit = query[modbus_get_header_length(ctx) - 1];
   int rc;
   // 0xFF is the Modbus TCP "unit id not used" value for a device addressed by IP alone (and
@@ -191,9 +210,20 @@ void RemoteIoSimulator::Impl::run_plant() noexcept {
       valve_v = decode_volts(valve, read_point(valve)).value_or(0.0);  // undecodable: centred valve
     }
     plant->step(valve_v);
+    last_valve_v.store(valve_v);
     {
       std::lock_guard lock(mapping_mutex);
-      write_point(sensor, encode_volts(sensor, plant->measured_v()));
+      switch (sensor_fault.load()) {
+        case ModuleFaults::Sensor::kNormal: write_point(sensor, encode_volts(sensor, plant->measured_v())); break;
+        case ModuleFaults::Sensor::kFrozen: break;  // the last reading stays
+        case ModuleFaults::Sensor::kFixed: write_point(sensor, encode_volts(sensor, fixed_sensor_v.load())); break;
+        case ModuleFaults::Sensor::kNotANumber:
+          // float32: NaN on the wire; int16: -32768, the broken-wire code of analog modules.
+          write_point(sensor, sensor.encoding == AnalogEncoding::kFloat32
+                                  ? core::encode_f32(std::numeric_limits<float>::quiet_NaN(), sensor.word_order)
+                                  : PointWords{0x8000, 0});
+          break;
+      }
     }
     position_mm.store(plant->position_mm());
     steps.fetch_add(1);
@@ -293,5 +323,14 @@ std::uint64_t RemoteIoSimulator::overruns() const { return impl_->overruns.load(
 std::uint64_t RemoteIoSimulator::requests() const { return impl_->requests.load(); }
 int RemoteIoSimulator::clients() const { return impl_->clients.load(); }
 void RemoteIoSimulator::stop() { impl_->stop(); }
+
+double RemoteIoSimulator::valve_v() const { return impl_->last_valve_v.load(); }
+
+void RemoteIoSimulator::inject(const ModuleFaults& f) {
+  impl_->late_ms.store(f.late_ms);
+  impl_->answers.store(f.answers);
+  impl_->fixed_sensor_v.store(f.sensor_v);
+  impl_->sensor_fault.store(f.sensor);
+}
 
 }  // namespace epa::hal

@@ -42,6 +42,17 @@ struct RemoteIoSimulatorConfig {
                                       // bounded time; 0: normal priority (refusal is not an error)
 };
 
+// Faults a test injects into the module (epa plant-server --control-stdin): how it answers, and
+// what its sensor reads. The defaults are a healthy module.
+struct ModuleFaults {
+  enum class Answers : std::uint8_t { kNormal, kSilent, kLate, kGarbage };
+  enum class Sensor : std::uint8_t { kNormal, kNotANumber, kFixed, kFrozen };
+  Answers answers = Answers::kNormal;
+  int late_ms = 0;            // kLate: every answer this much late
+  Sensor sensor = Sensor::kNormal;
+  double sensor_v = 0.0;      // kFixed: what the sensor reads (e.g. out of range)
+};
+
 class RemoteIoSimulator {
  public:
   static constexpr int kMaxClients = 16;
@@ -63,6 +74,10 @@ class RemoteIoSimulator {
   std::uint64_t overruns() const; // times the plant thread gave up catching up (see above)
   std::uint64_t requests() const; // Modbus requests answered (including exceptions)
   int clients() const;            // clients connected now
+  double valve_v() const;         // the valve command the plant got at its last step
+
+  // Takes effect at the next request (answers) or plant step (sensor); thread-safe.
+  void inject(const ModuleFaults& faults);
 
   // Stops both threads and closes every socket; idempotent. Returns within 50 ms + Ts, or 150 ms
   // + Ts while a client stalls mid-frame.

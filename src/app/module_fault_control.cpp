@@ -1,0 +1,66 @@
+#include "app/module_fault_control.hpp"
+
+#include <poll.h>
+#include <unistd.h>
+
+#include <sstream>
+
+#include "core/format.hpp"
+
+namespace epa::app {
+
+std::string apply_module_command(const std::string& line, hal::RemoteIoSimulator& sim, hal::ModuleFaults& f) {
+  std::istringstream in(line);
+  std::string what, how;
+  in >> what >> how;
+  using A = hal::ModuleFaults::Answers;
+  using S = hal::ModuleFaults::Sensor;
+  if (what == "status")
+    return "valve " + core::format_number(sim.valve_v()) + " position " + core::format_number(sim.position_mm());
+  if (what == "answers") {
+    if (how == "normal") f.answers = A::kNormal;
+    else if (how == "silent") f.answers = A::kSilent;
+    else if (how == "garbage") f.answers = A::kGarbage;
+    else if (how == "late" && (in >> f.late_ms) && f.late_ms >= 0 && f.late_ms <= 10000) f.answers = A::kLate;
+    else return "error: answers takes normal, silent, garbage or late MS (0..10000), not '" + line + "'";
+  } else if (what == "sensor") {
+    if (how == "normal") f.sensor = S::kNormal;
+    else if (how == "nan") f.sensor = S::kNotANumber;
+    else if (how == "frozen") f.sensor = S::kFrozen;
+    else if (how == "fixed" && (in >> f.sensor_v)) f.sensor = S::kFixed;
+    else return "error: sensor takes normal, nan, frozen or fixed VOLTS, not '" + line + "'";
+  } else {
+    return "error: unknown command '" + line + "' (answers, sensor, status)";
+  }
+  sim.inject(f);
+  return "ok " + line;
+}
+
+ModuleFaultControl::ModuleFaultControl(hal::RemoteIoSimulator& sim, std::ostream& out) : sim_(sim), out_(out) {
+  thread_ = std::thread([this] { run(); });
+}
+
+void ModuleFaultControl::stop() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+}
+
+void ModuleFaultControl::run() {
+  hal::ModuleFaults faults;
+  std::string pending;
+  char buf[256];
+  while (!stop_) {
+    pollfd p{STDIN_FILENO, POLLIN, 0};
+    if (poll(&p, 1, 100) <= 0) continue;
+    const ssize_t n = ::read(STDIN_FILENO, buf, sizeof buf);
+    if (n <= 0) return;  // EOF: no more commands
+    pending.append(buf, static_cast<std::size_t>(n));
+    for (std::size_t eol; (eol = pending.find('\n')) != std::string::npos;) {
+      const std::string line = pending.substr(0, eol);
+      pending.erase(0, eol + 1);
+      if (!line.empty()) out_ << apply_module_command(line, sim_, faults) << std::endl;
+    }
+  }
+}
+
+}  // namespace epa::app

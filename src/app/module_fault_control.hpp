@@ -1,0 +1,37 @@
+#pragma once
+// `epa plant-server --control-stdin`: fault injection for hardware-in-the-loop tests, one command
+// per line on standard input, answered with one line on standard output:
+//   answers normal | silent | garbage | late MS     how the module answers Modbus requests
+//   sensor normal | nan | frozen | fixed VOLTS      what its sensor reads
+//   status                                          "valve V position MM"
+// Anything else is answered "error: ..." naming what was wrong.
+#include <atomic>
+#include <ostream>
+#include <string>
+#include <thread>
+
+#include "hal/remote_io_simulator.hpp"
+
+namespace epa::app {
+
+// Applies one command line to `sim`; returns the answer line.
+std::string apply_module_command(const std::string& line, hal::RemoteIoSimulator& sim, hal::ModuleFaults& faults);
+
+// Reads standard input on its own thread (polling, so stop() returns within 100 ms) until EOF or stop().
+class ModuleFaultControl {
+ public:
+  ModuleFaultControl(hal::RemoteIoSimulator& sim, std::ostream& out);
+  ~ModuleFaultControl() { stop(); }
+  ModuleFaultControl(const ModuleFaultControl&) = delete;
+  ModuleFaultControl& operator=(const ModuleFaultControl&) = delete;
+  void stop();
+
+ private:
+  void run();
+  hal::RemoteIoSimulator& sim_;
+  std::ostream& out_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace epa::app
