@@ -208,6 +208,8 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   lim.number("following_error_time_s", r.following_error_time_s, kNonNegative, ">= 0 s (0: off)");
   lim.integer("max_consecutive_io_errors", r.max_consecutive_io_errors, 1, 1000000);
   lim.number("heartbeat_timeout_s", r.heartbeat_timeout_s, kNonNegative, ">= 0 s (0: off)");
+  lim.number("sensor_frozen_time_s", r.sensor_frozen_time_s, kNonNegative, ">= 0 s (0: off)");
+  lim.number("sensor_frozen_drive_v", r.sensor_frozen_drive_v, kPositive, "> 0 V");
   lim.refuse_unknown_keys();
 
   TableReader cal(top.subtable("calibration"), "calibration", file, error);

@@ -205,6 +205,17 @@ void supervise(const ApplianceConfig& c, double duration_s, const runtime::LoopC
   }
 }
 
+// The scan cycle's thread, stopped and joined on every way out of run_serve.
+struct LoopThread {
+  std::atomic<bool> stop{false};
+  std::thread thread;
+  void join() {
+    stop = true;
+    if (thread.joinable()) thread.join();
+  }
+  ~LoopThread() { join(); }
+};
+
 // Closes the DAQ on every way out of run_serve.
 struct DaqCloser {
   hal::Daq& daq;
@@ -254,6 +265,14 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   runtime::MonotonicClock clock;
   runtime::ScanCycle loop(c.runtime, control->tuning, **daq, clock, channels);
   store_writer.start();
+  // The loop runs before either interface opens, so a client that gets an answer reads a live
+  // loop (its first cycle is waited for, at most 1 s).
+  LoopThread loop_thread;
+  loop_thread.thread = std::thread([&] {
+    for (const auto& warning : hal::request_realtime(c.realtime)) spdlog::warn("{}", warning);
+    loop.run(loop_thread.stop);
+  });
+  for (int i = 0; i < 200 && channels.snapshot.read().cycle == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   LogAuditSink log_audit(&store_writer);
   web::RecentAudit audit(&log_audit);  // the last entries for the status page, the log, the store
   std::unique_ptr<modbus::ModbusServer> modbus_server;
@@ -274,11 +293,6 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
                              [&store_writer](const std::string& path, const core::Run& run) { store_writer.record_run(to_run_record(path, run)); });
   recorder.start();
 
-  std::atomic<bool> stop{false};
-  std::thread loop_thread([&] {
-    for (const auto& warning : hal::request_realtime(c.realtime)) spdlog::warn("{}", warning);
-    loop.run(stop);
-  });
   sd_notify(0, "READY=1");
   spdlog::info("running");
   supervise(c, o.duration_s, channels, signals);
@@ -286,7 +300,6 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   sd_notify(0, "STOPPING=1");
   if (web_server) web_server->stop();        // no more commands from either interface;
   if (modbus_server) modbus_server->stop();  // then the loop's last cycle
-  stop = true;
   loop_thread.join();  // the loop's last act: valve to its safe command
   recorder.stop();     // writes what is pending; the DAQ closes on the way out
   store_writer.stop(); // every accepted change and run on disk (or logged as not saved)

@@ -22,6 +22,7 @@ struct AuditEntry {
 struct ChangeCounters {
   std::uint64_t accepted = 0;
   std::uint64_t saved = 0;
+  bool saving = true;  // false while writes to disk fail (disk full, read-only): saved stands still
 };
 
 class AuditSink {

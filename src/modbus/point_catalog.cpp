@@ -34,7 +34,7 @@ std::vector<PointDef> build() {
       {"mode", "", "0 stop, 1 run, 2 manual (3 fault: read only; leave it with reset)", W::kMode, 0, 2, true,
        [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.mode)); }},
       {"fault_code", "", "latched fault: 0 none, 1 sensor not finite, 2 sensor out of range, 3 soft limit, 4 I/O errors, "
-                         "5 overruns, 6 following error, 7 heartbeat lost, 8 controller fault, 9 store damaged", W::kNone, 0, 0, true,
+                         "5 overruns, 6 following error, 7 heartbeat lost, 8 controller fault, 9 store damaged, 10 sensor frozen", W::kNone, 0, 0, true,
        [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.fault)); }},
       {"fault_active", "", "1 while a fault is latched", W::kNone, 0, 0, true, [](const Ctx& c, int) { return b(c.snapshot.mode == runtime::Mode::kFault); }},
       {"controller", "", "0 pp, 1 pp-ngidz, 2 pp-ffidz", W::kController, 0, 2, true,
@@ -57,6 +57,7 @@ std::vector<PointDef> build() {
       {"unlock", "", "write the configured key: tuning registers writable until the unlock timeout", W::kUnlock, 0, 65535, true,
        [](const Ctx&, int) { return 0.0; }},
       {"locked", "", "1 while tuning registers refuse writes", W::kNone, 0, 0, true, [](const Ctx& c, int) { return b(c.server.locked); }},
+      {"store_ok", "", "1 while the tuning store saves changes; 0 while its writes fail (disk full, read-only): saved_counter stands still until they succeed", W::kNone, 0, 0, true, [](const Ctx& c, int) { return b(c.server.saving); }},
       {"change_counter", "", "accepted changes since start (Modbus and web); the heartbeat and the unlock key do not count", W::kNone, 0, 0, true, [](const Ctx& c, int) { return double(c.server.change_counter); }},
       {"saved_counter", "", "how many of the accepted changes are on disk: once it reaches the change_counter read after a write, that write survives a crash", W::kNone, 0, 0, true, [](const Ctx& c, int) { return double(c.server.saved_counter); }},
       {"modbus_requests", "", "requests served since start", W::kNone, 0, 0, true, [](const Ctx& c, int) { return double(c.server.requests); }},

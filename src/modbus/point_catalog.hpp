@@ -16,6 +16,7 @@ namespace epa::modbus {
 struct ServerStatus {
   std::uint32_t change_counter = 0;  // accepted changes since start, every interface
   std::uint32_t saved_counter = 0;   // how many of them are on disk
+  bool saving = true;                // the store's writes succeed
   std::uint64_t requests = 0;
   int clients = 0;
   bool locked = true;                // tuning registers refuse writes

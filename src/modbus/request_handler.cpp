@@ -38,8 +38,8 @@ RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, int u
 
 ServerStatus RequestHandler::status(std::int64_t now_ns) const {
   const core::ChangeCounters changes = audit_ ? audit_->counters() : core::ChangeCounters{};
-  return {static_cast<std::uint32_t>(changes.accepted), static_cast<std::uint32_t>(changes.saved), requests_, clients_,
-          now_ns >= unlocked_until_ns_};
+  return {static_cast<std::uint32_t>(changes.accepted), static_cast<std::uint32_t>(changes.saved), changes.saving, requests_,
+          clients_, now_ns >= unlocked_until_ns_};
 }
 
 std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, const std::string& client, std::int64_t now_ns,

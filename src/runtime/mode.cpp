@@ -26,6 +26,7 @@ std::string_view to_string(FaultCode code) {
     case FaultCode::kHeartbeatLost: return "heartbeat-lost";
     case FaultCode::kControllerFault: return "controller-fault";
     case FaultCode::kStoreDamaged: return "store-damaged";
+    case FaultCode::kSensorFrozen: return "sensor-frozen";
   }
   return "?";
 }
@@ -41,6 +42,8 @@ std::string_view describe(FaultCode code) {
     case FaultCode::kFollowingError: return "the position did not follow the setpoint (following error too large for too long)";
     case FaultCode::kHeartbeatLost: return "the supervising client's heartbeat stopped";
     case FaultCode::kControllerFault: return "the control law produced a non-finite command";
+    case FaultCode::kSensorFrozen:
+      return "the position reading stopped changing while the valve was driving the piston: a frozen sensor or a stuck input";
     case FaultCode::kStoreDamaged:
       return "the tuning database was damaged: it was moved aside and the appliance started from the seeded defaults; check the tuning, then reset";
   }

@@ -26,6 +26,7 @@ enum class FaultCode : std::uint8_t {
   kHeartbeatLost = 7,     // the supervising client stopped incrementing the heartbeat
   kControllerFault = 8,   // the control law reported a non-finite result
   kStoreDamaged = 9,      // the tuning database was damaged: moved aside, started from defaults
+  kSensorFrozen = 10,     // the reading stopped changing while the valve drove the piston
 };
 
 std::string_view to_string(Mode mode);

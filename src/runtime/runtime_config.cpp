@@ -30,6 +30,8 @@ core::Status validate(const RuntimeConfig& c) {
     return core::invalid_argument("safe_valve_v must be a valve command within +-10 V, got " + core::format_number(c.safe_valve_v));
   if (!(c.following_error_time_s >= 0.0)) return core::invalid_argument("following_error_time_s must be >= 0 (0: off)");
   if (!(c.heartbeat_timeout_s >= 0.0)) return core::invalid_argument("heartbeat_timeout_s must be >= 0 (0: off)");
+  if (!(c.sensor_frozen_time_s >= 0.0)) return core::invalid_argument("sensor_frozen_time_s must be >= 0 (0: off)");
+  if (!(c.sensor_frozen_drive_v > 0.0)) return core::invalid_argument("sensor_frozen_drive_v must be > 0 V");
   if (c.max_consecutive_io_errors < 1) return core::invalid_argument("max_consecutive_io_errors must be >= 1");
   if (c.max_consecutive_overruns < 1) return core::invalid_argument("max_consecutive_overruns must be >= 1");
   if (c.start_mode == Mode::kFault || c.start_mode == Mode::kManual)

@@ -23,6 +23,10 @@ struct RuntimeConfig {
   int max_consecutive_io_errors = 3;
   int max_consecutive_overruns = 10;
   double heartbeat_timeout_s = 0.0;  // 0: no heartbeat supervision
+  // A reading that stays bit-identical for this long while |valve| > sensor_frozen_drive_v (beyond
+  // the dead band: the piston must move) away from the ends of the setpoint range faults (0: off).
+  double sensor_frozen_time_s = 0.5;
+  double sensor_frozen_drive_v = 2.0;
 
   control::ControllerKind controller = control::ControllerKind::kPpFfidz;
   Mode start_mode = Mode::kStop;

@@ -132,6 +132,17 @@ FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
   if (config_.heartbeat_timeout_s > 0.0 &&
       static_cast<double>(now_ns - heartbeat_changed_ns_) > config_.heartbeat_timeout_s * 1e9)
     return FaultCode::kHeartbeatLost;
+  if (read_ok && config_.sensor_frozen_time_s > 0.0) {
+    // valve_v_ is last cycle's command: the one the piston has been moving under since.
+    const bool driving = std::abs(valve_v_) > config_.sensor_frozen_drive_v &&
+                         position_mm_ > config_.setpoint_min_mm + 2.0 && position_mm_ < config_.setpoint_max_mm - 2.0;
+    if (driving && sensor_v_ == previous_sensor_v_) {
+      if (frozen_since_ns_ < 0) frozen_since_ns_ = now_ns;
+      if (static_cast<double>(now_ns - frozen_since_ns_) >= config_.sensor_frozen_time_s * 1e9) return FaultCode::kSensorFrozen;
+    } else {
+      frozen_since_ns_ = -1;
+    }
+  }
   if (mode_ == Mode::kRun && read_ok && config_.following_error_time_s > 0.0) {
     if (std::abs(setpoint_mm_ - position_mm_) > config_.following_error_mm) {
       if (following_error_since_ns_ < 0) following_error_since_ns_ = now_ns;
@@ -157,6 +168,7 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
   const hal::SensorReading reading = daq_.read_sensor();
   const bool read_ok = reading.status == hal::IoStatus::kOk;
   if (read_ok) {
+    previous_sensor_v_ = sensor_v_;
     sensor_v_ = reading.sensor_v;
     position_mm_ = (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain * config_.mm_per_volt;
     consecutive_read_errors_ = 0;

@@ -89,6 +89,8 @@ class ScanCycle {
   bool saturated_ = false, io_ok_ = true;
   int consecutive_read_errors_ = 0, consecutive_write_errors_ = 0, consecutive_overruns_ = 0;
   std::int64_t following_error_since_ns_ = -1;
+  std::int64_t frozen_since_ns_ = -1;  // the reading has been bit-identical while driving since then
+  double previous_sensor_v_ = 0.0;
   std::uint32_t heartbeat_ = 0;
   std::int64_t heartbeat_changed_ns_ = 0;
   std::uint64_t cycle_ = 0, faults_ = 0, io_errors_ = 0, applied_ = 0, rejected_ = 0;

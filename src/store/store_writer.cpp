@@ -55,7 +55,7 @@ void StoreWriter::record_run(const RunRecord& run) {
 
 core::ChangeCounters StoreWriter::counters() const {
   std::lock_guard lock(mutex_);
-  return {accepted_, saved_.load()};
+  return {accepted_, saved_.load(), health_.ok};
 }
 
 StoreHealth StoreWriter::health() const {

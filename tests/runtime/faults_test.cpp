@@ -2,6 +2,7 @@
 // explicit reset; a reset with the cause gone returns to STOP.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 
 #include "control/paper_controller.hpp"
@@ -16,7 +17,7 @@ constexpr double kSafeV = 0.0;
 
 class Faults : public ::testing::Test {
  protected:
-  void start(RuntimeConfig c = {}) {
+  void start(RuntimeConfig c = {}, bool expect_moving = true) {
     c.start_mode = Mode::kRun;
     c.start_setpoint_mm = c.start_setpoint_mm == 0.0 ? 300.0 : c.start_setpoint_mm;
     config_ = c;
@@ -25,7 +26,7 @@ class Faults : public ::testing::Test {
                                         daq_, clock_, ch_);
     cycles(3);
     ASSERT_EQ(snap().mode, Mode::kRun);
-    ASSERT_NE(daq_.last_written_v, kSafeV);  // moving: the valve is open
+    if (expect_moving) { ASSERT_NE(daq_.last_written_v, kSafeV); }  // moving: the valve is open
   }
   void cycles(int n) {
     for (int k = 0; k < n; ++k) {
@@ -123,6 +124,7 @@ TEST_F(Faults, FollowingErrorTooLargeForTooLong) {
   RuntimeConfig c;
   c.following_error_mm = 20.0;
   c.following_error_time_s = 0.5;
+  c.sensor_frozen_time_s = 0.0;  // the fake sensor never moves: that is not what this test is about
   start(c);    // cycles at 0, 5, 10 ms; the error (|300 - 100| mm) is there from t = 0
   cycles(98);  // up to t = 500 ms: exactly the allowed time, not more
   EXPECT_EQ(snap().mode, Mode::kRun);
@@ -135,6 +137,7 @@ TEST_F(Faults, FollowingErrorTooLargeForTooLong) {
 TEST_F(Faults, HeartbeatLostWhenTheClientStopsCounting) {
   RuntimeConfig c;
   c.heartbeat_timeout_s = 0.1;
+  c.sensor_frozen_time_s = 0.0;  // the fake sensor never moves: that is not what this test is about
   start(c);
   for (std::uint32_t beat = 1; beat <= 10; ++beat) {  // 10 beats, every 50 ms: no fault
     ASSERT_TRUE(ch_.commands.try_push(heartbeat_command(beat)));
@@ -149,6 +152,43 @@ TEST_F(Faults, HeartbeatLostWhenTheClientStopsCounting) {
   EXPECT_EQ(snap().mode, Mode::kFault);
   EXPECT_EQ(snap().fault, FaultCode::kHeartbeatLost);
   EXPECT_EQ(daq_.last_written_v, kSafeV);
+}
+
+TEST_F(Faults, AReadingThatStopsChangingWhileTheValveDrivesIsAFrozenSensor) {
+  RuntimeConfig c;
+  c.sensor_frozen_time_s = 0.5;
+  c.following_error_time_s = 0.0;
+  start(c);  // RUN to 300 mm from 100 mm: the valve drives hard, the fake reading stays at 2.0 V
+  ASSERT_GT(std::abs(daq_.last_written_v), c.sensor_frozen_drive_v);  // driving within the first 3 cycles
+  int ran = 3;
+  while (snap().mode == Mode::kRun && ran < 400) cycles(1), ++ran;
+  // 0.5 s of identical readings under drive: not before 100 cycles, and within 3 more.
+  EXPECT_GE(ran, 100);
+  EXPECT_LE(ran, 104);
+  EXPECT_EQ(snap().mode, Mode::kFault);
+  EXPECT_EQ(snap().fault, FaultCode::kSensorFrozen);
+  EXPECT_EQ(daq_.last_written_v, kSafeV);
+}
+
+TEST_F(Faults, AReadingThatChangesOrAPistonAtRestOrAtAnEndIsNotFrozen) {
+  RuntimeConfig c;
+  c.sensor_frozen_time_s = 0.5;
+  c.following_error_time_s = 0.0;
+  start(c);
+  for (int k = 0; k < 300; ++k) {  // moving: the reading changes by a count now and then
+    daq_.sensor_v += (k % 20 == 0) ? 0.001 : 0.0;
+    cycles(1);
+  }
+  EXPECT_EQ(snap().mode, Mode::kRun);
+  c.start_setpoint_mm = 100.0;  // at the setpoint: the valve rests inside the dead band
+  start(c, false);
+  cycles(300);
+  EXPECT_EQ(snap().mode, Mode::kRun);
+  c.start_setpoint_mm = 0.5;  // pushing against the end stop at 0 mm: pinned, not frozen
+  start(c, false);
+  daq_.sensor_v = 0.0;
+  cycles(300);
+  EXPECT_EQ(snap().fault, FaultCode::kNone);
 }
 
 TEST_F(Faults, FaultStaysLatchedUntilResetThenStop) {
