@@ -16,7 +16,8 @@ std::string apply_module_command(const std::string& line, hal::RemoteIoSimulator
   using A = hal::ModuleFaults::Answers;
   using S = hal::ModuleFaults::Sensor;
   if (what == "status")
-    return "valve " + core::format_number(sim.valve_v()) + " position " + core::format_number(sim.position_mm());
+    return "valve " + core::format_number(sim.valve_v()) + " position " + core::format_number(sim.position_mm()) +
+           " steps_to_safe " + std::to_string(sim.steps_to_safe_valve()) + " watchdog " + (sim.watchdog_tripped() ? "tripped" : "ok");
   if (what == "answers") {
     if (how == "normal") f.answers = A::kNormal;
     else if (how == "silent") f.answers = A::kSilent;

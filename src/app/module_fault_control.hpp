@@ -3,7 +3,8 @@
 // per line on standard input, answered with one line on standard output:
 //   answers normal | silent | garbage | late MS     how the module answers Modbus requests
 //   sensor normal | nan | frozen | fixed VOLTS      what its sensor reads
-//   status                                          "valve V position MM"
+//   status      "valve V position MM steps_to_safe N watchdog ok|tripped" (N: plant steps from the
+//               last sensor fault to the first 0 V valve command; -1: none yet)
 // Anything else is answered "error: ..." naming what was wrong.
 #include <atomic>
 #include <ostream>

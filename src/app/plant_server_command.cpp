@@ -34,6 +34,9 @@ void add_plant_server_command(CLI::App& app, PlantServerOptions& o) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--sensor-bits", o.sensor_bits, "Physics plant: ADC resolution over 0-10 V (0: none)")
       ->capture_default_str()->check(CLI::Range(0, 24));
+  cmd->add_option("--watchdog-ms", o.watchdog_ms, "Comms watchdog, as remote I/O modules have: centre the valve after this "
+                                                 "long without a request (0: off)")
+      ->capture_default_str()->check(CLI::Range(0, 60000));
   cmd->add_flag("--control-stdin", o.control_stdin,
                 "Fault injection for tests: read 'answers silent|garbage|late MS|normal', 'sensor nan|frozen|fixed V|normal' "
                 "and 'status' lines on standard input");
@@ -98,6 +101,7 @@ int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostrea
   config.plant.noise_std_mm = o.noise_mm;
   config.plant.seed = o.seed;
   config.realtime_priority = o.realtime_priority;
+  config.watchdog_ms = o.watchdog_ms;
 
   BlockedStopSignals signals;  // before start(): the simulator's threads must not take the signals
   if (!signals.ok()) return err << "epa plant-server: cannot block SIGINT/SIGTERM: " << std::strerror(errno) << "\n", 1;

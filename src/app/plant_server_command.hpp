@@ -20,6 +20,7 @@ struct PlantServerOptions {
   std::string plant = "hammerstein";  // or "physics"
   std::string physics_config;    // epa-pneumatic/1 for --plant physics; empty: the defaults
   int sensor_bits = 0;           // physics: ADC resolution over 0-10 V (0: none)
+  int watchdog_ms = 0;           // comms watchdog: valve centred after this long without a request (0: off)
   bool control_stdin = false;    // fault injection commands on standard input (module_fault_control.hpp)
   std::vector<std::string> effects;  // hammerstein: effects hidden in the plant, "valve_lag=0.02"
   double initial_position_mm = 0.0;

@@ -80,6 +80,10 @@ struct RemoteIoSimulator::Impl {
   std::atomic<std::uint64_t> steps{0}, overruns{0}, requests{0};
   std::atomic<int> clients{0};
   std::atomic<double> last_valve_v{0.0};
+  std::atomic<std::int64_t> last_request_ns{0};       // 0: no request yet (the watchdog waits for one)
+  std::atomic<bool> watchdog_tripped{false};
+  std::atomic<std::int64_t> sensor_fault_step{-1};    // plant step at which a sensor fault was injected
+  std::atomic<long> steps_to_safe{-1};
   // Injected faults (ModuleFaults), one atomic each so neither thread ever waits for the injector.
   std::atomic<ModuleFaults::Answers> answers{ModuleFaults::Answers::kNormal};
   std::atomic<int> late_ms{0};
@@ -188,6 +192,9 @@ bool RemoteIoSimulator::Impl::serve_request(int fd, std::uint8_t* query) noexcep
   }
   if (rc == -1) return false;
   requests.fetch_add(1);
+  timespec now{};
+  clock_gettime(CLOCK_MONOTONIC, &now);
+  last_request_ns.store(to_ns(now));
   return true;
 }
 
@@ -209,8 +216,16 @@ void RemoteIoSimulator::Impl::run_plant() noexcept {
       std::lock_guard lock(mapping_mutex);
       valve_v = decode_volts(valve, read_point(valve)).value_or(0.0);  // undecodable: centred valve
     }
+    if (config.watchdog_ms > 0) {
+      const std::int64_t last = last_request_ns.load();
+      const bool tripped = last != 0 && next_ns - last > static_cast<std::int64_t>(config.watchdog_ms) * 1'000'000;
+      watchdog_tripped.store(tripped);
+      if (tripped) valve_v = 0.0;  // the module's own safe output: the valve centred
+    }
     plant->step(valve_v);
     last_valve_v.store(valve_v);
+    if (const std::int64_t at = sensor_fault_step.load(); at >= 0 && steps_to_safe.load() < 0 && valve_v == 0.0)
+      steps_to_safe.store(static_cast<long>(static_cast<std::int64_t>(steps.load()) - at));
     {
       std::lock_guard lock(mapping_mutex);
       switch (sensor_fault.load()) {
@@ -325,11 +340,17 @@ int RemoteIoSimulator::clients() const { return impl_->clients.load(); }
 void RemoteIoSimulator::stop() { impl_->stop(); }
 
 double RemoteIoSimulator::valve_v() const { return impl_->last_valve_v.load(); }
+long RemoteIoSimulator::steps_to_safe_valve() const { return impl_->steps_to_safe.load(); }
+bool RemoteIoSimulator::watchdog_tripped() const { return impl_->watchdog_tripped.load(); }
 
 void RemoteIoSimulator::inject(const ModuleFaults& f) {
   impl_->late_ms.store(f.late_ms);
   impl_->answers.store(f.answers);
   impl_->fixed_sensor_v.store(f.sensor_v);
+  if (f.sensor != ModuleFaults::Sensor::kNormal && impl_->sensor_fault.load() == ModuleFaults::Sensor::kNormal) {
+    impl_->steps_to_safe.store(-1);
+    impl_->sensor_fault_step.store(static_cast<std::int64_t>(impl_->steps.load()));
+  }
   impl_->sensor_fault.store(f.sensor);
 }
 

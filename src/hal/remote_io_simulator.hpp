@@ -40,6 +40,8 @@ struct RemoteIoSimulatorConfig {
   plant::PlantOptions plant;          // model and plant: for start(config) only
   int realtime_priority = 0;          // SCHED_FIFO for both threads, as a module's firmware answers in
                                       // bounded time; 0: normal priority (refusal is not an error)
+  int watchdog_ms = 0;                // a module's comms watchdog: no request for this long (after the
+                                      // first) centres the valve until requests come back; 0: off
 };
 
 // Faults a test injects into the module (epa plant-server --control-stdin): how it answers, and
@@ -75,6 +77,10 @@ class RemoteIoSimulator {
   std::uint64_t requests() const; // Modbus requests answered (including exceptions)
   int clients() const;            // clients connected now
   double valve_v() const;         // the valve command the plant got at its last step
+  // Plant steps from the last sensor fault injected to the first step whose valve command was
+  // 0 V (the appliance's safe command); -1 while none has been. For "safe within one cycle" checks.
+  long steps_to_safe_valve() const;
+  bool watchdog_tripped() const;  // the comms watchdog centres the valve now
 
   // Takes effect at the next request (answers) or plant step (sensor); thread-safe.
   void inject(const ModuleFaults& faults);

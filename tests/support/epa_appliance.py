@@ -79,12 +79,19 @@ class Appliance:
     """`epa serve` on a free loopback port with the given register map and extra config, its data
     (database, runs, log) in a fresh temporary folder."""
 
-    def __init__(self, epa, register_map, extra_config="", start=True):
+    def __init__(self, epa, register_map, extra_config="", start=True, args=(), web_static_dir=None, db=None):
+        """`args` are added to `epa serve`'s command line; with `web_static_dir` the status page runs on
+        a free port too (`web_port`); `db` puts the database elsewhere (a small file system)."""
         self.epa = epa
         self.dir = tempfile.mkdtemp(prefix="epa-test.")
         self.port = free_port()
         self.config = os.path.join(self.dir, "epa.toml")
-        self.db = os.path.join(self.dir, "epa.db")
+        self.db = db or os.path.join(self.dir, "epa.db")
+        self.args = list(args)
+        self.env = None  # the environment of `epa serve` (None: this one's)
+        self.web_port = free_port() if web_static_dir else None
+        web = (f'[web]\naddress = "127.0.0.1"\nport = {self.web_port}\nstatic_dir = "{web_static_dir}"\n'
+               if web_static_dir else "[web]\nenabled = false\n")
         self.log_path = os.path.join(self.dir, "epa.log")
         self.proc = None
         self.log = None
@@ -96,8 +103,7 @@ class Appliance:
                     f"port = {self.port}\n"
                     f'register_map = "{register_map}"\n'
                     f"unlock_key = {UNLOCK_KEY}\n"
-                    "[web]\n"
-                    "enabled = false\n"
+                    + web +
                     "[log]\n"
                     "status_interval_s = 0\n"
                     "[recorder]\n"
@@ -110,8 +116,8 @@ class Appliance:
     def start(self):
         """Starts `epa serve` (again) and waits until it answers Modbus reads."""
         self.log = open(self.log_path, "a")
-        self.proc = subprocess.Popen([self.epa, "serve", "--config", self.config, "--mode", "stop"], stdout=self.log,
-                                     stderr=subprocess.STDOUT, preexec_fn=_die_with_parent)
+        self.proc = subprocess.Popen([self.epa, "serve", "--config", self.config, "--mode", "stop"] + self.args, stdout=self.log,
+                                     stderr=subprocess.STDOUT, preexec_fn=_die_with_parent, env=self.env)
         self.client = None
         try:
             self._wait_ready(10.0)
