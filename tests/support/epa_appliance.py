@@ -79,7 +79,7 @@ class Appliance:
     """`epa serve` on a free loopback port with the given register map and extra config, its data
     (database, runs, log) in a fresh temporary folder."""
 
-    def __init__(self, epa, register_map, extra_config="", start=True, args=(), web_static_dir=None, db=None):
+    def __init__(self, epa, register_map, extra_config="", start=True, args=(), web_static_dir=None, db=None, modbus_extra=""):
         """`args` are added to `epa serve`'s command line; with `web_static_dir` the status page runs on
         a free port too (`web_port`); `db` puts the database elsewhere (a small file system)."""
         self.epa = epa
@@ -103,7 +103,7 @@ class Appliance:
                     f"port = {self.port}\n"
                     f'register_map = "{register_map}"\n'
                     f"unlock_key = {UNLOCK_KEY}\n"
-                    + web +
+                    + modbus_extra + web +
                     "[log]\n"
                     "status_interval_s = 0\n"
                     "[recorder]\n"
