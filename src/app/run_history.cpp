@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "core/audit.hpp"
 #include "core/step_metrics.hpp"
 
 namespace epa::app {
@@ -9,7 +10,7 @@ namespace epa::app {
 store::RunRecord to_run_record(const std::string& path, const core::Run& run) {
   store::RunRecord r;
   r.path = path;
-  r.recorded_ms = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  r.recorded_ms = core::unix_time_ms();
   r.controller = run.meta("controller");
   r.samples = static_cast<std::int64_t>(run.size());
   r.Ts = run.Ts;

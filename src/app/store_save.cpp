@@ -1,6 +1,5 @@
 #include "app/store_save.hpp"
 
-#include <chrono>
 #include <cmath>
 
 #include "store/audit_log.hpp"
@@ -11,21 +10,15 @@
 
 namespace epa::app {
 
-namespace {
-std::int64_t now_ms() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-}  // namespace
-
 core::Result<std::int64_t> save_model(const std::string& db_path, store::ModelRecord model) {
   auto db = store::open_existing_store(db_path);
   if (!db) return db.error();
   auto tx = store::Transaction::begin(*db);
   if (!tx) return tx.error();
-  model.created_ms = now_ms();
+  model.created_ms = core::unix_time_ms();
   auto id = store::ModelTable(*db).find_or_insert(model);
   if (!id) return id.error();
-  if (auto s = store::AuditLog(*db).append({now_ms(), "cli", "save_model", std::nan(""), static_cast<double>(*id)}); !s) return s.error();
+  if (auto s = store::AuditLog(*db).append({core::unix_time_ms(), "cli", "save_model", std::nan(""), static_cast<double>(*id)}); !s) return s.error();
   if (auto s = tx->commit(); !s) return s.error();
   return id;
 }
@@ -36,13 +29,13 @@ core::Result<std::int64_t> save_tuning_set(const std::string& db_path, store::Mo
   if (!db) return db.error();
   auto tx = store::Transaction::begin(*db);
   if (!tx) return tx.error();
-  model.created_ms = set.created_ms = set.modified_ms = now_ms();
+  model.created_ms = set.created_ms = set.modified_ms = core::unix_time_ms();
   auto model_id = store::ModelTable(*db).find_or_insert(model);
   if (!model_id) return model_id.error();
   set.model_id = *model_id;
   auto id = store::TuningSetTable(*db).insert(set);
   if (!id) return id.error();
-  if (auto s = store::AuditLog(*db).append({now_ms(), "cli", "save_tuning_set", std::nan(""), static_cast<double>(*id)}); !s)
+  if (auto s = store::AuditLog(*db).append({core::unix_time_ms(), "cli", "save_tuning_set", std::nan(""), static_cast<double>(*id)}); !s)
     return s.error();
   if (auto s = tx->commit(); !s) return s.error();
   return id;

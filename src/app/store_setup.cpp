@@ -2,19 +2,12 @@
 
 #include <spdlog/spdlog.h>
 
-#include <chrono>
 
 #include "store/active_tuning.hpp"
 #include "store/retained_points.hpp"
 #include "store/schema.hpp"
 
 namespace epa::app {
-
-namespace {
-std::int64_t unix_time_ms() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-}  // namespace
 
 store::StoreSeed make_seed(const std::string& name, const core::ModelFile& model, const ControllerPolynomials& polynomials,
                            control::ControllerKind controller, double lc_mm, double valve_limit_v) {
@@ -36,7 +29,7 @@ store::StoreSeed make_seed(const std::string& name, const core::ModelFile& model
 
 core::Result<StoreStartup> open_tuning_store(const std::string& path, const store::StoreSeed& seed,
                                              std::set<std::string> persisted_points) {
-  auto opened = store::open_store(path, seed, unix_time_ms());
+  auto opened = store::open_store(path, seed, core::unix_time_ms());
   if (!opened) return core::Error{opened.error().code, "store: " + opened.error().message};
   StoreStartup out;
   if (!opened->moved_aside.empty()) {

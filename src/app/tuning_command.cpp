@@ -1,6 +1,5 @@
 #include "app/tuning_command.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <ctime>
 #include <fstream>
@@ -48,10 +47,6 @@ void add_tuning_command(CLI::App& app, TuningOptions& o) {
 }
 
 namespace {
-
-std::int64_t now_ms() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
 
 std::string iso_time(std::int64_t ms) {
   const std::time_t t = static_cast<std::time_t>(ms / 1000);
@@ -187,7 +182,7 @@ int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::os
       if (!tx) return fail(tx.error().message);
       if (auto st = sets.activate(s->set.id); !st) return fail(st.error().message);
       const double old_id = *before ? static_cast<double>(**before) : std::nan("");
-      if (auto st = store::AuditLog(*db).append({now_ms(), "cli", "active_tuning_set", old_id, static_cast<double>(s->set.id)}); !st)
+      if (auto st = store::AuditLog(*db).append({core::unix_time_ms(), "cli", "active_tuning_set", old_id, static_cast<double>(s->set.id)}); !st)
         return fail(st.error().message);
       if (auto st = tx->commit(); !st) return fail(st.error().message);
       out << "tuning set '" << s->set.name << "' (id " << s->set.id << ") is active: a running appliance uses it from its next start\n";
@@ -211,23 +206,23 @@ int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::os
       if (!o.name.empty()) file->set.name = o.name;
       auto tx = store::Transaction::begin(*db);
       if (!tx) return fail(tx.error().message);
-      file->model.created_ms = now_ms();
+      file->model.created_ms = core::unix_time_ms();
       auto model_id = store::ModelTable(*db).find_or_insert(file->model);
       if (!model_id) return fail(model_id.error().message);
       file->set.model_id = *model_id;
-      file->set.created_ms = file->set.modified_ms = now_ms();
+      file->set.created_ms = file->set.modified_ms = core::unix_time_ms();
       file->set.source = "imported from " + o.file + (file->set.source.empty() ? "" : " (" + file->set.source + ")");
       store::TuningSetTable sets(*db);
       auto id = sets.insert(file->set);
       if (!id) return fail(id.error().message + (o.name.empty() ? " (give another with --name)" : ""));
-      if (auto st = store::AuditLog(*db).append({now_ms(), "cli", "import_tuning_set", std::nan(""), static_cast<double>(*id)}); !st)
+      if (auto st = store::AuditLog(*db).append({core::unix_time_ms(), "cli", "import_tuning_set", std::nan(""), static_cast<double>(*id)}); !st)
         return fail(st.error().message);
       if (o.activate) {
         auto before = sets.active_id();
         if (!before) return fail(before.error().message);
         if (auto st = sets.activate(*id); !st) return fail(st.error().message);
         const double old_id = *before ? static_cast<double>(**before) : std::nan("");
-        if (auto st = store::AuditLog(*db).append({now_ms(), "cli", "active_tuning_set", old_id, static_cast<double>(*id)}); !st)
+        if (auto st = store::AuditLog(*db).append({core::unix_time_ms(), "cli", "active_tuning_set", old_id, static_cast<double>(*id)}); !st)
           return fail(st.error().message);
       }
       if (auto st = tx->commit(); !st) return fail(st.error().message);

@@ -3,11 +3,17 @@
 // an AuditSink as one group: who changed which points from what to what, and when. The store
 // (SQLite) keeps them append-only and applies the persisted ones; its counters tell clients
 // how many accepted changes are on disk.
+#include <chrono>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace epa::core {
+
+// Wall-clock time as audit entries, run history and the store keep it: unix milliseconds.
+inline std::int64_t unix_time_ms() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
 
 struct AuditEntry {
   std::int64_t unix_time_ms = 0;

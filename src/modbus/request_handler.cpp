@@ -3,7 +3,6 @@
 #include <modbus.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 namespace epa::modbus {
@@ -20,9 +19,6 @@ constexpr int kHeader = 7;  // MBAP: transaction, protocol, length, unit
 
 int be16(const std::uint8_t* p) { return (p[0] << 8) | p[1]; }
 
-std::int64_t unix_time_ms() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
 
 std::uint16_t* table_words(_modbus_mapping_t* m, Table t) {
   return t == Table::kHoldingRegister ? m->tab_registers : m->tab_input_registers;
@@ -219,7 +215,7 @@ std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, cons
     const ServerStatus server = status(now_ns);
     const PointContext ctx{snap, server};
     std::vector<core::AuditEntry> change;
-    const std::int64_t time_ms = unix_time_ms();
+    const std::int64_t time_ms = core::unix_time_ms();
     for (const auto& w : writes) {
       const WriteEffect effect = w.entry->point->write;
       if (effect == WriteEffect::kUnlock || effect == WriteEffect::kHeartbeat) continue;

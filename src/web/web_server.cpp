@@ -21,9 +21,6 @@ namespace {
 
 constexpr const char* kJson = "application/json";
 
-std::int64_t unix_time_ms() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
 
 // Compares without an early exit, so the time taken says nothing about how much of a guess was right.
 bool constant_time_equal(const std::string& a, const std::string& b) {
@@ -107,7 +104,7 @@ struct WebServer::Impl {
     const std::string source = "web " + req.remote_addr;
     if (audit) {
       std::vector<core::AuditEntry> change;
-      for (const auto& c : d.changes) change.push_back({unix_time_ms(), source, c.point, c.old_value, c.new_value});
+      for (const auto& c : d.changes) change.push_back({core::unix_time_ms(), source, c.point, c.old_value, c.new_value});
       audit->record(change);
     }
     res.set_content(R"({"accepted":true})", kJson);
