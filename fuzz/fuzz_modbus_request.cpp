@@ -1,0 +1,93 @@
+// Modbus TCP requests into the server's request path with the shipped map (registers/epa.csv):
+// the input is a byte stream as a client sends it, cut into ADUs by the MBAP length exactly as
+// ModbusServer does, each one through RequestHandler::handle and then libmodbus' modbus_reply /
+// modbus_reply_exception (which reads the register image the handler filled). Unlocking is
+// configured (key 4321, in the dictionary and the seeds), so tuning writes are reached.
+// Every input starts from a fresh handler and an empty command queue: a run replays alone.
+#include <modbus.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include "control/paper_controller.hpp"
+#include "modbus/request_handler.hpp"
+
+namespace {
+
+using namespace epa;
+
+constexpr int kMbapLength = 6;  // bytes before the MBAP length field's count starts (as the server)
+
+struct Fixture {
+  modbus::RegisterMap map;
+  modbus_mapping_t* image = nullptr;
+  modbus_t* ctx = nullptr;
+  int sink[2] = {-1, -1};  // replies go to sink[0]; sink[1] is drained after each input
+};
+
+Fixture& fixture() {
+  static Fixture* f = [] {
+    auto m = modbus::RegisterMap::load(EPA_SOURCE_DIR "/registers/epa.csv");
+    if (!m) std::abort();
+    auto* fx = new Fixture{std::move(*m)};
+    using modbus::Table;
+    fx->image = modbus_mapping_new_start_address(0, fx->map.end_address(Table::kCoil), 0, fx->map.end_address(Table::kDiscreteInput),
+                                                 0, fx->map.end_address(Table::kHoldingRegister), 0,
+                                                 fx->map.end_address(Table::kInputRegister));
+    fx->ctx = modbus_new_tcp("127.0.0.1", 502);
+    if (!fx->image || !fx->ctx || socketpair(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK, 0, fx->sink) != 0) std::abort();
+    modbus_set_socket(fx->ctx, fx->sink[0]);
+    return fx;
+  }();
+  return *f;
+}
+
+runtime::Snapshot running_snapshot() {
+  runtime::Snapshot s;
+  s.mode = runtime::Mode::kRun;
+  s.position_mm = 123.5;
+  s.setpoint_mm = 100.0;
+  s.tuning.b_r = 1.232;
+  s.tuning.b_l = -1.722;
+  return s;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  Fixture& fx = fixture();
+  runtime::LoopChannels channels(16);
+  channels.snapshot.publish(running_snapshot());
+  modbus::RequestHandler handler(fx.map, modbus::WritePolicy{.read_only = false, .unlock_key = 4321, .unlock_timeout_s = 10},
+                                 1, control::paper_controller_config(control::ControllerKind::kPpFfidz), 50.0, channels,
+                                 nullptr);
+  std::int64_t now_ns = 0;
+  std::size_t pos = 0;
+  while (size - pos >= static_cast<std::size_t>(kMbapLength + 1)) {
+    const std::uint8_t* frame = data + pos;
+    const int protocol = (frame[2] << 8) | frame[3];
+    const int count = (frame[4] << 8) | frame[5];
+    if (protocol != 0 || count < 2 || kMbapLength + count > MODBUS_TCP_MAX_ADU_LENGTH) break;  // the server drops the client
+    const auto total = static_cast<std::size_t>(kMbapLength + count);
+    if (size - pos < total) break;  // incomplete: the server waits for more
+    // The server hands libmodbus its own buffer of the frame; a copy of exactly `total` bytes lets
+    // ASan see a read past the frame.
+    std::unique_ptr<std::uint8_t[]> req(new std::uint8_t[total]);
+    std::copy(frame, frame + total, req.get());
+    const std::uint8_t exception = handler.handle(req.get(), static_cast<int>(total), "127.0.0.1", now_ns, fx.image);
+    if (exception) modbus_reply_exception(fx.ctx, req.get(), exception);
+    else modbus_reply(fx.ctx, req.get(), static_cast<int>(total), fx.image);
+    runtime::Command c;
+    while (channels.commands.try_pop(c)) {}
+    std::uint8_t discard[512];
+    while (read(fx.sink[1], discard, sizeof discard) > 0) {}
+    pos += total;
+    now_ns += 1'000'000'000;  // a second between requests: the 10 s unlock can run out
+  }
+  return 0;
+}
