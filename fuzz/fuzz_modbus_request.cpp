@@ -47,6 +47,14 @@ Fixture& fixture() {
   return *f;
 }
 
+// Counts what reaches the audit trail (the store's queue in the appliance), so the audit path of
+// an accepted write runs too, and the counters registers read something.
+struct CountingSink final : core::AuditSink {
+  std::uint64_t changes = 0;
+  void record(const std::vector<core::AuditEntry>& change) override { changes += change.empty() ? 0 : 1; }
+  core::ChangeCounters counters() const override { return {changes, changes}; }
+};
+
 runtime::Snapshot running_snapshot() {
   runtime::Snapshot s;
   s.mode = runtime::Mode::kRun;
@@ -62,10 +70,11 @@ runtime::Snapshot running_snapshot() {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   Fixture& fx = fixture();
   runtime::LoopChannels channels(16);
+  CountingSink audit;
   channels.snapshot.publish(running_snapshot());
   modbus::RequestHandler handler(fx.map, modbus::WritePolicy{.read_only = false, .unlock_key = 4321, .unlock_timeout_s = 10},
                                  1, control::paper_controller_config(control::ControllerKind::kPpFfidz), 50.0, channels,
-                                 nullptr);
+                                 &audit);
   std::int64_t now_ns = 0;
   std::size_t pos = 0;
   while (size - pos >= static_cast<std::size_t>(kMbapLength + 1)) {
