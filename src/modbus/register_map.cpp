@@ -100,7 +100,8 @@ core::Result<RegisterMap> RegisterMap::parse(const std::string& text, const std:
     if (line.empty() || line[0] == '#') continue;
     const auto f = split_csv(line);
     if (column.empty()) {
-      for (std::size_t i = 0; i < f.size(); ++i) column[f[i]] = static_cast<int>(i);
+      for (std::size_t i = 0; i < f.size(); ++i)  // a repeated name would leave an index past the row's fields
+        if (!column.emplace(f[i], static_cast<int>(i)).second) return fail("header: column '" + f[i] + "' appears twice");
       for (const char* required : {"name", "table", "address", "type"})
         if (!column.count(required)) return fail(std::string("header: missing column '") + required + "'");
       static const std::vector<std::string> kKnown = {"name", "table", "address", "type", "word_order", "scale", "unit",

@@ -63,6 +63,14 @@ TEST(RegisterMap, UnknownColumnAndMissingColumnAreRefused) {
   EXPECT_NE(m.error().message.find("missing column 'address'"), std::string::npos) << m.error().message;
 }
 
+// Found by fuzz_register_map: with a column named twice the row was checked against the number of
+// distinct names, and the second name's index read past the end of a row that short.
+TEST(RegisterMap, ARepeatedColumnIsRefused) {
+  auto m = RegisterMap::parse("name,table,address,type,min,min,max\nsetpoint_mm,holding,0,float32,0,500\n", "m.csv");
+  ASSERT_FALSE(m.has_value());
+  EXPECT_NE(m.error().message.find("m.csv:1: header: column 'min' appears twice"), std::string::npos) << m.error().message;
+}
+
 TEST(RegisterMap, QuotedDescriptionsMayHoldCommas) {
   auto m = RegisterMap::parse(kHeader + "position_mm,input,0,float32,,,mm,r,,,,no,\"position, measured\"\n", "m.csv");
   ASSERT_TRUE(m.has_value()) << m.error().message;
