@@ -32,8 +32,9 @@ class TableReader {
   void integer(const char* key, int& out, long lo, long hi) {
     const toml::node* n = find(key);
     if (!n) return;
-    const auto v = n->value<std::int64_t>();
-    if (!v || !n->is_integer()) return fail(*n, key, "must be a whole number");
+    // is_integer() first: toml++ converts a float such as 5e22 to int64 without a range check (UB).
+    const auto v = n->is_integer() ? n->value<std::int64_t>() : std::nullopt;
+    if (!v) return fail(*n, key, "must be a whole number");
     if (*v < lo || *v > hi) return fail(*n, key, "must be within " + std::to_string(lo) + ".." + std::to_string(hi));
     out = static_cast<int>(*v);
   }

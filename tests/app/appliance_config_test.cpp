@@ -67,6 +67,13 @@ TEST(ApplianceConfig, WrongTypeAndOutOfRangeNameTheKey) {
   EXPECT_NE(error_of("[startup]\nmode = \"fault\"\n").find("startup.mode"), std::string::npos);
 }
 
+// Found by fuzz_config: a float given for an integer key went through toml++'s unchecked
+// float-to-int64 conversion (undefined behaviour for 5e22) before the type was checked.
+TEST(ApplianceConfig, AFloatForAWholeNumberIsRefusedWhateverItsSize) {
+  EXPECT_NE(error_of("[modbus]\nport = 5e22\n").find("modbus.port must be a whole number"), std::string::npos);
+  EXPECT_NE(error_of("[modbus]\nport = 502.0\n").find("modbus.port must be a whole number"), std::string::npos);
+}
+
 TEST(ApplianceConfig, SyntaxErrorNamesTheLine) {
   EXPECT_NE(error_of("[loop]\nperiod_s = = 1\n").find("test.toml:2:"), std::string::npos);
 }
