@@ -5,6 +5,8 @@
 # Nothing is left out: the allocation-counting tests replace operator new with malloc-backed
 # versions, which ASan intercepts like any malloc, and the benchmarks are not ctest tests. The
 # interop, crash, HIL and browser tests run the instrumented epa binary as their appliance.
+# hardening.fault_injection preloads a shim (LD_PRELOAD) ahead of the ASan runtime, so the asan
+# test preset sets verify_asan_link_order=0; the runtime is still loaded and intercepts as usual.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
