@@ -1,6 +1,7 @@
 // Run-file text (epa-run/1) into the reader that `epa identify`, `epa diagnose` and the tests use:
-// a run or a parse error, never a crash; with and without an expected Ts. A run that parses must
-// be written back and read again (the writer's promise: what it writes, the reader reads).
+// a run or a parse error, never a crash; with and without an expected Ts. A run that parses is
+// written back and read again, so the writer meets every odd run the reader lets through (the
+// reread may refuse it: the writer rounds times, and a run with odd times is refused, not crashed).
 #include <cstddef>
 #include <cstdint>
 #include <sstream>
