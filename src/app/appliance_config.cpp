@@ -1,13 +1,13 @@
 #include "app/appliance_config.hpp"
 
+#include "core/text_file.hpp"
+
 #include "plant/effects.hpp"
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <set>
-#include <sstream>
 #include <toml++/toml.h>
 
 namespace epa::app {
@@ -310,11 +310,9 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
 }
 
 core::Result<ApplianceConfig> read_appliance_config(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return core::io_error(path + ": cannot open the configuration file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  auto c = parse_appliance_config(ss.str(), path);
+  auto text = core::read_text_file(path, "configuration file");
+  if (!text) return text.error();
+  auto c = parse_appliance_config(*text, path);
   if (!c) return c;
   // Files the configuration names are found next to it, wherever the appliance is started from.
   const auto folder = std::filesystem::path(path).parent_path();

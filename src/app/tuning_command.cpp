@@ -2,12 +2,11 @@
 
 #include <cmath>
 #include <ctime>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "app/output_file.hpp"
 #include "core/format.hpp"
+#include "core/text_file.hpp"
 #include "store/audit_log.hpp"
 #include "store/model_table.hpp"
 #include "store/run_table.hpp"
@@ -198,10 +197,9 @@ int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::os
     }
 
     if (cmd->got_subcommand("import")) {
-      std::ifstream in(o.file);
-      std::stringstream text;
-      text << in.rdbuf();
-      auto file = store::parse_tuning_toml(text.str(), o.file);
+      auto text = core::read_text_file(o.file, "tuning file");
+      if (!text) return fail(text.error().message);
+      auto file = store::parse_tuning_toml(*text, o.file);
       if (!file) return fail(file.error().message);
       if (!o.name.empty()) file->set.name = o.name;
       auto tx = store::Transaction::begin(*db);

@@ -1,11 +1,11 @@
 #include "core/model_file.hpp"
 
 #include <charconv>
-#include <fstream>
 #include <sstream>
 #include <toml++/toml.h>
 
 #include "core/atomic_file.hpp"
+#include "core/text_file.hpp"
 #include "core/toml_number.hpp"
 
 namespace epa::core {
@@ -81,11 +81,9 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
 }
 
 Result<ModelFile> read_model_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return io_error(path + ": cannot open model file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_model_toml(ss.str(), path);
+  auto text = read_text_file(path, "model file");
+  if (!text) return text.error();
+  return parse_model_toml(*text, path);
 }
 
 std::string format_model_toml(const ModelFile& f) {

@@ -1,9 +1,10 @@
 #include "modbus/register_map.hpp"
 
+#include "core/text_file.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -78,11 +79,9 @@ std::string_view to_string(DataType t) {
 bool is_bit_table(Table t) { return t == Table::kCoil || t == Table::kDiscreteInput; }
 
 core::Result<RegisterMap> RegisterMap::load(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return core::io_error(path + ": cannot open the register map");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse(ss.str(), path);
+  auto text = core::read_text_file(path, "register map");
+  if (!text) return text.error();
+  return parse(*text, path);
 }
 
 core::Result<RegisterMap> RegisterMap::parse(const std::string& text, const std::string& src) {

@@ -1,11 +1,11 @@
 #include "plant/pneumatic_params.hpp"
 
+#include "core/text_file.hpp"
+
 #include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <string_view>
 #include <toml++/toml.h>
 
@@ -141,11 +141,9 @@ core::Result<PneumaticParams> parse_pneumatic_toml(const std::string& text, cons
 }
 
 core::Result<PneumaticParams> read_pneumatic_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return core::io_error(path + ": cannot open pneumatic plant file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_pneumatic_toml(ss.str(), path);
+  auto text = core::read_text_file(path, "pneumatic plant file");
+  if (!text) return text.error();
+  return parse_pneumatic_toml(*text, path);
 }
 
 std::string format_pneumatic_toml(const PneumaticParams& p) {
