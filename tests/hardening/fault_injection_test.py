@@ -217,19 +217,19 @@ def run_faults(rig, failures, rows):
 
 
 def fill(path):
-    """Writes a file until the file system is full."""
-    with open(path, "wb") as f:
+    """Writes a file until the file system is full (unbuffered, so nothing is left to flush when
+    the file is closed on a full disk)."""
+    with open(path, "wb", buffering=0) as f:
         block = b"\0" * 65536
-        try:
-            while True:
-                f.write(block)
-                f.flush()
-        except OSError:
-            pass
-    try:
-        os.sync()
-    except OSError:
-        pass
+        while True:
+            try:
+                if f.write(block) < len(block):
+                    block = block[:4096] if len(block) > 4096 else block
+            except OSError:
+                if len(block) == 1:
+                    break
+                block = block[: max(1, len(block) // 16)]  # fill the last pages too
+    os.sync()
 
 
 def run_disk(rig, mount, failures, rows):
