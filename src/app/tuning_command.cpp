@@ -117,6 +117,17 @@ core::Result<SetWithModel> find_set(store::Database& db, const std::string& key)
   return SetWithModel{std::move(*set), std::move(*model)};
 }
 
+// Makes set `id` the active one and audits the switch (old id -> new id), inside the caller's
+// transaction.
+core::Status activate_audited(store::Database& db, std::int64_t id) {
+  store::TuningSetTable sets(db);
+  auto before = sets.active_id();
+  if (!before) return before.error();
+  if (auto st = sets.activate(id); !st) return st;
+  const double old_id = *before ? static_cast<double>(**before) : std::nan("");
+  return store::AuditLog(db).append({core::unix_time_ms(), "cli", "active_tuning_set", old_id, static_cast<double>(id)});
+}
+
 std::string number_or_dash(const std::optional<double>& v) { return v ? core::format_number(*v) : "-"; }
 
 int list(store::Database& db, std::ostream& out) {
@@ -174,15 +185,9 @@ int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::os
     if (cmd->got_subcommand("activate")) {
       auto s = find_set(*db, o.set);
       if (!s) return fail(s.error().message);
-      store::TuningSetTable sets(*db);
-      auto before = sets.active_id();
-      if (!before) return fail(before.error().message);
       auto tx = store::Transaction::begin(*db);
       if (!tx) return fail(tx.error().message);
-      if (auto st = sets.activate(s->set.id); !st) return fail(st.error().message);
-      const double old_id = *before ? static_cast<double>(**before) : std::nan("");
-      if (auto st = store::AuditLog(*db).append({core::unix_time_ms(), "cli", "active_tuning_set", old_id, static_cast<double>(s->set.id)}); !st)
-        return fail(st.error().message);
+      if (auto st = activate_audited(*db, s->set.id); !st) return fail(st.error().message);
       if (auto st = tx->commit(); !st) return fail(st.error().message);
       out << "tuning set '" << s->set.name << "' (id " << s->set.id << ") is active: a running appliance uses it from its next start\n";
       return 0;
@@ -210,19 +215,12 @@ int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::os
       file->set.model_id = *model_id;
       file->set.created_ms = file->set.modified_ms = core::unix_time_ms();
       file->set.source = "imported from " + o.file + (file->set.source.empty() ? "" : " (" + file->set.source + ")");
-      store::TuningSetTable sets(*db);
-      auto id = sets.insert(file->set);
+      auto id = store::TuningSetTable(*db).insert(file->set);
       if (!id) return fail(id.error().message + (o.name.empty() ? " (give another with --name)" : ""));
       if (auto st = store::AuditLog(*db).append({core::unix_time_ms(), "cli", "import_tuning_set", std::nan(""), static_cast<double>(*id)}); !st)
         return fail(st.error().message);
-      if (o.activate) {
-        auto before = sets.active_id();
-        if (!before) return fail(before.error().message);
-        if (auto st = sets.activate(*id); !st) return fail(st.error().message);
-        const double old_id = *before ? static_cast<double>(**before) : std::nan("");
-        if (auto st = store::AuditLog(*db).append({core::unix_time_ms(), "cli", "active_tuning_set", old_id, static_cast<double>(*id)}); !st)
-          return fail(st.error().message);
-      }
+      if (o.activate)
+        if (auto st = activate_audited(*db, *id); !st) return fail(st.error().message);
       if (auto st = tx->commit(); !st) return fail(st.error().message);
       out << "imported tuning set '" << file->set.name << "' (id " << *id << ")" << (o.activate ? ", active from the appliance's next start" : "") << "\n";
       return 0;
