@@ -22,14 +22,14 @@ core::Result<std::vector<AuditRecord>> AuditLog::query(const AuditFilter& f) {
   stmt->bind(1, f.since_ms).bind(2, f.until_ms).bind(3, f.source).bind(4, f.point);
   stmt->bind(5, f.limit == 0 ? std::int64_t{-1} : static_cast<std::int64_t>(f.limit));
   std::vector<AuditRecord> out;
-  for (;;) {
-    auto row = stmt->step();
-    if (!row) return row.error();
-    if (!*row) return out;
-    out.push_back({stmt->column_int(0),
-                   {stmt->column_int(1), stmt->column_text(2), stmt->column_text(3), stmt->column_double_or_nan(4),
-                    stmt->column_double_or_nan(5)}});
-  }
+  auto s = stmt->each_row([&out](const Statement& row) {
+    out.push_back({row.column_int(0),
+                   {row.column_int(1), row.column_text(2), row.column_text(3), row.column_double_or_nan(4),
+                    row.column_double_or_nan(5)}});
+    return core::ok();
+  });
+  if (!s) return s.error();
+  return out;
 }
 
 core::Result<std::int64_t> AuditLog::count() {

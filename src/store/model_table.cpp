@@ -83,14 +83,14 @@ core::Result<std::vector<ModelRecord>> ModelTable::all() {
   auto stmt = db_.prepare(std::string("SELECT ") + kColumns + " FROM models ORDER BY id");
   if (!stmt) return stmt.error();
   std::vector<ModelRecord> out;
-  for (;;) {
-    auto row = stmt->step();
-    if (!row) return row.error();
-    if (!*row) return out;
-    auto r = read_row(*stmt);
+  auto s = stmt->each_row([&out](const Statement& row) -> core::Status {
+    auto r = read_row(row);
     if (!r) return r.error();
     out.push_back(std::move(*r));
-  }
+    return core::ok();
+  });
+  if (!s) return s.error();
+  return out;
 }
 
 }  // namespace epa::store

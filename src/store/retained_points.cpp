@@ -17,12 +17,12 @@ core::Result<std::map<std::string, double>> RetainedPoints::all() {
   auto stmt = db_.prepare("SELECT point, value FROM retained_points");
   if (!stmt) return stmt.error();
   std::map<std::string, double> out;
-  for (;;) {
-    auto row = stmt->step();
-    if (!row) return row.error();
-    if (!*row) return out;
-    out[stmt->column_text(0)] = stmt->column_double(1);
-  }
+  auto s = stmt->each_row([&out](const Statement& row) {
+    out[row.column_text(0)] = row.column_double(1);
+    return core::ok();
+  });
+  if (!s) return s.error();
+  return out;
 }
 
 }  // namespace epa::store

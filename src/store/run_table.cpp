@@ -22,26 +22,26 @@ core::Result<std::vector<RunRecord>> RunTable::recent(std::size_t limit) {
   if (!stmt) return stmt.error();
   stmt->bind(1, static_cast<std::int64_t>(limit));
   std::vector<RunRecord> out;
-  for (;;) {
-    auto row = stmt->step();
-    if (!row) return row.error();
-    if (!*row) return out;
+  auto s = stmt->each_row([&out](const Statement& row) {
     RunRecord r;
-    r.id = stmt->column_int(0);
-    r.path = stmt->column_text(1);
-    r.recorded_ms = stmt->column_int(2);
-    r.controller = stmt->column_text(3);
-    if (!stmt->column_is_null(4)) r.tuning_set_id = stmt->column_int(4);
-    r.samples = stmt->column_int(5);
-    r.Ts = stmt->column_double(6);
-    r.from_mm = stmt->column_optional_double(7);
-    r.to_mm = stmt->column_optional_double(8);
-    r.rise_s = stmt->column_optional_double(9);
-    r.settling_s = stmt->column_optional_double(10);
-    r.ess_mm = stmt->column_optional_double(11);
-    r.overshoot_pct = stmt->column_optional_double(12);
+    r.id = row.column_int(0);
+    r.path = row.column_text(1);
+    r.recorded_ms = row.column_int(2);
+    r.controller = row.column_text(3);
+    if (!row.column_is_null(4)) r.tuning_set_id = row.column_int(4);
+    r.samples = row.column_int(5);
+    r.Ts = row.column_double(6);
+    r.from_mm = row.column_optional_double(7);
+    r.to_mm = row.column_optional_double(8);
+    r.rise_s = row.column_optional_double(9);
+    r.settling_s = row.column_optional_double(10);
+    r.ess_mm = row.column_optional_double(11);
+    r.overshoot_pct = row.column_optional_double(12);
     out.push_back(std::move(r));
-  }
+    return core::ok();
+  });
+  if (!s) return s.error();
+  return out;
 }
 
 }  // namespace epa::store

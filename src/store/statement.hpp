@@ -34,6 +34,18 @@ class Statement {
   Statement& bind_null(int index);
 
   core::Result<bool> step();  // true: a row is ready to read
+
+  // Steps through every row, calling visit(*this) (which returns a core::Status) for each; stops
+  // at the first error, SQLite's or visit's.
+  template <typename Visit>
+  core::Status each_row(Visit&& visit) {
+    for (;;) {
+      auto row = step();
+      if (!row) return row.error();
+      if (!*row) return core::ok();
+      if (core::Status s = visit(*this); !s) return s;
+    }
+  }
   core::Status run();         // steps a statement that returns no rows
   void reset();
 

@@ -26,13 +26,12 @@ core::Result<std::string> integrity_problem(Database& db) {
   auto stmt = db.prepare("PRAGMA integrity_check");
   if (!stmt) return stmt.error();
   std::string report;
-  for (;;) {
-    auto row = stmt->step();
-    if (!row) return row.error();
-    if (!*row) break;
-    const std::string line = stmt->column_text(0);
+  auto s = stmt->each_row([&report](const Statement& row) {
+    const std::string line = row.column_text(0);
     if (line != "ok") report += (report.empty() ? "" : "; ") + line;
-  }
+    return core::ok();
+  });
+  if (!s) return s.error();
   return report;
 }
 

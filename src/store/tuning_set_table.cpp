@@ -49,14 +49,14 @@ void bind_values(Statement& s, const TuningSet& t) {
 
 core::Result<std::vector<TuningSet>> read_all(Statement& stmt) {
   std::vector<TuningSet> out;
-  for (;;) {
-    auto row = stmt.step();
-    if (!row) return row.error();
-    if (!*row) return out;
-    auto t = read_row(stmt);
+  auto s = stmt.each_row([&out](const Statement& row) -> core::Status {
+    auto t = read_row(row);
     if (!t) return t.error();
     out.push_back(std::move(*t));
-  }
+    return core::ok();
+  });
+  if (!s) return s.error();
+  return out;
 }
 
 }  // namespace
