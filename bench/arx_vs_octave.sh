@@ -4,7 +4,7 @@
 #
 #   bench/arx_vs_octave.sh [BUILD_DIR=build/release] [SAMPLES=100000] [REPEATS=20]
 #
-# Installs octave and octave-control (Debian) if missing. Both sides are timed from data in memory
+# Installs octave and octave-control (Debian) if missing (scripts/install-deps.sh bench). Both sides are timed from data in memory
 # to coefficients (regression matrix, QR, solve), repeated, best and median reported; Octave's
 # start-up, `pkg load` and file reading are outside its tic/toc.
 #
@@ -21,13 +21,7 @@ repeats=${3:-20}
 here=$(cd "$(dirname "$0")/.." && pwd)
 cd "$here"
 
-if ! command -v octave-cli >/dev/null || ! octave-cli -q --eval 'pkg load control' >/dev/null 2>&1; then
-  sudo=""
-  [ "$(id -u)" -ne 0 ] && sudo="sudo"
-  echo "arx_vs_octave: installing octave and octave-control"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends octave octave-control >/dev/null
-fi
+scripts/install-deps.sh bench  # octave, octave-control
 
 cmake --build "$build" --target arx_bench >/dev/null
 work=$(mktemp -d)

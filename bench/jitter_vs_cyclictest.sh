@@ -7,7 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
-command -v cyclictest >/dev/null || { echo "cyclictest missing: apt-get install rt-tests" >&2; exit 1; }
+scripts/install-deps.sh bench  # cyclictest (rt-tests)
 cmake --build --preset release --target loop_jitter_bench >/dev/null
 out=$(mktemp -d)
 

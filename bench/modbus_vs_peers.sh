@@ -29,8 +29,8 @@ seconds=${1:-10}
 warmup=1
 py=/usr/bin/python3  # Debian's interpreter: python3-pymodbus lives there
 "$py" -c 'import pymodbus.server' 2>/dev/null ||
-  { echo "pymodbus 3.0 missing: apt-get install -y python3-pymodbus python3-serial" >&2; exit 1; }
-command -v taskset >/dev/null && command -v chrt >/dev/null || { echo "taskset, chrt missing: apt-get install -y util-linux" >&2; exit 1; }
+  { echo "pymodbus 3.0 missing: run scripts/install-deps.sh" >&2; exit 1; }
+command -v taskset >/dev/null && command -v chrt >/dev/null || { echo "taskset, chrt missing: run scripts/install-deps.sh" >&2; exit 1; }
 [[ $EUID -eq 0 ]] || echo "warning: not root: the appliance's loop runs without SCHED_FIFO and memory locking" >&2
 
 online_cpus=$(cat /sys/devices/system/cpu/online)  # e.g. 0-1
@@ -90,6 +90,10 @@ status_interval_s = 0
 address = "127.0.0.1"
 port = $port
 register_map = "$repo/registers/epa.csv"
+[web]
+address = "127.0.0.1"
+port = $(free_port)
+static_dir = "$repo/web"
 [hal]
 backend = "sim"
 EOF

@@ -1,18 +1,41 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages the project builds, tests and runs with. Idempotent: it only
-# calls apt-get when something is missing, so repeated runs cost nothing.
+# Installs the Debian 12 packages the project builds, tests, runs and benchmarks with. Idempotent:
+# it only calls apt-get when something is missing, so repeated runs cost nothing.
+#
+#   scripts/install-deps.sh          # build, run and the whole test suite (scripts/run.sh, scripts/test.sh)
+#   scripts/install-deps.sh bench    # also what the benchmarks compare against (bench/, CI's smoke step)
+#
+# Every program a script, test or benchmark calls is named here, even the ones a minimal Debian
+# usually has, so nothing is assumed from the machine (a fresh debootstrap root has no curl and
+# no python3). A test that needs a program checks for it and fails naming this script.
 set -euo pipefail
 
 packages=(
+  # build
   build-essential cmake ninja-build ccache pkg-config
   libeigen3-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libjs-chart.js libpagmo-dev libnlopt-cxx-dev libsqlite3-dev sqlite3
+  libjs-chart.js libpagmo-dev libnlopt-cxx-dev libsqlite3-dev
+  libmodbus-dev libcomedi-dev libspdlog-dev libsystemd-dev libcpp-httplib-dev
+  # sanitizer and fuzz builds (scripts/test-sanitizers.sh, test-tsan.sh, fuzz.sh)
   clang libclang-rt-14-dev
-  libmodbus-dev libcomedi-dev libspdlog-dev libsystemd-dev
-  rt-tests mbpoll python3-pymodbus python3-serial-asyncio
-  libcpp-httplib-dev chromium
+  # programs the tests and scripts call: Modbus clients (mbpoll, Debian's python3 with pymodbus),
+  # the browser, HTTP (curl), taskset/chrt (util-linux), mount (fault injection); sqlite3 is the
+  # database's own shell, for looking into the tuning store (epa.db)
+  python3 python3-pymodbus python3-serial-asyncio mbpoll chromium curl sqlite3 util-linux mount
 )
+bench_packages=(
+  # bench/jitter_vs_cyclictest.sh: cyclictest is the scan cycle's timing peer
+  rt-tests
+  # bench/arx_vs_octave.sh: GNU Octave's control package is the ARX peer
+  octave octave-control
+)
+
+case "${1:-}" in
+  "") ;;
+  bench) packages+=("${bench_packages[@]}") ;;
+  *) echo "usage: $0 [bench]" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do
