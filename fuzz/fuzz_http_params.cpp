@@ -1,31 +1,53 @@
-// HTTP API parameters: a POST body into the command validation of each endpoint (setpoint, mode,
-// reset), in a running and a faulted state; then the same bytes as an epa-tuning/1 TOML file
-// (`epa tuning import`). Validation must answer with a status or the commands, never crash, and
-// an accepted setpoint must be within the configured limits.
+// HTTP API parameters: a POST body read into point writes for each command endpoint (setpoint,
+// mode, reset, points), then decided by the write gate in a running, a manual and a faulted
+// state; then the same bytes as an epa-tuning/1 TOML file (`epa tuning import`). Nothing may
+// crash; a malformed body carries no writes; whatever the gate accepts, the scan cycle's own rules
+// accept in the same state, and an accepted setpoint is within the configured limits.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
+#include "control/paper_controller.hpp"
+#include "points/write_gate.hpp"
 #include "store/tuning_file.hpp"
-#include "web/command_validation.hpp"
+#include "web/command_body.hpp"
+
+namespace {
+
+struct Rig {
+  epa::runtime::RuntimeConfig config;
+  epa::runtime::LoopChannels channels{16};
+  epa::points::WriteGate gate;
+  Rig()
+      : gate(*epa::points::WriteLimits::from_config(config, "fuzz"), config,
+             epa::control::paper_controller_config(epa::control::ControllerKind::kPpFfidz), channels, nullptr) {}
+};
+
+}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace epa;
+  static Rig rig;
   const std::string body(reinterpret_cast<const char*>(data), size);
-  const runtime::RuntimeConfig limits;
-  runtime::Snapshot snap;
-  snap.mode = runtime::Mode::kRun;
-  for (int faulted = 0; faulted < 2; ++faulted) {
-    if (faulted) snap.mode = runtime::Mode::kFault;
-    for (auto endpoint : {web::CommandEndpoint::kSetpoint, web::CommandEndpoint::kMode, web::CommandEndpoint::kReset}) {
-      const auto d = web::validate_command(endpoint, body, snap, limits);
-      if (d.status == 200 && !d.error.empty()) __builtin_trap();
-      if (d.status != 200 && !d.commands.empty()) __builtin_trap();
-      for (const auto& c : d.commands)
+  const points::Requester who{"web fuzz", true, "", true};
+  for (auto mode : {runtime::Mode::kRun, runtime::Mode::kManual, runtime::Mode::kFault}) {
+    runtime::Snapshot snap;
+    snap.mode = mode;
+    for (auto endpoint : {web::CommandEndpoint::kSetpoint, web::CommandEndpoint::kMode, web::CommandEndpoint::kReset,
+                          web::CommandEndpoint::kPoints}) {
+      const auto parsed = web::parse_command_body(endpoint, body);
+      if (!parsed.error.empty() && !parsed.writes.empty()) __builtin_trap();
+      if (!parsed.error.empty()) continue;
+      std::vector<runtime::Command> commands;
+      const auto r = rig.gate.decide(parsed.writes, who, snap, &commands);
+      if (!r.accepted() && (r.reason.empty() || !commands.empty())) __builtin_trap();
+      for (const auto& c : commands) {
+        if (runtime::check_command(c, mode, rig.config) != runtime::CommandRefusal::kNone) __builtin_trap();
         if (c.kind == runtime::CommandKind::kSetpoint &&
-            !(c.value >= limits.setpoint_min_mm && c.value <= limits.setpoint_max_mm))
+            !(c.value >= rig.config.setpoint_min_mm && c.value <= rig.config.setpoint_max_mm))
           __builtin_trap();
+      }
     }
   }
   (void)store::parse_tuning_toml(body, "fuzz.toml");

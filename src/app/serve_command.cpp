@@ -79,18 +79,31 @@ std::string describe_snapshot(const runtime::Snapshot& s) {
 struct ControlSetup {
   core::ModelFile plant_model;            // the configuration's model: what the sim backend simulates
   StoreStartup store;                     // the active tuning set, its model, the store thread
-  control::ControllerConfig tuning_base;  // what tuning writes edit (Modbus)
+  control::ControllerConfig tuning_base;  // the running tuning, handed to its owner, the write gate
   runtime::Tuning tuning;
 };
 
 // The points whose accepted values the store keeps: the register map's persisted column; without
 // Modbus, the setpoint (the only persisted point the web page can change).
-std::set<std::string> persisted_points(const std::optional<modbus::RegisterMap>& map) {
-  if (!map) return {"setpoint_mm"};
-  std::set<std::string> out;
+std::set<points::PointId> persisted_points(const std::optional<modbus::RegisterMap>& map) {
+  if (!map) return {points::PointId::kSetpoint};
+  std::set<points::PointId> out;
   for (const auto& e : map->entries())
-    if (e.persisted) out.insert(std::string(e.point->name));
+    if (e.persisted) out.insert(e.point->id);
   return out;
+}
+
+// The one set of write limits: the catalog's, narrowed by the configuration and the register map;
+// the start-up setpoint (configuration or --setpoint) must lie within them too.
+core::Result<points::WriteLimits> write_limits(const ApplianceConfig& c, const std::string& config_path,
+                                               const std::optional<modbus::RegisterMap>& map) {
+  auto limits = points::WriteLimits::from_config(c.runtime, config_path);
+  if (!limits) return limits.error();
+  if (map)
+    if (auto s = modbus::narrow_limits(*map, *limits); !s) return s.error();
+  if (auto why = limits->check(points::PointId::kSetpoint, c.runtime.start_setpoint_mm); !why.empty())
+    return core::invalid_argument("start-up setpoint: " + why);
+  return limits;
 }
 
 core::Result<ControlSetup> prepare_control(ApplianceConfig& c, const std::optional<modbus::RegisterMap>& map, bool setpoint_given) {
@@ -126,10 +139,8 @@ core::Result<ControlSetup> prepare_control(ApplianceConfig& c, const std::option
 }
 
 core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const ApplianceConfig& c, const modbus::RegisterMap& map,
-                                                                 const ControlSetup& control, runtime::LoopChannels& channels,
-                                                                 core::AuditSink& audit) {
-  auto server = modbus::ModbusServer::start(c.modbus, map, control.tuning_base, c.runtime.mm_per_volt, channels, &audit,
-                                            [](const std::string& line) { spdlog::info("{}", line); });
+                                                                 points::WriteGate& gate, runtime::LoopChannels& channels) {
+  auto server = modbus::ModbusServer::start(c.modbus, map, gate, channels, [](const std::string& line) { spdlog::info("{}", line); });
   if (!server) return server.error();
   const auto& p = c.modbus.policy;
   spdlog::info("modbus: listening on {}:{} (unit {}, map {}, {} points, {})", c.modbus.address, (*server)->port(),
@@ -139,7 +150,7 @@ core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const Appliance
 }
 
 core::Result<std::unique_ptr<web::WebServer>> start_web(const ApplianceConfig& c, runtime::LoopChannels& channels,
-                                                        web::RecentAudit& audit, const modbus::ModbusServer* mb,
+                                                        points::WriteGate& gate, web::RecentAudit& audit, const modbus::ModbusServer* mb,
                                                         const store::StoreWriter& store, const std::string& set_name) {
   auto modbus_stats = [mb] {
     return mb ? web::ModbusStats{true, mb->clients(), mb->requests(), mb->exceptions()} : web::ModbusStats{};
@@ -149,7 +160,7 @@ core::Result<std::unique_ptr<web::WebServer>> start_web(const ApplianceConfig& c
     const auto health = store.health();
     return web::StoreStats{true, health.ok, counters.accepted, counters.saved, health.last_error, set_name};
   };
-  auto server = web::WebServer::start(c.web, channels, c.runtime, &audit, modbus_stats, store_stats);
+  auto server = web::WebServer::start(c.web, channels, &gate, &audit, modbus_stats, store_stats);
   if (!server) return server.error();
   spdlog::info("web: listening on {}:{} (static files {}, commands {})", c.web.address, (*server)->port(), c.web.static_dir,
                c.web.token.empty() ? "disabled: no token configured" : "enabled with the token");
@@ -169,9 +180,11 @@ void log_changes(const runtime::Snapshot& previous, const runtime::Snapshot& s) 
 }
 
 // The main thread while the appliance runs: waits for SIGTERM/SIGINT (or the duration), logs
-// events and a periodic status, and pings the systemd watchdog only while the loop advances,
-// so a stuck loop gets the unit restarted.
-void supervise(const ApplianceConfig& c, double duration_s, const runtime::LoopChannels& channels, const sigset_t& signals) {
+// events and a periodic status, has the gate log and audit the commands the loop refused after
+// acceptance, and pings the systemd watchdog only while the loop advances, so a stuck loop gets
+// the unit restarted.
+void supervise(const ApplianceConfig& c, double duration_s, const runtime::LoopChannels& channels, points::WriteGate& gate,
+               const sigset_t& signals) {
   std::uint64_t watchdog_usec = 0;
   const bool watchdog = sd_watchdog_enabled(0, &watchdog_usec) > 0;
   const auto started = std::chrono::steady_clock::now();
@@ -188,6 +201,7 @@ void supervise(const ApplianceConfig& c, double duration_s, const runtime::LoopC
     const auto now = std::chrono::steady_clock::now();
     const runtime::Snapshot s = channels.snapshot.read();
     log_changes(previous, s);
+    gate.take_refusals([](const std::string& line) { spdlog::warn("{}", line); });
     previous = s;
     if (c.status_interval_s > 0 && now - last_status >= std::chrono::duration<double>(c.status_interval_s)) {
       spdlog::info("status: {}", describe_snapshot(s));
@@ -236,6 +250,8 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
     if (!map) return fail(map.error());
     register_map = std::move(*map);
   }
+  auto limits = write_limits(c, o.config_path, register_map);
+  if (!limits) return fail(limits.error());
   auto control = prepare_control(c, register_map, o.setpoint_mm >= 0.0);
   if (!control) return fail(control.error());
   for (const auto& line : control->store.notes) spdlog::info("{}", line);
@@ -275,15 +291,16 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   for (int i = 0; i < 200 && channels.snapshot.read().cycle == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   LogAuditSink log_audit(&store_writer);
   web::RecentAudit audit(&log_audit);  // the last entries for the status page, the log, the store
+  points::WriteGate gate(std::move(*limits), c.runtime, control->tuning_base, channels, &audit);  // every interface's writes
   std::unique_ptr<modbus::ModbusServer> modbus_server;
   if (register_map) {
-    auto server = start_modbus(c, *register_map, *control, channels, audit);
+    auto server = start_modbus(c, *register_map, gate, channels);
     if (!server) return spdlog::error("{}", server.error().message), 1;
     modbus_server = std::move(*server);
   }
   std::unique_ptr<web::WebServer> web_server;
   if (c.web_enabled) {
-    auto server = start_web(c, channels, audit, modbus_server.get(), store_writer, control->store.set.name);
+    auto server = start_web(c, channels, gate, audit, modbus_server.get(), store_writer, control->store.set.name);
     if (!server) return spdlog::error("{}", server.error().message), 1;
     web_server = std::move(*server);
   }
@@ -295,7 +312,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
 
   sd_notify(0, "READY=1");
   spdlog::info("running");
-  supervise(c, o.duration_s, channels, signals);
+  supervise(c, o.duration_s, channels, gate, signals);
 
   sd_notify(0, "STOPPING=1");
   if (web_server) web_server->stop();        // no more commands from either interface;

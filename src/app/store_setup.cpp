@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 
+#include "points/point_catalog.hpp"
 #include "store/active_tuning.hpp"
 #include "store/retained_points.hpp"
 #include "store/schema.hpp"
@@ -28,7 +29,7 @@ store::StoreSeed make_seed(const std::string& name, const core::ModelFile& model
 }
 
 core::Result<StoreStartup> open_tuning_store(const std::string& path, const store::StoreSeed& seed,
-                                             std::set<std::string> persisted_points) {
+                                             std::set<points::PointId> persisted_points) {
   auto opened = store::open_store(path, seed, core::unix_time_ms());
   if (!opened) return core::Error{opened.error().code, "store: " + opened.error().message};
   StoreStartup out;
@@ -47,7 +48,7 @@ core::Result<StoreStartup> open_tuning_store(const std::string& path, const stor
   for (const auto& refusal : loaded->refused) out.warnings.push_back("store: refused " + refusal + "; using the next good set");
   auto retained = store::RetainedPoints(opened->db).all();
   if (!retained) return core::Error{retained.error().code, "store: " + retained.error().message};
-  if (auto it = retained->find("setpoint_mm"); it != retained->end()) out.retained_setpoint_mm = it->second;
+  if (auto it = retained->find(std::string(points::name(points::PointId::kSetpoint))); it != retained->end()) out.retained_setpoint_mm = it->second;
 
   out.set = loaded->set;
   out.model = loaded->model;

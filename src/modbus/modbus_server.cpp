@@ -39,9 +39,8 @@ struct ModbusServer::Impl {
   runtime::MonotonicClock clock;
   Log log;
 
-  Impl(const ServerConfig& c, const RegisterMap& map, control::ControllerConfig tuning, double mm_per_volt,
-       runtime::LoopChannels& ch, core::AuditSink* audit, Log l)
-      : config(c), handler(map, c.policy, c.unit_id, std::move(tuning), mm_per_volt, ch, audit), log(std::move(l)) {}
+  Impl(const ServerConfig& c, const RegisterMap& map, points::WriteGate& gate, runtime::LoopChannels& ch, Log l)
+      : config(c), handler(map, c.policy, c.unit_id, gate, ch), log(std::move(l)) {}
   ~Impl() {
     for (auto& cl : clients) ::close(cl.fd);
     if (listener >= 0) ::close(listener);
@@ -51,10 +50,9 @@ struct ModbusServer::Impl {
 };
 
 core::Result<std::unique_ptr<ModbusServer>> ModbusServer::start(const ServerConfig& c, const RegisterMap& map,
-                                                                control::ControllerConfig tuning, double mm_per_volt,
-                                                                runtime::LoopChannels& ch, core::AuditSink* audit, Log log) {
+                                                                points::WriteGate& gate, runtime::LoopChannels& ch, Log log) {
   const std::string where = c.address + ":" + std::to_string(c.port);
-  auto impl = std::make_unique<Impl>(c, map, std::move(tuning), mm_per_volt, ch, audit, std::move(log));
+  auto impl = std::make_unique<Impl>(c, map, gate, ch, std::move(log));
   impl->ctx = modbus_new_tcp(c.address.c_str(), c.port);
   if (!impl->ctx) return core::invalid_argument("modbus: cannot listen on " + where + ": " + modbus_strerror(errno));
   impl->image = modbus_mapping_new_start_address(0, static_cast<unsigned>(map.end_address(Table::kCoil)), 0,

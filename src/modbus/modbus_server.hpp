@@ -26,10 +26,9 @@ struct ServerConfig {
 class ModbusServer {
  public:
   using Log = std::function<void(const std::string&)>;
-  // Binds, then serves on its own thread. The map, channels and sink must outlive the server.
+  // Binds, then serves on its own thread. The map, gate and channels must outlive the server.
   static core::Result<std::unique_ptr<ModbusServer>> start(const ServerConfig& config, const RegisterMap& map,
-                                                           control::ControllerConfig tuning_base, double mm_per_volt,
-                                                           runtime::LoopChannels& channels, core::AuditSink* audit,
+                                                           points::WriteGate& gate, runtime::LoopChannels& channels,
                                                            Log log = {});
   ~ModbusServer();
   ModbusServer(const ModbusServer&) = delete;

@@ -69,7 +69,7 @@ std::string export_csv(const RegisterMap& map) {
 std::string points_markdown() {
   std::ostringstream out;
   out << "| point | unit | writes | range | description |\n| --- | --- | --- | --- | --- |\n";
-  for (const auto& p : point_catalog()) {
+  for (const auto& p : points::point_catalog()) {
     out << "| " << p.name << " | " << p.unit << " | " << (p.tuning() ? "yes, after unlock" : p.writable() ? "yes" : "") << " | "
         << (p.writable() ? core::format_number(p.min) + " .. " + core::format_number(p.max) : "") << " | " << p.description << " |\n";
   }

@@ -115,7 +115,7 @@ core::Result<RegisterMap> RegisterMap::parse(const std::string& text, const std:
 
     RegisterEntry e;
     e.line = line_no;
-    e.point = find_point(get("name"));
+    e.point = points::find_point(get("name"));
     if (!e.point) return fail("unknown point '" + get("name") + "' (epa registers --points lists the points)");
     const auto table = std::find_if(std::begin(kTables), std::end(kTables), [&](auto& t) { return t.second == get("table"); });
     if (table == std::end(kTables)) return fail("table '" + get("table") + "' is not one of coil, discrete, input, holding");
@@ -244,6 +244,20 @@ double decode_value(const RegisterEntry& e, const std::uint16_t* w) noexcept {
     case DataType::kFloat32: return core::decode_f32({w[0], w[1]}, e.word_order);
   }
   return 0.0;
+}
+
+core::Status narrow_limits(const RegisterMap& map, points::WriteLimits& limits) {
+  for (const RegisterEntry& e : map.entries()) {
+    if (!e.writable) continue;
+    const std::string at = map.source() + ":" + std::to_string(e.line);
+    if (auto s = limits.narrow(e.point->id, e.min, e.max, at); !s) return s;
+  }
+  for (const RegisterEntry& e : map.entries()) {
+    if (!e.writable || !e.default_value) continue;
+    if (auto why = limits.check(e.point->id, *e.default_value); !why.empty())
+      return core::invalid_argument(map.source() + ":" + std::to_string(e.line) + ": default: " + why);
+  }
+  return core::ok();
 }
 
 }  // namespace epa::modbus

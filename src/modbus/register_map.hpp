@@ -1,6 +1,6 @@
 #pragma once
 // The register map (registers/*.csv, `epa-registers/1`): the single source of the Modbus
-// interface. Each row binds a named point (point_catalog.hpp) to a table and address with a data
+// interface. Each row binds a named point (points/point_catalog.hpp) to a table and address with a data
 // type, word order, scale, unit, access, range, default and persistence. Loaded and validated at
 // start-up; every error names the file, the line and what was expected.
 //
@@ -18,7 +18,8 @@
 
 #include "core/result.hpp"
 #include "core/word_order.hpp"
-#include "modbus/point_catalog.hpp"
+#include "points/point_catalog.hpp"
+#include "points/write_limits.hpp"
 
 namespace epa::modbus {
 
@@ -30,7 +31,7 @@ std::string_view to_string(DataType t);  // "bool", "uint16", ...
 bool is_bit_table(Table t);
 
 struct RegisterEntry {
-  const PointDef* point = nullptr;
+  const points::PointDef* point = nullptr;
   Table table = Table::kHoldingRegister;
   int address = 0;
   DataType type = DataType::kUint16;
@@ -71,6 +72,11 @@ class RegisterMap {
 // Engineering value <-> register words (width() of them) or a bit. Integer types round and clamp
 // to their range; a NaN ("never reached") becomes the type's sentinel: int16 -32768, uint16 65535,
 // int32 INT32_MIN, uint32 UINT32_MAX (float32 carries the NaN itself).
+// The map's ranges narrow the one set of write limits (every interface's), and its defaults must
+// lie within them: a map that leaves a point no value, or whose default the configuration's limits
+// exclude, is refused with the file, line and reason.
+core::Status narrow_limits(const RegisterMap& map, points::WriteLimits& limits);
+
 void encode_value(const RegisterEntry& e, double value, std::uint16_t* words) noexcept;
 double decode_value(const RegisterEntry& e, const std::uint16_t* words) noexcept;
 

@@ -13,7 +13,6 @@ constexpr std::uint8_t kIllegalFunction = MODBUS_EXCEPTION_ILLEGAL_FUNCTION;    
 constexpr std::uint8_t kIllegalAddress = MODBUS_EXCEPTION_ILLEGAL_DATA_ADDRESS;       // 02
 constexpr std::uint8_t kIllegalValue = MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE;           // 03
 constexpr std::uint8_t kCannotApply = MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE;       // 04
-constexpr std::uint8_t kBusy = MODBUS_EXCEPTION_SLAVE_OR_SERVER_BUSY;                 // 06
 constexpr std::uint8_t kOtherUnit = MODBUS_EXCEPTION_GATEWAY_TARGET;                  // 0B
 constexpr int kHeader = 7;  // MBAP: transaction, protocol, length, unit
 
@@ -27,13 +26,12 @@ std::uint8_t* table_bits(_modbus_mapping_t* m, Table t) { return t == Table::kCo
 
 }  // namespace
 
-RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, int unit_id, control::ControllerConfig tuning_base,
-                               double mm_per_volt, runtime::LoopChannels& channels, core::AuditSink* audit)
-    : map_(map), policy_(std::move(policy)), unit_id_(unit_id), tuning_base_(std::move(tuning_base)),
-      mm_per_volt_(mm_per_volt), channels_(channels), audit_(audit) {}
+RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, int unit_id, points::WriteGate& gate,
+                               runtime::LoopChannels& channels)
+    : map_(map), policy_(std::move(policy)), unit_id_(unit_id), gate_(gate), channels_(channels) {}
 
-ServerStatus RequestHandler::status(std::int64_t now_ns) const {
-  const core::ChangeCounters changes = audit_ ? audit_->counters() : core::ChangeCounters{};
+points::InterfaceStatus RequestHandler::status(std::int64_t now_ns) const {
+  const core::ChangeCounters changes = gate_.counters();
   return {static_cast<std::uint32_t>(changes.accepted), static_cast<std::uint32_t>(changes.saved), changes.saving, requests_,
           clients_, now_ns >= unlocked_until_ns_};
 }
@@ -111,13 +109,13 @@ std::uint8_t RequestHandler::read_into(Table t, int address, int quantity, const
   const int max = is_bit_table(t) ? MODBUS_MAX_READ_BITS : MODBUS_MAX_READ_REGISTERS;
   if (quantity < 1 || quantity > max) return kIllegalValue;
   if (address + quantity > 65536) return kIllegalAddress;
-  const ServerStatus server = status(now_ns);
-  const PointContext ctx{snap, server};
+  const points::InterfaceStatus server = status(now_ns);
+  const points::PointContext ctx{snap, server};
   for (int a = address; a < address + quantity;) {
     const auto hit = map_.find(t, a);
     if (!hit.entry) return kIllegalAddress;
     const RegisterEntry& e = *hit.entry;
-    const double value = e.point->read(ctx, e.point->index);
+    const double value = e.point->value(ctx);
     if (is_bit_table(t)) {
       table_bits(image, t)[e.address] = value != 0.0 ? 1 : 0;
     } else {
@@ -155,75 +153,28 @@ std::uint8_t RequestHandler::collect_coil_writes(int address, int quantity, cons
 }
 
 std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, const std::string& client,
-                                          const runtime::Snapshot& snap, std::int64_t now_ns) {
-  // 1. Values: within range, whole numbers where the point is an enumeration, counter or key.
-  for (const auto& w : writes) {
-    if (!(w.value >= w.entry->min && w.value <= w.entry->max)) return kIllegalValue;
-    if (w.entry->point->integer && w.value != std::floor(w.value)) return kIllegalValue;
-  }
-  // 2. Policy: read-only server, clients allowed to write, tuning lock, mode.
-  if (policy_.read_only) return kCannotApply;
+                                          const runtime::Snapshot&, std::int64_t now_ns) {
+  // The unlock key is this interface's own; everything else goes through the gate as one group.
+  points::Requester who{"modbus " + client, true, "", now_ns < unlocked_until_ns_};
+  if (policy_.read_only) who.may_write = false, who.no_write_reason = "the Modbus server is read-only";
   if (!policy_.write_clients.empty() &&
       std::find(policy_.write_clients.begin(), policy_.write_clients.end(), client) == policy_.write_clients.end())
-    return kCannotApply;
-  const bool unlocked = now_ns < unlocked_until_ns_;
+    who.may_write = false, who.no_write_reason = "client " + client + " is not in [modbus] write_clients";
+  std::vector<points::PointWrite> group;
+  bool unlock = false;
   for (const auto& w : writes) {
-    if (w.entry->point->tuning() && !unlocked) return kCannotApply;
-    if (w.entry->point->write == WriteEffect::kManualValve && snap.mode != runtime::Mode::kManual) return kCannotApply;
-    if (w.entry->point->write == WriteEffect::kMode && snap.mode == runtime::Mode::kFault) return kCannotApply;
-  }
-  // 3. Commands, all of them or none.
-  std::vector<runtime::Command> commands;
-  control::ControllerConfig tuning = tuning_base_;
-  bool tuning_changed = false;
-  std::int64_t unlock_until = unlocked_until_ns_;
-  for (const auto& w : writes) {
-    switch (w.entry->point->write) {
-      case WriteEffect::kSetpoint: commands.push_back(runtime::setpoint_command(w.value)); break;
-      case WriteEffect::kMode: commands.push_back(runtime::mode_command(static_cast<runtime::Mode>(static_cast<int>(w.value)))); break;
-      case WriteEffect::kController:
-        commands.push_back(runtime::controller_command(static_cast<control::ControllerKind>(static_cast<int>(w.value))));
-        break;
-      case WriteEffect::kManualValve: commands.push_back(runtime::manual_valve_command(w.value)); break;
-      case WriteEffect::kReset: commands.push_back(runtime::reset_command()); break;
-      case WriteEffect::kHeartbeat: commands.push_back(runtime::heartbeat_command(static_cast<std::uint32_t>(w.value))); break;
-      case WriteEffect::kRecord: commands.push_back(runtime::record_command(w.value)); break;
-      case WriteEffect::kUnlock:
-        if (policy_.unlock_key == 0 || w.value != policy_.unlock_key) return kIllegalValue;
-        unlock_until = now_ns + static_cast<std::int64_t>(policy_.unlock_timeout_s * 1e9);
-        break;
-      case WriteEffect::kDeadZoneMr: tuning.dead_zone.m_r = w.value, tuning_changed = true; break;
-      case WriteEffect::kDeadZoneMl: tuning.dead_zone.m_l = w.value, tuning_changed = true; break;
-      case WriteEffect::kDeadZoneBr: tuning.dead_zone.b_r = w.value, tuning_changed = true; break;
-      case WriteEffect::kDeadZoneBl: tuning.dead_zone.b_l = w.value, tuning_changed = true; break;
-      case WriteEffect::kLc: tuning.lc_v = w.value / mm_per_volt_, tuning_changed = true; break;
-      case WriteEffect::kNone: return kIllegalAddress;
+    if (w.entry->point->access != points::Access::kKey) {
+      group.push_back({w.entry->point->id, w.value});
+      continue;
     }
+    if (!(w.value >= w.entry->min && w.value <= w.entry->max) || w.value != std::floor(w.value)) return kIllegalValue;
+    if (!who.may_write) return kCannotApply;
+    if (policy_.unlock_key == 0 || w.value != policy_.unlock_key) return kIllegalValue;
+    unlock = true;
   }
-  if (tuning_changed) {
-    auto t = runtime::make_tuning(tuning);  // e.g. b_l > b_r after this write: refused whole
-    if (!t) return kIllegalValue;
-    commands.push_back(runtime::tuning_command(*t));
-  }
-  if (!commands.empty() && !channels_.commands.try_push_all(commands.data(), commands.size())) return kBusy;
-  // 4. Accepted: the lock and the tuning base follow, and the change goes to the audit trail
-  // (and so to the store) as one group. Not audited: the key (never logged) and the heartbeat
-  // (a keep-alive every second, not a change anyone needs to trace).
-  unlocked_until_ns_ = unlock_until;
-  if (tuning_changed) tuning_base_ = tuning;
-  if (audit_) {
-    const ServerStatus server = status(now_ns);
-    const PointContext ctx{snap, server};
-    std::vector<core::AuditEntry> change;
-    const std::int64_t time_ms = core::unix_time_ms();
-    for (const auto& w : writes) {
-      const WriteEffect effect = w.entry->point->write;
-      if (effect == WriteEffect::kUnlock || effect == WriteEffect::kHeartbeat) continue;
-      change.push_back({time_ms, "modbus " + client, std::string(w.entry->point->name),
-                        w.entry->point->read(ctx, w.entry->point->index), w.value});
-    }
-    if (!change.empty()) audit_->record(change);
-  }
+  if (!group.empty())
+    if (const auto r = gate_.submit(group, who); !r.accepted()) return points::modbus_exception(r.refusal);
+  if (unlock) unlocked_until_ns_ = now_ns + static_cast<std::int64_t>(policy_.unlock_timeout_s * 1e9);
   return 0;
 }
 

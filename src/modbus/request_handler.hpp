@@ -1,22 +1,22 @@
 #pragma once
 // The Modbus application layer, without sockets: one request ADU in, an exception code or a
 // filled register image out (libmodbus' modbus_reply then builds the answer). Reads encode the
-// published snapshot; writes are validated whole (mapped, writable, whole 32-bit values, ranges,
-// write protection, mode) and sent to the scan cycle as one command group that is applied in one
-// cycle or not at all.
+// published snapshot through the point catalog; writes are decoded (mapped, writable, whole
+// 32-bit values), the unlock key is taken here, and the rest goes to the one write gate
+// (points::WriteGate) as one group: queued for the scan cycle whole, or refused whole.
 //
 // Exceptions: 01 unsupported function; 02 unmapped address or write to a read-only register;
-// 03 bad quantity, a value outside min/max, a write that covers only part of a 32-bit value, a
-// wrong unlock key, or tuning values that do not validate together; 04 the write cannot be
-// applied (server read-only, client not allowed to write, tuning locked, wrong mode);
-// 06 the command queue is full (busy); 0B a request for another unit id.
+// 03 bad quantity, a value outside the limits (the catalog's, the configuration's and the map's),
+// a write that covers only part of a 32-bit value, a wrong unlock key, or tuning values that do
+// not validate together; 04 the write cannot be applied (server read-only, client not allowed to
+// write, tuning locked, wrong mode, fault latched); 06 the command queue is full (busy); 0B a
+// request for another unit id.
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "control/controller.hpp"
-#include "core/audit.hpp"
 #include "modbus/register_map.hpp"
+#include "points/write_gate.hpp"
 #include "runtime/scan_cycle.hpp"
 
 struct _modbus_mapping_t;  // libmodbus' register image (modbus_mapping_t)
@@ -32,16 +32,16 @@ struct WritePolicy {
 
 class RequestHandler {
  public:
-  // `tuning_base` is the configuration the running tuning was made from (tuning writes edit it).
-  RequestHandler(const RegisterMap& map, WritePolicy policy, int unit_id, control::ControllerConfig tuning_base,
-                 double mm_per_volt, runtime::LoopChannels& channels, core::AuditSink* audit);
+  // The map, gate and channels must outlive the handler.
+  RequestHandler(const RegisterMap& map, WritePolicy policy, int unit_id, points::WriteGate& gate,
+                 runtime::LoopChannels& channels);
 
   // `req` is a whole Modbus TCP ADU (7-byte MBAP header, then the PDU). Returns 0 when `image`
   // holds what modbus_reply needs for the answer, else the exception code to send.
   std::uint8_t handle(const std::uint8_t* req, int length, const std::string& client, std::int64_t now_ns,
                       _modbus_mapping_t* image);
 
-  ServerStatus status(std::int64_t now_ns) const;
+  points::InterfaceStatus status(std::int64_t now_ns) const;
   void set_clients(int n) { clients_ = n; }
   const RegisterMap& map() const { return map_; }
 
@@ -60,10 +60,8 @@ class RequestHandler {
   const RegisterMap& map_;
   WritePolicy policy_;
   int unit_id_;
-  control::ControllerConfig tuning_base_;
-  double mm_per_volt_;
+  points::WriteGate& gate_;
   runtime::LoopChannels& channels_;
-  core::AuditSink* audit_;
   std::int64_t unlocked_until_ns_ = 0;
   std::uint64_t requests_ = 0;
   int clients_ = 0;

@@ -1,7 +1,8 @@
 #pragma once
-// What other threads ask of the scan cycle. Commands are validated by their producer (Modbus,
-// web, command line) against the configured ranges, queued, and applied at the start of the
-// next cycle, whole, or refused there (wrong mode, latched fault) and counted as rejected.
+// What other threads ask of the scan cycle. Commands are validated by the write gate
+// (points::WriteGate) with the loop's own rules (command_rules.hpp), queued, and applied at the
+// start of the next cycle, whole, or refused there for a reason that arose after the gate looked
+// (counted as rejected and reported back by sequence number).
 #include <cstdint>
 
 #include "control/controller_kind.hpp"
@@ -27,6 +28,7 @@ struct Command {
   Mode mode = Mode::kStop;
   control::ControllerKind controller = control::ControllerKind::kPpFfidz;
   std::uint32_t heartbeat = 0;
+  std::uint64_t sequence = 0;  // the producer's number for it: a refusal is reported with it
   Tuning tuning;
 };
 

@@ -43,61 +43,59 @@ void ScanCycle::apply_commands(std::int64_t now_ns) noexcept {
 }
 
 void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
-  bool accepted = true;
-  switch (c.kind) {
-    case CommandKind::kSetpoint:
-      if (!(c.value >= config_.setpoint_min_mm && c.value <= config_.setpoint_max_mm)) {
-        accepted = false;
-      } else if (c.value != setpoint_mm_) {
-        setpoint_mm_ = c.value;
-        if (mode_ == Mode::kRun) start_move();
-      }
-      break;
-    case CommandKind::kMode:
-      if (mode_ == Mode::kFault || c.mode == Mode::kFault) {
-        accepted = false;  // a latched fault needs an explicit reset first
-      } else if (c.mode != mode_) {
-        if (moves_.active()) finish_move();
-        if (c.mode == Mode::kRun) enter_run(now_ns);
-        if (c.mode == Mode::kManual) {
-          manual_valve_v_ = config_.safe_valve_v;  // never resume a stale manual command
+  CommandRefusal refusal = check_command(c, mode_, config_);
+  if (refusal == CommandRefusal::kNone) {
+    switch (c.kind) {
+      case CommandKind::kSetpoint:
+        if (c.value != setpoint_mm_) {
+          setpoint_mm_ = c.value;
+          if (mode_ == Mode::kRun) start_move();
+        }
+        break;
+      case CommandKind::kMode:
+        if (c.mode != mode_) {
+          if (moves_.active()) finish_move();
+          if (c.mode == Mode::kRun) enter_run(now_ns);
+          if (c.mode == Mode::kManual) {
+            manual_valve_v_ = config_.safe_valve_v;  // never resume a stale manual command
+            heartbeat_changed_ns_ = now_ns;
+          }
+          mode_ = c.mode;
+        }
+        break;
+      case CommandKind::kManualValve: manual_valve_v_ = c.value; break;
+      case CommandKind::kController: controller_ = c.controller; break;  // bumpless: the RST history carries over
+      case CommandKind::kTuning: tuning_ = c.tuning; break;              // takes effect in this cycle's step, whole
+      case CommandKind::kReset:
+        if (mode_ == Mode::kFault) {
+          mode_ = Mode::kStop;
+          fault_ = FaultCode::kNone;
+          consecutive_read_errors_ = consecutive_write_errors_ = consecutive_overruns_ = 0;
+          following_error_since_ns_ = -1;
+        }
+        break;
+      case CommandKind::kHeartbeat:
+        if (c.heartbeat != heartbeat_) {
+          heartbeat_ = c.heartbeat;
           heartbeat_changed_ns_ = now_ns;
         }
-        mode_ = c.mode;
+        break;
+      case CommandKind::kRecord: {
+        const auto end = ch_.samples.written();
+        const auto n = static_cast<std::uint64_t>(c.value / config_.period_s);
+        if (!ch_.record_requests.try_push({RecordRequest::Reason::kRequest, end > n ? end - n : 0, end, {}, controller_}))
+          refusal = CommandRefusal::kRecordQueueFull;
+        break;
       }
-      break;
-    case CommandKind::kManualValve:
-      if (!(std::abs(c.value) <= config_.manual_valve_limit_v)) accepted = false;
-      else manual_valve_v_ = c.value;
-      break;
-    case CommandKind::kController:
-      controller_ = c.controller;  // bumpless: the RST history carries over
-      break;
-    case CommandKind::kTuning:
-      tuning_ = c.tuning;  // takes effect in this cycle's control step, whole
-      break;
-    case CommandKind::kReset:
-      if (mode_ == Mode::kFault) {
-        mode_ = Mode::kStop;
-        fault_ = FaultCode::kNone;
-        consecutive_read_errors_ = consecutive_write_errors_ = consecutive_overruns_ = 0;
-        following_error_since_ns_ = -1;
-      }
-      break;
-    case CommandKind::kHeartbeat:
-      if (c.heartbeat != heartbeat_) {
-        heartbeat_ = c.heartbeat;
-        heartbeat_changed_ns_ = now_ns;
-      }
-      break;
-    case CommandKind::kRecord: {
-      const auto end = ch_.samples.written();
-      const auto n = static_cast<std::uint64_t>(std::max(0.0, c.value) / config_.period_s);
-      accepted = ch_.record_requests.try_push({RecordRequest::Reason::kRequest, end > n ? end - n : 0, end, {}, controller_});
-      break;
     }
   }
-  (accepted ? applied_ : rejected_)++;
+  if (refusal == CommandRefusal::kNone) {
+    ++applied_;
+    return;
+  }
+  ++rejected_;
+  last_refusal_ = refusal;
+  ch_.refusals.try_push({c.sequence, refusal});  // full: the count and last_refusal still tell
 }
 
 void ScanCycle::enter_run(std::int64_t now_ns) noexcept {
@@ -249,6 +247,7 @@ void ScanCycle::publish(bool full_stats) noexcept {
   s.io_errors = io_errors_;
   s.commands_applied = applied_;
   s.commands_rejected = rejected_;
+  s.last_refusal = last_refusal_;
   const auto& m = last_move_.metrics;
   s.last_move = {last_move_.number, last_move_.from_mm, last_move_.to_mm, or_nan(m.rise_s), or_nan(m.settling_s),
                  last_move_.number ? m.ess_mm : kNaN, or_nan(m.overshoot_pct)};

@@ -14,6 +14,7 @@
 #include "hal/daq.hpp"
 #include "runtime/clock.hpp"
 #include "runtime/command.hpp"
+#include "runtime/command_rules.hpp"
 #include "runtime/command_queue.hpp"
 #include "runtime/loop_stats.hpp"
 #include "runtime/move_tracker.hpp"
@@ -43,6 +44,7 @@ struct LoopChannels {
   SeqlockCell<Snapshot> snapshot;
   SampleRing samples;
   SpscRing<RecordRequest, 16> record_requests;
+  SpscRing<CommandOutcome, 64> refusals;  // commands the loop refused, for the gate to log and audit
 };
 
 class ScanCycle {
@@ -94,6 +96,7 @@ class ScanCycle {
   std::uint32_t heartbeat_ = 0;
   std::int64_t heartbeat_changed_ns_ = 0;
   std::uint64_t cycle_ = 0, faults_ = 0, io_errors_ = 0, applied_ = 0, rejected_ = 0;
+  CommandRefusal last_refusal_ = CommandRefusal::kNone;
 
   MoveTracker moves_;
   MoveResult last_move_;

@@ -6,6 +6,7 @@
 
 #include "control/controller_kind.hpp"
 #include "control/rst_law.hpp"
+#include "runtime/command_rules.hpp"
 #include "runtime/loop_stats.hpp"
 #include "runtime/mode.hpp"
 
@@ -36,6 +37,7 @@ struct Snapshot {
   double valve_v = 0, controller_v = 0, manual_valve_v = 0;
   std::uint32_t heartbeat = 0;
   std::uint64_t moves = 0, faults = 0, io_errors = 0, commands_applied = 0, commands_rejected = 0;
+  CommandRefusal last_refusal = CommandRefusal::kNone;  // why the loop last refused a command
   MoveMetricsView last_move;
   LoopStatsView loop;
   TuningView tuning;

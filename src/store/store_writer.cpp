@@ -7,12 +7,13 @@
 #include "store/retained_points.hpp"
 #include "store/run_table.hpp"
 #include "store/transaction.hpp"
+#include "points/point_catalog.hpp"
 #include "store/tuning_points.hpp"
 #include "store/tuning_set_table.hpp"
 
 namespace epa::store {
 
-StoreWriter::StoreWriter(Database db, TuningSet running, std::set<std::string> persisted, Log log)
+StoreWriter::StoreWriter(Database db, TuningSet running, std::set<points::PointId> persisted, Log log)
     : db_(std::move(db)), running_(std::move(running)), persisted_(std::move(persisted)), log_(std::move(log)) {}
 
 StoreWriter::~StoreWriter() { stop(0.0); }
@@ -81,8 +82,9 @@ core::Status StoreWriter::write(const std::deque<Item>& batch, TuningSet& runnin
     }
     for (const core::AuditEntry& e : std::get<std::vector<core::AuditEntry>>(item)) {
       if (auto s = audit.append(e); !s) return s;
-      if (!persisted_.contains(e.point)) continue;
-      if (apply_tuning_point(running, e.point, e.new_value)) {
+      const points::PointDef* point = points::find_point(e.point);
+      if (!point || !persisted_.contains(point->id)) continue;
+      if (apply_tuning_point(running, point->id, e.new_value)) {
         running.modified_ms = e.unix_time_ms;
         tuning_changed = true;
       } else if (auto s = retained.put(e.point, e.new_value, e.unix_time_ms); !s) {

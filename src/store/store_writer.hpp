@@ -17,6 +17,7 @@
 #include <variant>
 
 #include "core/audit.hpp"
+#include "points/point_id.hpp"
 #include "store/database.hpp"
 #include "store/run_record.hpp"
 #include "store/tuning_set.hpp"
@@ -34,9 +35,10 @@ class StoreWriter final : public core::AuditSink {
  public:
   using Log = std::function<void(const std::string&)>;
 
-  // `running` is the tuning set the loop runs: persisted tuning points edit it. `persisted`
-  // names the points whose new values are kept (the register map's persisted column).
-  StoreWriter(Database db, TuningSet running, std::set<std::string> persisted, Log log = {});
+  // `running` is the row of the tuning set the loop runs: persisted tuning points edit it (the
+  // write gate owns the running tuning; this is its stored image). `persisted` names the points
+  // whose new values are kept (the register map's persisted column).
+  StoreWriter(Database db, TuningSet running, std::set<points::PointId> persisted, Log log = {});
   ~StoreWriter() override;
   StoreWriter(const StoreWriter&) = delete;
   StoreWriter& operator=(const StoreWriter&) = delete;
@@ -62,7 +64,7 @@ class StoreWriter final : public core::AuditSink {
 
   Database db_;
   TuningSet running_;  // owned by the writing side (the thread, or flush() in tests)
-  std::set<std::string> persisted_;
+  std::set<points::PointId> persisted_;
   Log log_;
 
   mutable std::mutex mutex_;

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "control/controller_kind.hpp"
+#include "points/point_catalog.hpp"
 #include "runtime/mode.hpp"
 
 namespace epa::web {
@@ -11,6 +12,10 @@ namespace epa::web {
 namespace {
 
 using nlohmann::json;
+using P = points::PointId;
+
+// A key that is a point's public name is the catalog's, so the API and the register map agree.
+std::string k(P id) { return std::string(points::name(id)); }
 
 json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 // Trend values rounded to 1e-4, so a poll of 600 points stays small.
@@ -36,24 +41,27 @@ std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, b
       {"cycle", s.cycle},
       {"time_s", num(s.time_s)},
       {"Ts", num(s.Ts)},
-      {"mode", std::string(runtime::to_string(s.mode))},
+      {k(P::kMode), std::string(runtime::to_string(s.mode))},
       {"fault", std::string(runtime::to_string(s.fault))},
       {"fault_text", faulted ? json(std::string(runtime::describe(s.fault))) : json(nullptr)},
-      {"controller", std::string(control::to_string(s.controller))},
+      {k(P::kController), std::string(control::to_string(s.controller))},
       {"controller_name", std::string(control::display_name(s.controller))},
-      {"saturated", s.saturated},
-      {"io_ok", s.io_ok},
-      {"setpoint_mm", num(s.setpoint_mm)},
-      {"position_mm", num(s.position_mm)},
-      {"sensor_v", num(s.sensor_v)},
-      {"error_mm", num(s.error_mm)},
-      {"valve_v", num(s.valve_v)},
+      {k(P::kSaturated), s.saturated},
+      {k(P::kIoOk), s.io_ok},
+      {k(P::kSetpoint), num(s.setpoint_mm)},
+      {k(P::kPosition), num(s.position_mm)},
+      {k(P::kSensor), num(s.sensor_v)},
+      {k(P::kError), num(s.error_mm)},
+      {k(P::kValve), num(s.valve_v)},
       {"controller_v", num(s.controller_v)},
-      {"manual_valve_v", num(s.manual_valve_v)},
-      {"heartbeat", s.heartbeat},
+      {k(P::kManualValve), num(s.manual_valve_v)},
+      {k(P::kHeartbeat), s.heartbeat},
       {"counters",
-       {{"moves", s.moves}, {"faults", s.faults}, {"io_errors", s.io_errors}, {"commands_applied", s.commands_applied},
-        {"commands_rejected", s.commands_rejected}}},
+       {{k(P::kMoves), s.moves}, {k(P::kFaults), s.faults}, {k(P::kIoErrors), s.io_errors},
+        {k(P::kCommandsApplied), s.commands_applied}, {k(P::kCommandsRejected), s.commands_rejected},
+        {k(P::kLastCommandRefusal), s.last_refusal == runtime::CommandRefusal::kNone
+                                        ? json(nullptr)
+                                        : json(std::string(runtime::describe(s.last_refusal)))}}},
       {"last_move", s.last_move.number ? move_json(s.last_move) : json(nullptr)},
       {"loop",
        {{"wake_p50_us", num(s.loop.wake_p50_us)}, {"wake_p99_us", num(s.loop.wake_p99_us)},
@@ -82,9 +90,9 @@ std::string trend_json(const std::vector<TrendPoint>& points, const runtime::Sna
     u.push_back(short_num(p.valve_v));
   }
   json j = {{"period_s", TrendBuffer::kPeriodS}, {"window_s", TrendBuffer::kWindowS},
-            {"dead_zone", {{"b_l", num(s.tuning.b_l)}, {"b_r", num(s.tuning.b_r)}}},
+            {"dead_zone", {{k(P::kBl), num(s.tuning.b_l)}, {k(P::kBr), num(s.tuning.b_r)}}},
             {"valve_limit_v", num(s.tuning.valve_limit_v)},
-            {"t_s", std::move(t)}, {"setpoint_mm", std::move(r)}, {"position_mm", std::move(y)}, {"valve_v", std::move(u)}};
+            {"t_s", std::move(t)}, {k(P::kSetpoint), std::move(r)}, {k(P::kPosition), std::move(y)}, {k(P::kValve), std::move(u)}};
   return j.dump();
 }
 
@@ -92,7 +100,7 @@ std::string moves_json(const std::vector<MoveRecord>& moves) {
   json a = json::array();
   for (const auto& m : moves) {
     json e = move_json(m.metrics);
-    e["controller"] = std::string(control::to_string(m.controller));
+    e[k(P::kController)] = std::string(control::to_string(m.controller));
     e["finished_s"] = num(m.finished_s);
     a.push_back(std::move(e));
   }
@@ -101,10 +109,10 @@ std::string moves_json(const std::vector<MoveRecord>& moves) {
 
 std::string tuning_json(const runtime::Snapshot& s) {
   const auto& t = s.tuning;
-  json j = {{"controller", std::string(control::to_string(s.controller))},
+  json j = {{k(P::kController), std::string(control::to_string(s.controller))},
             {"Ts", num(s.Ts)},
-            {"m_r", num(t.m_r)}, {"m_l", num(t.m_l)}, {"b_r", num(t.b_r)}, {"b_l", num(t.b_l)},
-            {"lc_mm", num(t.lc_mm)}, {"valve_limit_v", num(t.valve_limit_v)},
+            {k(P::kMr), num(t.m_r)}, {k(P::kMl), num(t.m_l)}, {k(P::kBr), num(t.b_r)}, {k(P::kBl), num(t.b_l)},
+            {k(P::kLc), num(t.lc_mm)}, {"valve_limit_v", num(t.valve_limit_v)},
             {"F", poly(t.F, t.nF)}, {"G", poly(t.G, t.nG)}, {"H", poly(t.H, t.nH)}};
   return j.dump();
 }
@@ -115,6 +123,23 @@ std::string audit_json(const std::vector<core::AuditEntry>& entries) {
     a.push_back({{"unix_time_ms", it->unix_time_ms}, {"source", it->source}, {"point", it->point},
                  {"old_value", num(it->old_value)}, {"new_value", num(it->new_value)}});
   return json{{"entries", std::move(a)}}.dump();
+}
+
+std::string points_json(const points::WriteLimits& limits) {
+  json a = json::array();
+  for (const auto& p : points::point_catalog()) {
+    static constexpr const char* kAccess[] = {"r", "rw", "rw after unlock", "key (Modbus only)"};
+    json e = {{"name", std::string(p.name)}, {"unit", std::string(p.unit)}, {"access", kAccess[static_cast<int>(p.access)]},
+              {"description", std::string(p.description)}};
+    if (p.writable() && p.access != points::Access::kKey) {
+      const auto& r = limits.range(p.id);
+      e["min"] = r.min.value;
+      e["max"] = r.max.value;
+      e["integer"] = p.integer;
+    }
+    a.push_back(std::move(e));
+  }
+  return json{{"points", std::move(a)}}.dump();
 }
 
 std::string error_json(const std::string& message) { return json{{"error", message}}.dump(); }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/audit.hpp"
+#include "points/write_limits.hpp"
 #include "runtime/snapshot.hpp"
 #include "web/trend_buffer.hpp"
 
@@ -34,6 +35,8 @@ std::string trend_json(const std::vector<TrendPoint>& points, const runtime::Sna
 std::string moves_json(const std::vector<MoveRecord>& moves);
 std::string tuning_json(const runtime::Snapshot& s);
 std::string audit_json(const std::vector<core::AuditEntry>& entries);
+// The point catalog with each writable point's range as the write gate applies it.
+std::string points_json(const points::WriteLimits& limits);
 std::string error_json(const std::string& message);
 
 }  // namespace epa::web

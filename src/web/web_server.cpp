@@ -10,7 +10,7 @@
 #include <sstream>
 #include <thread>
 
-#include "web/command_validation.hpp"
+#include "web/command_body.hpp"
 #include "web/prometheus.hpp"
 #include "web/recent_audit.hpp"
 #include "web/trend_buffer.hpp"
@@ -44,7 +44,7 @@ void send_error(httplib::Response& res, int status, const std::string& message) 
 struct WebServer::Impl {
   WebConfig config;
   runtime::LoopChannels& channels;
-  runtime::RuntimeConfig limits;
+  points::WriteGate* gate;
   RecentAudit* audit;
   ModbusStatsFn modbus_stats;
   StoreStatsFn store_stats;
@@ -60,9 +60,8 @@ struct WebServer::Impl {
   bool stopping = false;
   std::thread listener, sampler;
 
-  Impl(const WebConfig& c, runtime::LoopChannels& ch, const runtime::RuntimeConfig& l, RecentAudit* a, ModbusStatsFn m,
-       StoreStatsFn st)
-      : config(c), channels(ch), limits(l), audit(a), modbus_stats(std::move(m)), store_stats(std::move(st)) {}
+  Impl(const WebConfig& c, runtime::LoopChannels& ch, points::WriteGate* g, RecentAudit* a, ModbusStatsFn m, StoreStatsFn st)
+      : config(c), channels(ch), gate(g), audit(a), modbus_stats(std::move(m)), store_stats(std::move(st)) {}
 
   ModbusStats modbus() const { return modbus_stats ? modbus_stats() : ModbusStats{}; }
   StoreStats store() const { return store_stats ? store_stats() : StoreStats{}; }
@@ -94,19 +93,16 @@ struct WebServer::Impl {
     return true;
   }
 
+  // A command: the token, then the body read into point writes, then the write gate decides (and
+  // audits what it takes); its refusal becomes 400, 403, 409 or 503 with the gate's reason.
   void command(CommandEndpoint endpoint, const httplib::Request& req, httplib::Response& res) {
     if (!authorised(req, res)) return;
-    const runtime::Snapshot snap = channels.snapshot.read();
-    CommandDecision d = validate_command(endpoint, req.body, snap, limits);
-    if (d.status != 200) return send_error(res, d.status, d.error);
-    if (!channels.commands.try_push_all(d.commands.data(), d.commands.size()))
-      return send_error(res, 503, "the command queue is full: try again");
-    const std::string source = "web " + req.remote_addr;
-    if (audit) {
-      std::vector<core::AuditEntry> change;
-      for (const auto& c : d.changes) change.push_back({core::unix_time_ms(), source, c.point, c.old_value, c.new_value});
-      audit->record(change);
-    }
+    const CommandBody body = parse_command_body(endpoint, req.body);
+    if (!body.error.empty()) return send_error(res, 400, body.error);
+    if (!gate) return send_error(res, 503, "this server takes no commands (no write gate)");
+    const points::Requester who{"web " + req.remote_addr, true, "", /*tuning_unlocked=*/true};  // the token is the unlock
+    const points::GateResult r = gate->submit(body.writes, who);
+    if (!r.accepted()) return send_error(res, points::http_status(r.refusal), r.reason);
     res.set_content(R"({"accepted":true})", kJson);
   }
 
@@ -129,6 +125,10 @@ struct WebServer::Impl {
     s.Get("/api/tuning", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(tuning_json(channels.snapshot.read()), kJson);
     });
+    s.Get("/api/points", [this](const httplib::Request&, httplib::Response& res) {
+      if (!gate) return send_error(res, 404, "no point catalog on this server");
+      res.set_content(points_json(gate->limits()), kJson);
+    });
     s.Get("/api/audit", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(audit_json(audit ? audit->entries() : std::vector<core::AuditEntry>{}), kJson);
     });
@@ -145,6 +145,7 @@ struct WebServer::Impl {
     s.Post("/api/setpoint", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kSetpoint, q, r); });
     s.Post("/api/mode", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kMode, q, r); });
     s.Post("/api/reset", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kReset, q, r); });
+    s.Post("/api/points", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kPoints, q, r); });
 
     // Every error leaves as JSON: httplib's own (404 no route, 413 payload too large, 400 bad request) included.
     s.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
@@ -172,10 +173,10 @@ struct WebServer::Impl {
 };
 
 core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& config, runtime::LoopChannels& channels,
-                                                          const runtime::RuntimeConfig& limits, RecentAudit* audit,
+                                                          points::WriteGate* gate, RecentAudit* audit,
                                                           ModbusStatsFn modbus_stats, StoreStatsFn store_stats) {
   if (config.worker_threads < 1) return core::invalid_argument("web: worker_threads must be >= 1");
-  auto impl = std::make_unique<Impl>(config, channels, limits, audit, std::move(modbus_stats), std::move(store_stats));
+  auto impl = std::make_unique<Impl>(config, channels, gate, audit, std::move(modbus_stats), std::move(store_stats));
   if (!std::filesystem::is_directory(config.static_dir))
     return core::io_error("web: static_dir '" + config.static_dir + "' is not a folder (it holds index.html, app.js, style.css)");
   {

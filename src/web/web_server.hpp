@@ -1,6 +1,7 @@
 #pragma once
 // The status page's HTTP server (cpp-httplib): the JSON API, /metrics, the page's static files
-// and Chart.js, and, when a token is configured, the setpoint/mode/reset commands. It reads only
+// and Chart.js, and, when a token is configured, the commands (setpoint, mode, reset, and any
+// writable point through /api/points), each decided by the one write gate. It reads only
 // the published snapshot and keeps its own buffers (a sampler thread fills the 30 s trend), so it
 // cannot slow the scan cycle; a bounded worker pool, timeouts and a payload cap bound what a
 // crowd of clients can cost.
@@ -10,7 +11,7 @@
 
 #include "core/audit.hpp"
 #include "core/result.hpp"
-#include "runtime/runtime_config.hpp"
+#include "points/write_gate.hpp"
 #include "runtime/scan_cycle.hpp"
 #include "web/json_api.hpp"
 
@@ -32,10 +33,11 @@ class WebServer {
  public:
   using ModbusStatsFn = std::function<ModbusStats()>;
   using StoreStatsFn = std::function<StoreStats()>;
-  // Binds, then serves on its own thread. channels, limits and audit must outlive the server.
-  // `audit` may be null; when it is a RecentAudit, /api/audit shows its entries.
+  // Binds, then serves on its own thread. channels, gate and audit must outlive the server.
+  // `gate` takes the commands (null: commands answer 503); `audit` may be null, else /api/audit
+  // shows its entries (the gate records through it).
   static core::Result<std::unique_ptr<WebServer>> start(const WebConfig& config, runtime::LoopChannels& channels,
-                                                        const runtime::RuntimeConfig& limits, RecentAudit* audit,
+                                                        points::WriteGate* gate, RecentAudit* audit,
                                                         ModbusStatsFn modbus_stats = {}, StoreStatsFn store_stats = {});
   ~WebServer();
   WebServer(const WebServer&) = delete;

@@ -26,7 +26,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from epa_appliance import (UNIT, UNLOCK_KEY, Appliance, f32_value, f32_words, i16_value, pymodbus,  # noqa: E402
                            u32_value, u32_words)
 
-VERSION = (0, 2, 0)  # src/modbus/point_catalog.hpp kVersionMajor/Minor/Patch
+VERSION = (0, 2, 0)  # src/points/point_catalog.hpp kVersionMajor/Minor/Patch
 MM_PER_VOLT = 50.0   # the paper's position sensor scale (config/paper-model.toml)
 HEARTBEAT_TIMEOUT_S = 5.0  # [limits] heartbeat_timeout_s of the epa.csv appliance: generous, so a test
 # process starved for a moment on a loaded CI machine does not lapse it by accident

@@ -36,8 +36,10 @@ class Server : public ::testing::Test {
     channels_.snapshot.publish(s);
     c.address = "127.0.0.1";
     c.port = 0;
-    auto server = ModbusServer::start(c, *map_, control::paper_controller_config(control::ControllerKind::kPpFfidz), 50.0,
-                                      channels_, nullptr);
+    gate_ = std::make_unique<points::WriteGate>(*points::WriteLimits::from_config(loop_, "test.toml"), loop_,
+                                                control::paper_controller_config(control::ControllerKind::kPpFfidz), channels_,
+                                                nullptr);
+    auto server = ModbusServer::start(c, *map_, *gate_, channels_);
     ASSERT_TRUE(server.has_value()) << server.error().message;
     server_ = std::move(*server);
   }
@@ -78,7 +80,9 @@ class Server : public ::testing::Test {
     return n;
   }
 
+  runtime::RuntimeConfig loop_;
   runtime::LoopChannels channels_{16};
+  std::unique_ptr<points::WriteGate> gate_;
   std::unique_ptr<RegisterMap> map_;
   std::unique_ptr<ModbusServer> server_;
   std::vector<modbus_t*> clients_;

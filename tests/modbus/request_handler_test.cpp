@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 #include <modbus.h>
 
+#include <cmath>
+
 #include "control/paper_controller.hpp"
 
 namespace epa::modbus {
@@ -37,9 +39,13 @@ class Handler : public ::testing::Test {
     auto m = RegisterMap::load(std::string(EPA_SOURCE_DIR) + "/registers/epa.csv");
     ASSERT_TRUE(m.has_value()) << m.error().message;
     map_ = std::make_unique<RegisterMap>(std::move(*m));
-    handler_ = std::make_unique<RequestHandler>(*map_, std::move(policy), 1,
-                                                control::paper_controller_config(control::ControllerKind::kPpFfidz), 50.0,
-                                                channels_, &sink_);
+    auto limits = points::WriteLimits::from_config(loop_, "test.toml");
+    ASSERT_TRUE(limits.has_value()) << limits.error().message;
+    ASSERT_TRUE(narrow_limits(*map_, *limits));
+    gate_ = std::make_unique<points::WriteGate>(std::move(*limits), loop_,
+                                                control::paper_controller_config(control::ControllerKind::kPpFfidz), channels_,
+                                                &sink_);
+    handler_ = std::make_unique<RequestHandler>(*map_, std::move(policy), 1, *gate_, channels_);
     if (image_) modbus_mapping_free(image_);
     image_ = modbus_mapping_new_start_address(0, map_->end_address(Table::kCoil), 0, map_->end_address(Table::kDiscreteInput), 0,
                                               map_->end_address(Table::kHoldingRegister), 0, map_->end_address(Table::kInputRegister));
@@ -67,9 +73,11 @@ class Handler : public ::testing::Test {
     s.tuning.b_l = -1.722;
     return s;
   }();
+  runtime::RuntimeConfig loop_;  // the configuration's limits: setpoint 0..500 mm, manual valve +-3 V
   runtime::LoopChannels channels_{16};
   RecordingSink sink_;
   std::unique_ptr<RegisterMap> map_;
+  std::unique_ptr<points::WriteGate> gate_;
   std::unique_ptr<RequestHandler> handler_;
   modbus_mapping_t* image_ = nullptr;
 };
@@ -133,6 +141,55 @@ TEST_F(Handler, ValueOutsideTheRangeIs03) {
   EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x44, 0x16, 0x00, 0x00}), 0x03);  // 600.0f > 500
   EXPECT_EQ(send({0x06, 0x00, 0x02, 0x00, 0x03}), 0x03);                                // mode 3
   EXPECT_TRUE(drain().empty());
+}
+
+TEST_F(Handler, TheConfigurationsLimitsNarrowTheMapsForModbusToo) {
+  // [limits] setpoint_max_mm = 300 while the map keeps 0..500: 400 is refused (03), nothing is
+  // queued and nothing audited; 300 is taken.
+  loop_.setpoint_max_mm = 300;
+  make(WritePolicy{.read_only = false, .unlock_key = 4321, .unlock_timeout_s = 10, .write_clients = {}});
+  EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x43, 0xC8, 0x00, 0x00}), 0x03);  // 400.0f
+  EXPECT_TRUE(drain().empty());
+  EXPECT_TRUE(sink_.entries.empty());
+  EXPECT_EQ(handler_->status(0).change_counter, 0u);
+  EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x43, 0x96, 0x00, 0x00}), 0);  // 300.0f
+  EXPECT_EQ(drain().size(), 1u);
+  EXPECT_EQ(sink_.entries.size(), 1u);
+}
+
+// Every writable register of the shipped map, written just beyond the gate's limits (the
+// configuration narrows the setpoint to 0..300 and the manual valve to +-3 V): exception 03,
+// nothing queued, nothing audited. Values the register type cannot carry are skipped.
+TEST_F(Handler, EveryWritablePointBeyondItsLimitsIs03AndLeavesNoTrace) {
+  loop_.setpoint_max_mm = 300;
+  make(WritePolicy{.read_only = false, .unlock_key = 4321, .unlock_timeout_s = 10, .write_clients = {}});
+  ASSERT_EQ(send({0x06, 0x00, 0x09, 0x10, 0xE1}), 0);  // unlocked: the range must refuse tuning writes too
+  snap_.mode = runtime::Mode::kManual;
+  publish();
+  int checked = 0;
+  for (const RegisterEntry& e : map_->entries()) {
+    if (!e.writable || e.point->access == points::Access::kKey) continue;
+    const auto& r = gate_->limits().range(e.point->id);
+    for (double v : {r.max.value + std::max(1.0, std::abs(r.max.value) * 1e-3), r.min.value - std::max(1.0, std::abs(r.min.value) * 1e-3)}) {
+      Bytes pdu;
+      if (e.table == Table::kCoil) {
+        if (v != 0.0 && v != 1.0) continue;
+        pdu = {0x05, 0x00, static_cast<std::uint8_t>(e.address), static_cast<std::uint8_t>(v != 0 ? 0xFF : 0x00), 0x00};
+      } else {
+        std::uint16_t words[2] = {};
+        encode_value(e, v, words);
+        if (decode_value(e, words) != static_cast<double>(static_cast<float>(v)) && decode_value(e, words) != v) continue;
+        pdu = {0x10, static_cast<std::uint8_t>(e.address >> 8), static_cast<std::uint8_t>(e.address), 0x00,
+               static_cast<std::uint8_t>(e.width()), static_cast<std::uint8_t>(2 * e.width())};
+        for (int i = 0; i < e.width(); ++i) pdu.insert(pdu.end(), {static_cast<std::uint8_t>(words[i] >> 8), static_cast<std::uint8_t>(words[i])});
+      }
+      EXPECT_EQ(send(pdu), 0x03) << e.point->name << " = " << v;
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 10);
+  EXPECT_TRUE(drain().empty());
+  EXPECT_TRUE(sink_.entries.empty());
 }
 
 TEST_F(Handler, WriteToAnUnmappedRegisterIs02) {

@@ -18,7 +18,8 @@ namespace {
 
 using testing::paper_seed;
 
-const std::set<std::string> kPersisted = {"setpoint_mm", "controller", "m_r", "m_l", "b_r", "b_l", "lc_mm"};
+using P = points::PointId;
+const std::set<P> kPersisted = {P::kSetpoint, P::kController, P::kMr, P::kMl, P::kBr, P::kBl, P::kLc};
 
 class StoreWriterTest : public testing::ScratchDir {
  protected:
@@ -71,7 +72,7 @@ TEST_F(StoreWriterTest, APointNotPersistedInTheMapDoesNotChangeTheSet) {
   Database db0 = reader();
   auto opened = open_store(path("other.db"), paper_seed(), 1000);
   ASSERT_TRUE(opened);
-  StoreWriter writer(std::move(opened->db), running_, {"setpoint_mm"});
+  StoreWriter writer(std::move(opened->db), running_, {P::kSetpoint});
   writer.record({{2000, "modbus", "m_r", 1.7627, 2.0}});
   ASSERT_TRUE(writer.flush());
   auto db = Database::open(path("other.db"), false);

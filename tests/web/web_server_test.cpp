@@ -3,6 +3,8 @@
 // that bad requests and idle connections are survived.
 #include "web/web_server.hpp"
 
+#include "control/paper_controller.hpp"
+
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <httplib.h>
@@ -65,7 +67,12 @@ class WebServerTest : public ::testing::Test {
     config.port = 0;
     config.token = token;
     config.static_dir = std::string(EPA_SOURCE_DIR) + "/web";
-    auto server = epa::web::WebServer::start(config, channels_, limits_, &audit_, [] {
+    auto limits = epa::points::WriteLimits::from_config(limits_, "test.toml");
+    ASSERT_TRUE(limits.has_value()) << limits.error().message;
+    gate_ = std::make_unique<epa::points::WriteGate>(std::move(*limits), limits_,
+                                                     epa::control::paper_controller_config(epa::control::ControllerKind::kPpFfidz),
+                                                     channels_, &audit_);
+    auto server = epa::web::WebServer::start(config, channels_, gate_.get(), &audit_, [] {
       return epa::web::ModbusStats{true, 2, 77, 1};
     });
     ASSERT_TRUE(server.has_value()) << server.error().message;
@@ -99,6 +106,7 @@ class WebServerTest : public ::testing::Test {
   epa::runtime::Snapshot snap_;
   Collecting log_;
   epa::web::RecentAudit audit_{&log_};
+  std::unique_ptr<epa::points::WriteGate> gate_;
   std::unique_ptr<epa::web::WebServer> server_;
   std::unique_ptr<httplib::Client> client_;
 };
@@ -300,6 +308,51 @@ TEST_F(WebServerTest, CommandsAreValidatedLikeModbusWrites) {
   auto reset = post("/api/reset", "", "t");  // reset is what a latched fault needs
   ASSERT_TRUE(reset);
   EXPECT_EQ(reset->status, 200);
+}
+
+// The catalog over HTTP: GET /api/points lists every point with the gate's ranges, and
+// POST /api/points with any writable point beyond its range is 400 naming the limit, with
+// nothing queued or audited; within range (and in a state that allows it) it is taken.
+TEST_F(WebServerTest, EveryWritablePointBeyondItsLimitsIs400NamingTheLimit) {
+  limits_.setpoint_max_mm = 300;  // the configuration narrows the catalog's 0..500
+  start("t");
+  snap_.mode = epa::runtime::Mode::kManual;  // so only the range can refuse the manual valve
+  channels_.snapshot.publish(snap_);
+  const json catalog = get_json("/api/points");
+  int checked = 0;
+  for (const auto& p : catalog["points"]) {
+    if (!p.contains("max")) continue;  // read-only, or the Modbus key
+    const std::string name = p["name"];
+    for (double v : {p["max"].get<double>() + std::max(1.0, std::abs(p["max"].get<double>()) * 1e-3),
+                     p["min"].get<double>() - std::max(1.0, std::abs(p["min"].get<double>()) * 1e-3)}) {
+      auto res = post("/api/points", json{{name, v}}.dump(), "t");
+      ASSERT_TRUE(res);
+      EXPECT_EQ(res->status, 400) << name << " = " << v << ": " << res->body;
+      const std::string error = json::parse(res->body)["error"];
+      EXPECT_NE(error.find(name), std::string::npos) << error;
+      EXPECT_NE(error.find("outside"), std::string::npos) << error;
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 24);
+  auto far = post("/api/setpoint", R"({"setpoint_mm": 400})", "t");
+  ASSERT_TRUE(far);
+  EXPECT_EQ(far->status, 400);
+  EXPECT_NE(json::parse(far->body)["error"].get<std::string>().find("setpoint_max_mm"), std::string::npos) << far->body;
+  EXPECT_TRUE(queued().empty());
+  EXPECT_TRUE(audit_.entries().empty());
+
+  auto group = post("/api/points", R"({"manual_valve_v": 1.5, "m_r": 2.0, "controller": "pp"})", "t");
+  ASSERT_TRUE(group);
+  EXPECT_EQ(group->status, 200) << group->body;
+  EXPECT_EQ(queued().size(), 3u);  // manual valve, controller, tuning
+  EXPECT_EQ(audit_.entries().size(), 3u);
+  auto unknown = post("/api/points", R"({"setpoint": 100})", "t");
+  ASSERT_TRUE(unknown);
+  EXPECT_EQ(unknown->status, 400);
+  auto read_only = post("/api/points", R"({"position_mm": 100})", "t");
+  ASSERT_TRUE(read_only);
+  EXPECT_EQ(read_only->status, 400);
 }
 
 TEST_F(WebServerTest, UnknownPathsAndOversizedBodiesGetJsonErrors) {

@@ -1,0 +1,146 @@
+#include "points/point_catalog.hpp"
+
+#include <array>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace epa::points {
+
+namespace {
+
+using Ctx = PointContext;
+using A = Access;
+using P = PointId;
+double b(bool v) { return v ? 1.0 : 0.0; }
+double coefficient(const std::array<double, kCoefficients>& c, std::uint8_t degree, int i) {
+  return i <= degree ? c[static_cast<std::size_t>(i)] : 0.0;
+}
+
+// Names of the coefficient points (F0..H6), kept alive for the string_views in the catalog.
+const std::vector<std::string>& coefficient_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (char p : {'F', 'G', 'H'})
+      for (std::size_t i = 0; i < kCoefficients; ++i) n.push_back(std::string(1, p) + std::to_string(i));
+    return n;
+  }();
+  return names;
+}
+
+std::vector<PointDef> build() {
+  // {id, name, unit, description, access, min, max, integer, audited, read}
+  std::vector<PointDef> p = {
+      {P::kVersionMajor, "version_major", "", "firmware version, major", A::kRead, 0, 0, true, true, [](const Ctx&, int) { return double(kVersionMajor); }},
+      {P::kVersionMinor, "version_minor", "", "firmware version, minor", A::kRead, 0, 0, true, true, [](const Ctx&, int) { return double(kVersionMinor); }},
+      {P::kVersionPatch, "version_patch", "", "firmware version, patch", A::kRead, 0, 0, true, true, [](const Ctx&, int) { return double(kVersionPatch); }},
+      {P::kMode, "mode", "", "0 stop, 1 run, 2 manual (3 fault: read only; leave it with reset)", A::kWrite, 0, 2, true, true,
+       [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.mode)); }},
+      {P::kFaultCode, "fault_code", "", "latched fault: 0 none, 1 sensor not finite, 2 sensor out of range, 3 soft limit, 4 I/O errors, "
+                                        "5 overruns, 6 following error, 7 heartbeat lost, 8 controller fault, 9 store damaged, 10 sensor frozen",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.fault)); }},
+      {P::kFaultActive, "fault_active", "", "1 while a fault is latched", A::kRead, 0, 0, true, true,
+       [](const Ctx& c, int) { return b(c.snapshot.mode == runtime::Mode::kFault); }},
+      {P::kController, "controller", "", "0 pp, 1 pp-ngidz, 2 pp-ffidz", A::kWrite, 0, 2, true, true,
+       [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.controller)); }},
+      {P::kSetpoint, "setpoint_mm", "mm", "position setpoint", A::kWrite, 0, 500, false, true, [](const Ctx& c, int) { return c.snapshot.setpoint_mm; }},
+      {P::kPosition, "position_mm", "mm", "measured piston position", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.position_mm; }},
+      {P::kError, "error_mm", "mm", "setpoint - position", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.error_mm; }},
+      {P::kSensor, "sensor_v", "V", "position sensor voltage", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.sensor_v; }},
+      {P::kValve, "valve_v", "V", "valve command applied", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.valve_v; }},
+      {P::kControllerOutput, "controller_output_v", "V", "pole-placement output before dead-zone compensation", A::kRead, 0, 0, false, true,
+       [](const Ctx& c, int) { return c.snapshot.controller_v; }},
+      {P::kManualValve, "manual_valve_v", "V", "valve command in MANUAL (writable in MANUAL only)", A::kWrite, -10, 10, false, true,
+       [](const Ctx& c, int) { return c.snapshot.manual_valve_v; }},
+      {P::kSaturated, "saturated", "", "1 while the valve command is at its limit", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return b(c.snapshot.saturated); }},
+      {P::kIoOk, "io_ok", "", "1 while the DAQ reads and writes succeed", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return b(c.snapshot.io_ok); }},
+      {P::kReset, "reset", "", "write 1: clear a latched fault (to STOP)", A::kWrite, 1, 1, true, true, [](const Ctx&, int) { return 0.0; }},
+      {P::kHeartbeat, "heartbeat", "", "the supervising client increments this; if it stops, the appliance faults", A::kWrite, 0, 4294967295.0, true,
+       false, [](const Ctx& c, int) { return double(c.snapshot.heartbeat); }},
+      {P::kRecord, "record_s", "s", "write N: save the last N seconds as a run file", A::kWrite, 0.1, 3600, false, true, [](const Ctx&, int) { return 0.0; }},
+      {P::kUnlock, "unlock", "", "write the configured key: tuning registers writable until the unlock timeout", A::kKey, 0, 65535, true, false,
+       [](const Ctx&, int) { return 0.0; }},
+      {P::kLocked, "locked", "", "1 while tuning registers refuse writes", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return b(c.status.locked); }},
+      {P::kStoreOk, "store_ok", "", "1 while the tuning store saves changes; 0 while its writes fail (disk full, read-only): saved_counter stands still until they succeed",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return b(c.status.saving); }},
+      {P::kChangeCounter, "change_counter", "", "accepted changes since start (Modbus and web); the heartbeat and the unlock key do not count",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.change_counter); }},
+      {P::kSavedCounter, "saved_counter", "", "how many of the accepted changes are on disk: once it reaches the change_counter read after a write, that write survives a crash",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.saved_counter); }},
+      {P::kModbusRequests, "modbus_requests", "", "requests served since start", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.requests); }},
+      {P::kModbusClients, "modbus_clients", "", "connected Modbus clients", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.clients); }},
+      // tuning
+      {P::kTs, "Ts_s", "s", "sample time", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.Ts; }},
+      {P::kMr, "m_r", "", "dead zone right slope", A::kTuning, 1e-6, 100, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.m_r; }},
+      {P::kMl, "m_l", "", "dead zone left slope", A::kTuning, 1e-6, 100, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.m_l; }},
+      {P::kBr, "b_r", "V", "dead zone right break point", A::kTuning, -10, 10, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.b_r; }},
+      {P::kBl, "b_l", "V", "dead zone left break point", A::kTuning, -10, 10, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.b_l; }},
+      {P::kLc, "lc_mm", "mm", "FF-IDZ switch-off band l_c", A::kTuning, 0, 100, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.lc_mm; }},
+      // last move (NaN: never reached / never moved)
+      {P::kMoveNumber, "move_number", "", "moves measured since start", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.last_move.number); }},
+      {P::kMoveFrom, "move_from_mm", "mm", "last move: start", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.from_mm; }},
+      {P::kMoveTo, "move_to_mm", "mm", "last move: setpoint", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.to_mm; }},
+      {P::kMoveRise, "move_rise_s", "s", "last move: rise time 10-90 %", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.rise_s; }},
+      {P::kMoveSettling, "move_settling_s", "s", "last move: 2 % settling time", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.settling_s; }},
+      {P::kMoveEss, "move_ess_mm", "mm", "last move: steady-state error", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.ess_mm; }},
+      {P::kMoveOvershoot, "move_overshoot_pct", "%", "last move: overshoot", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.overshoot_pct; }},
+      // loop statistics and counters
+      {P::kLoopWakeP50, "loop_wake_p50_us", "us", "scan cycle wake-up latency, median", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.loop.wake_p50_us; }},
+      {P::kLoopWakeP99, "loop_wake_p99_us", "us", "scan cycle wake-up latency, 99th percentile", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.loop.wake_p99_us; }},
+      {P::kLoopWakeMax, "loop_wake_max_us", "us", "scan cycle wake-up latency, maximum", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.loop.wake_max_us; }},
+      {P::kLoopJitterP99, "loop_jitter_p99_us", "us", "scan period jitter, 99th percentile", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.loop.jitter_p99_us; }},
+      {P::kLoopComputeP99, "loop_compute_p99_us", "us", "scan cycle compute time, 99th percentile", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.loop.compute_p99_us; }},
+      {P::kLoopOverruns, "loop_overruns", "", "cycles that missed their deadline", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.loop.overruns); }},
+      {P::kCycles, "cycles", "", "scan cycles since start", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.cycle); }},
+      {P::kUptime, "uptime_s", "s", "time since start", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.time_s; }},
+      {P::kMoves, "moves", "", "moves finished since start", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.moves); }},
+      {P::kFaults, "faults", "", "faults since start", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.faults); }},
+      {P::kIoErrors, "io_errors", "", "failed DAQ reads and writes since start", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.io_errors); }},
+      {P::kCommandsApplied, "commands_applied", "", "commands the scan cycle applied", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.commands_applied); }},
+      {P::kCommandsRejected, "commands_rejected", "", "accepted commands the scan cycle refused after all (the state changed before it applied them)",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.commands_rejected); }},
+      {P::kLastCommandRefusal, "last_command_refusal", "", "why the scan cycle last refused a command: 0 none, 1 setpoint out of range, 2 manual valve out of range, "
+                                                            "3 not in MANUAL, 4 fault latched, 5 FAULT not settable, 6 recorder busy, 7 record seconds out of range",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.last_refusal)); }},
+  };
+  const auto& names = coefficient_names();
+  static constexpr std::string_view kWhat[] = {"controller F coefficient of q^-i (F u = H r - G y)", "controller G coefficient of q^-i",
+                                               "controller H coefficient of q^-i"};
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const int i = static_cast<int>(k % kCoefficients);
+    PointDef d{static_cast<PointId>(index(PointId::kF0) + k), names[k], "", kWhat[k / kCoefficients], A::kRead, 0, 0, false, true, nullptr, i};
+    switch (k / kCoefficients) {
+      case 0: d.read = [](const Ctx& c, int j) { return coefficient(c.snapshot.tuning.F, c.snapshot.tuning.nF, j); }; break;
+      case 1: d.read = [](const Ctx& c, int j) { return coefficient(c.snapshot.tuning.G, c.snapshot.tuning.nG, j); }; break;
+      default: d.read = [](const Ctx& c, int j) { return coefficient(c.snapshot.tuning.H, c.snapshot.tuning.nH, j); }; break;
+    }
+    p.push_back(d);
+  }
+  return p;
+}
+
+const std::vector<PointDef>& catalog() {
+  static const std::vector<PointDef> c = [] {
+    auto p = build();
+    // In PointId order, one definition each: point(id) is an index.
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (index(p[i].id) != i) std::abort();
+    if (p.size() != kPointCount) std::abort();
+    return p;
+  }();
+  return c;
+}
+
+}  // namespace
+
+std::span<const PointDef> point_catalog() { return catalog(); }
+const PointDef& point(PointId id) { return catalog()[index(id)]; }
+std::string_view name(PointId id) { return point(id).name; }
+
+const PointDef* find_point(std::string_view name) {
+  for (const auto& p : catalog())
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+}  // namespace epa::points

@@ -1,0 +1,64 @@
+#pragma once
+// The catalog of points: everything an operator or integrator reads from the appliance (snapshot
+// values, tuning, metrics, loop statistics, counters) and the things they write (setpoint, mode,
+// controller, manual valve, tuning, reset, heartbeat, record, unlock), each with its public name,
+// unit, access, range and description. Every interface reads it: the register map binds Modbus
+// addresses to its points, the JSON API and /metrics name values by it, the store keys retained
+// points by it, and the write gate checks writes against its access and range. `epa registers
+// --points` lists it.
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include "points/point_id.hpp"
+#include "runtime/snapshot.hpp"
+
+namespace epa::points {
+
+// What the interfaces know besides the loop's snapshot, for the points that describe them.
+struct InterfaceStatus {
+  std::uint32_t change_counter = 0;  // accepted changes since start, every interface
+  std::uint32_t saved_counter = 0;   // how many of them are on disk
+  bool saving = true;                // the store's writes succeed
+  std::uint64_t requests = 0;        // Modbus requests served
+  int clients = 0;                   // connected Modbus clients
+  bool locked = true;                // tuning points refuse this client's writes
+};
+
+struct PointContext {
+  const runtime::Snapshot& snapshot;
+  const InterfaceStatus& status;
+};
+
+enum class Access : std::uint8_t {
+  kRead,    // read only
+  kWrite,   // any client with write rights
+  kTuning,  // only while unlocked (Modbus: the key; HTTP: the token)
+  kKey,     // the unlock key: taken by the interface that owns the key, never queued to the loop
+};
+
+struct PointDef {
+  PointId id = PointId::kCount;
+  std::string_view name;
+  std::string_view unit;
+  std::string_view description;
+  Access access = Access::kRead;
+  double min = 0, max = 0;  // the values a write may carry, before the configuration narrows them
+  bool integer = false;     // whole numbers only (enumerations, counters, keys)
+  bool audited = true;      // accepted writes go to the audit trail (not: the heartbeat, a keep-alive)
+  double (*read)(const PointContext&, int index) = nullptr;
+  int index = 0;            // for the coefficients: F3 reads F[3]
+
+  bool writable() const { return access != Access::kRead; }
+  bool tuning() const { return access == Access::kTuning; }
+  double value(const PointContext& c) const { return read(c, index); }
+};
+
+std::span<const PointDef> point_catalog();        // in PointId order
+const PointDef& point(PointId id);                 // id < kCount
+std::string_view name(PointId id);                 // the public name
+const PointDef* find_point(std::string_view name);  // nullptr when unknown
+
+inline constexpr int kVersionMajor = 0, kVersionMinor = 2, kVersionPatch = 0;
+
+}  // namespace epa::points

@@ -1,0 +1,42 @@
+#pragma once
+// The typed names of the appliance's points. Code refers to a point by its PointId; its public
+// name (the register map's `name` column, the JSON API's keys, the audit trail, the store's
+// retained points) is written once, in point_catalog.cpp.
+#include <cstddef>
+#include <cstdint>
+
+#include "control/rst_law.hpp"
+
+namespace epa::points {
+
+inline constexpr std::size_t kCoefficients = control::kMaxLawOrder + 1;  // F0..F6, G0..G6, H0..H6
+
+enum class PointId : std::uint16_t {
+  // identity and status
+  kVersionMajor, kVersionMinor, kVersionPatch, kMode, kFaultCode, kFaultActive, kController,
+  kSetpoint, kPosition, kError, kSensor, kValve, kControllerOutput, kManualValve, kSaturated, kIoOk,
+  // commands
+  kReset, kHeartbeat, kRecord, kUnlock,
+  // the interfaces and the store
+  kLocked, kStoreOk, kChangeCounter, kSavedCounter, kModbusRequests, kModbusClients,
+  // tuning
+  kTs, kMr, kMl, kBr, kBl, kLc,
+  // the last move
+  kMoveNumber, kMoveFrom, kMoveTo, kMoveRise, kMoveSettling, kMoveEss, kMoveOvershoot,
+  // loop statistics and counters
+  kLoopWakeP50, kLoopWakeP99, kLoopWakeMax, kLoopJitterP99, kLoopComputeP99, kLoopOverruns, kCycles, kUptime,
+  kMoves, kFaults, kIoErrors, kCommandsApplied, kCommandsRejected, kLastCommandRefusal,
+  // controller coefficients: kF0 + i, kG0 + i, kH0 + i for i < kCoefficients
+  kF0,
+  kG0 = kF0 + kCoefficients,
+  kH0 = kG0 + kCoefficients,
+  kCount = kH0 + kCoefficients,
+};
+
+inline constexpr std::size_t kPointCount = static_cast<std::size_t>(PointId::kCount);
+inline constexpr std::size_t index(PointId id) { return static_cast<std::size_t>(id); }
+inline constexpr PointId coefficient_id(PointId first, std::size_t i) {
+  return static_cast<PointId>(static_cast<std::size_t>(first) + i);
+}
+
+}  // namespace epa::points

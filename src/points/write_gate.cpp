@@ -1,0 +1,193 @@
+#include "points/write_gate.hpp"
+
+#include <cmath>
+
+#include "core/format.hpp"
+#include "points/point_catalog.hpp"
+#include "runtime/tuning.hpp"
+
+namespace epa::points {
+
+struct WriteGate::Decision {
+  std::vector<runtime::Command> commands;
+  std::vector<PointId> command_point;  // the point each command came from (a tuning command: the first tuning point)
+  control::ControllerConfig tuning;
+  bool tuning_changed = false;
+};
+
+namespace {
+
+GateResult refuse(Refusal r, std::string reason) { return {r, std::move(reason)}; }
+
+std::string quoted(PointId id) { return "'" + std::string(name(id)) + "'"; }
+
+// Which refusals of the loop's rules mean "not in this state" rather than "not this value".
+Refusal gate_refusal(runtime::CommandRefusal r) {
+  switch (r) {
+    case runtime::CommandRefusal::kNotManual:
+    case runtime::CommandRefusal::kFaultLatched:
+    case runtime::CommandRefusal::kRecordQueueFull: return Refusal::kConflict;
+    default: return Refusal::kInvalidValue;
+  }
+}
+
+}  // namespace
+
+WriteGate::WriteGate(WriteLimits limits, const runtime::RuntimeConfig& loop_rules, control::ControllerConfig tuning,
+                     runtime::LoopChannels& channels, core::AuditSink* audit)
+    : limits_(std::move(limits)), loop_rules_(loop_rules), channels_(channels), audit_(audit), tuning_(std::move(tuning)) {}
+
+control::ControllerConfig WriteGate::running_tuning() const {
+  std::lock_guard lock(mutex_);
+  return tuning_;
+}
+
+GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester& who, const runtime::Snapshot& snap,
+                            const control::ControllerConfig& tuning, Decision& out) const {
+  if (writes.empty()) return refuse(Refusal::kInvalidValue, "nothing to write");
+  // 1. Each value: a writable point, within the one set of limits, whole where it must be.
+  for (const PointWrite& w : writes) {
+    if (index(w.id) >= kPointCount) return refuse(Refusal::kNotWritable, "unknown point");
+    const PointDef& p = point(w.id);
+    if (!p.writable() || p.access == Access::kKey) return refuse(Refusal::kNotWritable, quoted(w.id) + " is read-only");
+    if (auto e = limits_.check(w.id, w.value); !e.empty()) return refuse(Refusal::kInvalidValue, e);
+    if (p.integer && w.value != std::floor(w.value))
+      return refuse(Refusal::kInvalidValue, quoted(w.id) + " takes whole numbers, not " + core::format_number(w.value));
+  }
+  // 2. The client's rights.
+  if (!who.may_write) return refuse(Refusal::kForbidden, who.no_write_reason.empty() ? "this client may not write" : who.no_write_reason);
+  for (const PointWrite& w : writes)
+    if (point(w.id).tuning() && !who.tuning_unlocked)
+      return refuse(Refusal::kForbidden, quoted(w.id) + " is a tuning point: unlock the tuning first");
+  // 3. The commands, all of them or none.
+  out.tuning = tuning;
+  PointId first_tuning_point = PointId::kCount;
+  for (const PointWrite& w : writes) {
+    runtime::Command c;
+    switch (w.id) {
+      case PointId::kSetpoint: c = runtime::setpoint_command(w.value); break;
+      case PointId::kMode: c = runtime::mode_command(static_cast<runtime::Mode>(static_cast<int>(w.value))); break;
+      case PointId::kController: c = runtime::controller_command(static_cast<control::ControllerKind>(static_cast<int>(w.value))); break;
+      case PointId::kManualValve: c = runtime::manual_valve_command(w.value); break;
+      case PointId::kReset: c = runtime::reset_command(); break;
+      case PointId::kHeartbeat: c = runtime::heartbeat_command(static_cast<std::uint32_t>(w.value)); break;
+      case PointId::kRecord: c = runtime::record_command(w.value); break;
+      case PointId::kMr: out.tuning.dead_zone.m_r = w.value; break;
+      case PointId::kMl: out.tuning.dead_zone.m_l = w.value; break;
+      case PointId::kBr: out.tuning.dead_zone.b_r = w.value; break;
+      case PointId::kBl: out.tuning.dead_zone.b_l = w.value; break;
+      case PointId::kLc: out.tuning.lc_v = w.value / loop_rules_.mm_per_volt; break;
+      default: return refuse(Refusal::kNotWritable, quoted(w.id) + " has no command behind it");
+    }
+    if (point(w.id).tuning()) {
+      if (first_tuning_point == PointId::kCount) first_tuning_point = w.id;
+      continue;
+    }
+    out.commands.push_back(c);
+    out.command_point.push_back(w.id);
+  }
+  if (first_tuning_point != PointId::kCount) {
+    // Every tuning point of the group becomes one tuning command, validated whole (e.g. b_l > b_r
+    // after this write is refused), last in the group.
+    auto t = runtime::make_tuning(out.tuning);
+    if (!t) return refuse(Refusal::kInvalidValue, "the tuning would not validate: " + t.error().message);
+    out.tuning_changed = true;
+    out.commands.push_back(runtime::tuning_command(*t));
+    out.command_point.push_back(first_tuning_point);
+  }
+  // 4. The scan cycle's own rules, in the state it last published.
+  for (std::size_t i = 0; i < out.commands.size(); ++i)
+    if (const auto r = runtime::check_command(out.commands[i], snap.mode, loop_rules_); r != runtime::CommandRefusal::kNone)
+      return refuse(gate_refusal(r), quoted(out.command_point[i]) + ": " + std::string(runtime::describe(r)));
+  return {};
+}
+
+GateResult WriteGate::decide(std::span<const PointWrite> writes, const Requester& who, const runtime::Snapshot& snap,
+                             std::vector<runtime::Command>* commands) const {
+  Decision d;
+  const auto tuning = running_tuning();
+  GateResult r = build(writes, who, snap, tuning, d);
+  if (r.accepted() && commands) *commands = d.commands;
+  return r;
+}
+
+GateResult WriteGate::submit(std::span<const PointWrite> writes, const Requester& who) {
+  std::lock_guard lock(mutex_);
+  const runtime::Snapshot snap = channels_.snapshot.read();
+  Decision d;
+  if (GateResult r = build(writes, who, snap, tuning_, d); !r.accepted()) return r;
+  const std::uint64_t first = next_sequence_;
+  for (std::size_t i = 0; i < d.commands.size(); ++i) d.commands[i].sequence = first + i;
+  if (!d.commands.empty() && !channels_.commands.try_push_all(d.commands.data(), d.commands.size()))
+    return refuse(Refusal::kBusy, "the scan cycle's command queue is full: try again");
+  next_sequence_ += d.commands.size();
+  if (d.tuning_changed) tuning_ = d.tuning;
+
+  // Accepted: the audit trail (and so the store) gets the group. Each entry keeps its command's
+  // sequence number while it is in flight, so a late refusal can be audited against it.
+  const InterfaceStatus status;
+  const PointContext ctx{snap, status};
+  const std::int64_t time_ms = core::unix_time_ms();
+  std::vector<core::AuditEntry> change;
+  for (const PointWrite& w : writes) {
+    const PointDef& p = point(w.id);
+    if (!p.audited) continue;
+    core::AuditEntry e{time_ms, who.source, std::string(p.name), p.value(ctx), w.value};
+    std::uint64_t sequence = first + d.commands.size() - 1;  // a tuning point: the tuning command, last
+    for (std::size_t i = 0; i < d.commands.size() && !p.tuning(); ++i)
+      if (d.command_point[i] == w.id) sequence = first + i;
+    in_flight_.push_back({sequence, e});
+    if (in_flight_.size() > kInFlight) in_flight_.pop_front();
+    change.push_back(std::move(e));
+  }
+  if (audit_ && !change.empty()) audit_->record(change);
+  return {};
+}
+
+void WriteGate::take_refusals(const std::function<void(const std::string&)>& log) {
+  runtime::CommandOutcome o;
+  while (channels_.refusals.try_pop(o)) {
+    std::vector<core::AuditEntry> refused;
+    {
+      std::lock_guard lock(mutex_);
+      for (const InFlight& f : in_flight_) {
+        if (f.sequence != o.sequence) continue;
+        // The point kept its value: audited as a change from the refused value back to it.
+        refused.push_back({core::unix_time_ms(), "scan cycle, refusing " + f.entry.source + ": " + std::string(runtime::describe(o.refusal)),
+                           f.entry.point, f.entry.new_value, f.entry.old_value});
+      }
+    }
+    if (log) {
+      if (refused.empty()) log("scan cycle refused command " + std::to_string(o.sequence) + ": " + std::string(runtime::describe(o.refusal)));
+      for (const auto& e : refused)
+        log("scan cycle refused " + e.point + " = " + core::format_number(e.old_value) + " (" + e.source + ")");
+    }
+    if (audit_ && !refused.empty()) audit_->record(refused);
+  }
+}
+
+std::uint8_t modbus_exception(Refusal r) {
+  switch (r) {
+    case Refusal::kNone: return 0;
+    case Refusal::kNotWritable: return 0x02;
+    case Refusal::kInvalidValue: return 0x03;
+    case Refusal::kForbidden:
+    case Refusal::kConflict: return 0x04;
+    case Refusal::kBusy: return 0x06;
+  }
+  return 0x04;
+}
+
+int http_status(Refusal r) {
+  switch (r) {
+    case Refusal::kNone: return 200;
+    case Refusal::kNotWritable:
+    case Refusal::kInvalidValue: return 400;
+    case Refusal::kForbidden: return 403;
+    case Refusal::kConflict: return 409;
+    case Refusal::kBusy: return 503;
+  }
+  return 400;
+}
+
+}  // namespace epa::points

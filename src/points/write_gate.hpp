@@ -1,0 +1,109 @@
+#pragma once
+// The one write gate. Every interface (Modbus, HTTP, and the ones to come) hands it a write of one
+// point or a group, with who asks and what that client may do; the gate checks the group whole
+// against the catalog's access, one set of limits (write_limits.hpp), the client's rights, the
+// tuning lock, and the scan cycle's own rules in the state it last published
+// (runtime/command_rules.hpp). It then either queues one command group for the loop and hands the
+// audit trail its entries, or refuses with one reason that each interface maps to its own error
+// (Modbus exception 02/03/04/06, HTTP 400/403/409/503). Nothing is half-applied.
+//
+// The gate owns the running tuning: tuning writes edit its copy, which becomes the loop's whole
+// at the next cycle; everyone else reads it (running_tuning(), the snapshot).
+//
+// A command the gate accepted is refused by the loop only when the state changed in between (a
+// fault latched, the recorder busy). take_refusals() collects those off the loop: each is logged
+// and audited as refused, with the value the point kept, and counted in the snapshot.
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "control/controller.hpp"
+#include "core/audit.hpp"
+#include "points/point_id.hpp"
+#include "points/write_limits.hpp"
+#include "runtime/scan_cycle.hpp"
+
+namespace epa::points {
+
+struct PointWrite {
+  PointId id = PointId::kCount;
+  double value = 0;
+};
+
+enum class Refusal : std::uint8_t {
+  kNone,
+  kNotWritable,   // a read-only point                                  Modbus 02, HTTP 400
+  kInvalidValue,  // out of range, not whole, tuning that does not validate  03, 400
+  kForbidden,     // no write rights, or a tuning point while locked          04, 403
+  kConflict,      // not now: wrong mode, a fault latched                     04, 409
+  kBusy,          // the loop's command queue is full: try again              06, 503
+};
+
+struct GateResult {
+  Refusal refusal = Refusal::kNone;
+  std::string reason;  // names the point and what was wrong
+  bool accepted() const { return refusal == Refusal::kNone; }
+};
+
+// Who writes, as the interface knows it.
+struct Requester {
+  std::string source;            // for the audit trail and logs: "modbus 127.0.0.1:50312", "web 127.0.0.1"
+  bool may_write = true;         // the interface's write policy for this client
+  std::string no_write_reason;   // why not, when !may_write ("the Modbus server is read-only")
+  bool tuning_unlocked = false;  // Modbus: the key was sent; HTTP: the token
+};
+
+class WriteGate {
+ public:
+  // `loop_rules` is the scan cycle's configuration (its command rules and mm_per_volt); `tuning`
+  // the running tuning's configuration; `audit` may be null.
+  WriteGate(WriteLimits limits, const runtime::RuntimeConfig& loop_rules, control::ControllerConfig tuning,
+            runtime::LoopChannels& channels, core::AuditSink* audit);
+
+  // Checks `writes` whole against the loop's current snapshot; queues and audits them, or refuses.
+  GateResult submit(std::span<const PointWrite> writes, const Requester& who);
+
+  // The same decision against the state `snap`, without queueing or auditing; on acceptance
+  // `commands` holds what submit would queue (tests hold it against the loop's checks).
+  GateResult decide(std::span<const PointWrite> writes, const Requester& who, const runtime::Snapshot& snap,
+                    std::vector<runtime::Command>* commands = nullptr) const;
+
+  // Logs and audits the commands the loop refused after the gate accepted them. Off the loop.
+  void take_refusals(const std::function<void(const std::string&)>& log);
+
+  control::ControllerConfig running_tuning() const;
+  const WriteLimits& limits() const { return limits_; }
+  core::ChangeCounters counters() const { return audit_ ? audit_->counters() : core::ChangeCounters{}; }
+
+ private:
+  struct Decision;
+  GateResult build(std::span<const PointWrite> writes, const Requester& who, const runtime::Snapshot& snap,
+                   const control::ControllerConfig& tuning, Decision& out) const;
+
+  // An accepted, audited write whose command the loop may still refuse.
+  struct InFlight {
+    std::uint64_t sequence = 0;
+    core::AuditEntry entry;
+  };
+
+  const WriteLimits limits_;
+  const runtime::RuntimeConfig loop_rules_;
+  runtime::LoopChannels& channels_;
+  core::AuditSink* audit_;
+
+  mutable std::mutex mutex_;  // one writer at a time: Modbus and web threads
+  control::ControllerConfig tuning_;
+  std::uint64_t next_sequence_ = 1;
+  std::deque<InFlight> in_flight_;  // the last kInFlight accepted writes, for late refusals
+  static constexpr std::size_t kInFlight = 1024;
+};
+
+// The interfaces' codes for a refusal.
+std::uint8_t modbus_exception(Refusal r);  // 02, 03, 04 or 06
+int http_status(Refusal r);                // 400, 403, 409 or 503
+
+}  // namespace epa::points

@@ -1,0 +1,43 @@
+#include "runtime/command_rules.hpp"
+
+#include <cmath>
+
+namespace epa::runtime {
+
+CommandRefusal check_command(const Command& c, Mode mode, const RuntimeConfig& config) noexcept {
+  switch (c.kind) {
+    case CommandKind::kSetpoint:
+      return c.value >= config.setpoint_min_mm && c.value <= config.setpoint_max_mm ? CommandRefusal::kNone
+                                                                                  : CommandRefusal::kSetpointOutOfRange;
+    case CommandKind::kMode:
+      if (c.mode == Mode::kFault) return CommandRefusal::kModeNotSettable;
+      return mode == Mode::kFault ? CommandRefusal::kFaultLatched : CommandRefusal::kNone;
+    case CommandKind::kManualValve:
+      if (!(std::abs(c.value) <= config.manual_valve_limit_v)) return CommandRefusal::kManualValveOutOfRange;
+      return mode == Mode::kManual ? CommandRefusal::kNone : CommandRefusal::kNotManual;
+    case CommandKind::kRecord:
+      return c.value > 0.0 && std::isfinite(c.value) ? CommandRefusal::kNone : CommandRefusal::kRecordOutOfRange;
+    case CommandKind::kController:
+    case CommandKind::kTuning:  // validated whole by runtime::make_tuning before it is queued
+    case CommandKind::kReset:   // a reset without a latched fault does nothing, and that is fine
+    case CommandKind::kHeartbeat:
+      return CommandRefusal::kNone;
+  }
+  return CommandRefusal::kNone;
+}
+
+std::string_view describe(CommandRefusal r) {
+  switch (r) {
+    case CommandRefusal::kNone: return "accepted";
+    case CommandRefusal::kSetpointOutOfRange: return "the setpoint is outside the configured setpoint range";
+    case CommandRefusal::kManualValveOutOfRange: return "the manual valve command is beyond the manual valve limit";
+    case CommandRefusal::kNotManual: return "the manual valve command is only taken in MANUAL";
+    case CommandRefusal::kFaultLatched: return "a fault is latched: reset it before changing the mode";
+    case CommandRefusal::kModeNotSettable: return "FAULT is entered by faults only";
+    case CommandRefusal::kRecordQueueFull: return "the recorder has not caught up with earlier requests";
+    case CommandRefusal::kRecordOutOfRange: return "the seconds to record must be positive";
+  }
+  return "unknown";
+}
+
+}  // namespace epa::runtime

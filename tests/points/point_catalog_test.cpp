@@ -1,0 +1,79 @@
+// The catalog itself: one entry per PointId in order, unique names, ranges for writable points;
+// and the rule that a point's public name is written once in the source tree, in the catalog.
+#include "points/point_catalog.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+
+namespace epa::points {
+namespace {
+
+TEST(PointCatalog, OneEntryPerIdInOrderWithUniqueNames) {
+  const auto catalog = point_catalog();
+  ASSERT_EQ(catalog.size(), kPointCount);
+  std::set<std::string_view> names;
+  for (std::size_t i = 0; i < catalog.size(); ++i) {
+    EXPECT_EQ(index(catalog[i].id), i);
+    EXPECT_TRUE(names.insert(catalog[i].name).second) << catalog[i].name;
+    EXPECT_NE(catalog[i].read, nullptr) << catalog[i].name;
+    EXPECT_EQ(find_point(catalog[i].name), &catalog[i]);
+    if (catalog[i].writable()) {
+      EXPECT_LE(catalog[i].min, catalog[i].max) << catalog[i].name;
+    }
+  }
+  EXPECT_EQ(find_point("no_such_point"), nullptr);
+  EXPECT_EQ(name(PointId::kSetpoint), "setpoint_mm");
+  EXPECT_EQ(name(coefficient_id(PointId::kG0, 3)), "G3");
+}
+
+// Files that spell a point's name as a key of their own documented format (FORMATS.md), not as
+// the point: the configuration's [startup] setpoint_mm and [controller] lc_mm, epa-tuning/1 and
+// epa-model/1 keys, the run files' `controller` metadata, report labels, the recent-moves list.
+const std::map<std::string, std::string> kFormatFiles = {
+    {"app/appliance_config.cpp", "epa-config/1 keys"},
+    {"store/tuning_file.cpp", "epa-tuning/1 keys"},
+    {"core/dead_zone.cpp", "epa-model/1 dead-zone keys"},
+    {"core/model_file.cpp", "epa-model/1 keys"},
+    {"core/run_file.cpp", "epa-run/1 metadata"},
+    {"runtime/recorder.cpp", "epa-run/1 metadata"},
+    {"app/run_history.cpp", "epa-run/1 metadata"},
+    {"app/identify_command.cpp", "epa-run/1 metadata"},
+    {"app/simulate_command.cpp", "epa-run/1 metadata"},
+    {"ident/excitation.cpp", "epa-run/1 metadata"},
+    {"sim/closed_loop.cpp", "epa-run/1 metadata"},
+    {"app/identify_report.cpp", "a report's row labels"},
+    {"app/tuning_command.cpp", "epa tuning show's labels"},
+    {"web/json_api.cpp", "the loop statistics' cycle count and the recent-moves list, other values than the points"},
+};
+
+TEST(PointCatalog, APointsNameIsWrittenOnceInTheSourceTreeInTheCatalog) {
+  std::set<std::string> names;
+  for (const auto& p : point_catalog()) names.insert(std::string(p.name));
+  const std::filesystem::path src = std::filesystem::path(EPA_SOURCE_DIR) / "src";
+  const std::regex literal("\"([A-Za-z_0-9]+)\"");
+  int files = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(src)) {
+    if (!entry.is_regular_file()) continue;
+    const std::string rel = std::filesystem::relative(entry.path(), src).generic_string();
+    if (rel == "points/point_catalog.cpp" || kFormatFiles.contains(rel)) continue;
+    ++files;
+    std::ifstream in(entry.path());
+    std::string line;
+    for (int n = 1; std::getline(in, line); ++n) {
+      const auto code = line.substr(0, line.find("//"));  // comments may show examples
+      for (std::sregex_iterator it(code.begin(), code.end(), literal), end; it != end; ++it)
+        EXPECT_FALSE(names.contains((*it)[1].str()))
+            << "src/" << rel << ":" << n << " spells the point name \"" << (*it)[1].str()
+            << "\": use points::name(PointId::...) (or, for a file format's own key, list the file here)";
+    }
+  }
+  EXPECT_GT(files, 100);
+}
+
+}  // namespace
+}  // namespace epa::points

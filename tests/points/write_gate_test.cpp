@@ -1,0 +1,262 @@
+// The one write gate, held against what it must guarantee: every writable point outside its one
+// set of limits is refused with the limit named and nothing queued or audited; every write it
+// accepts is applied by a real scan cycle in the same state; and a refusal that arises after it
+// looked is counted, logged and audited as refused.
+#include "points/write_gate.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "../runtime/fake_daq.hpp"
+#include "control/paper_controller.hpp"
+#include "points/point_catalog.hpp"
+#include "runtime/tuning.hpp"
+
+namespace epa::points {
+namespace {
+
+using runtime::Mode;
+
+struct RecordingSink final : core::AuditSink {
+  std::vector<core::AuditEntry> entries;
+  void record(const std::vector<core::AuditEntry>& change) override { entries.insert(entries.end(), change.begin(), change.end()); }
+};
+
+control::ControllerConfig paper() { return control::paper_controller_config(control::ControllerKind::kPpFfidz); }
+
+// The integrator's case of the issue: [limits] setpoint_max_mm = 300, the catalog allows 500.
+runtime::RuntimeConfig narrowed_config() {
+  runtime::RuntimeConfig c;
+  c.setpoint_max_mm = 300.0;
+  return c;
+}
+
+WriteLimits limits_of(const runtime::RuntimeConfig& c) {
+  auto l = WriteLimits::from_config(c, "epa.toml");
+  EXPECT_TRUE(l.has_value()) << l.error().message;
+  return *l;
+}
+
+const Requester kOperator{"test", true, "", /*tuning_unlocked=*/true};
+
+std::vector<const PointDef*> gated_points() {
+  std::vector<const PointDef*> out;
+  for (const auto& p : point_catalog())
+    if (p.writable() && p.access != Access::kKey) out.push_back(&p);
+  return out;
+}
+
+// A value just beyond a bound: far enough that no rounding brings it back.
+double beyond(double bound, double direction) { return bound + direction * std::max(1.0, std::abs(bound) * 1e-3); }
+
+TEST(WriteGate, EveryWritablePointOutsideItsLimitsIsRefusedNamingTheLimitAndNothingIsQueuedOrAudited) {
+  const auto config = narrowed_config();
+  runtime::LoopChannels channels(16);
+  runtime::Snapshot snap;
+  snap.mode = Mode::kManual;  // the mode rules would allow the manual valve: the range must refuse it
+  channels.snapshot.publish(snap);
+  RecordingSink sink;
+  WriteGate gate(limits_of(config), config, paper(), channels, &sink);
+  int checked = 0;
+  for (const PointDef* p : gated_points()) {
+    const PointRange& r = gate.limits().range(p->id);
+    for (const auto& [value, bound] : {std::pair{beyond(r.max.value, +1), &r.max}, std::pair{beyond(r.min.value, -1), &r.min},
+                                       std::pair{std::numeric_limits<double>::quiet_NaN(), &r.max}}) {
+      const PointWrite w{p->id, value};
+      const GateResult result = gate.submit({&w, 1}, kOperator);
+      EXPECT_EQ(result.refusal, Refusal::kInvalidValue) << p->name << " = " << value;
+      EXPECT_NE(result.reason.find(std::string(p->name)), std::string::npos) << result.reason;
+      EXPECT_NE(result.reason.find(bound->source), std::string::npos) << result.reason;
+      EXPECT_EQ(modbus_exception(result.refusal), 0x03);
+      EXPECT_EQ(http_status(result.refusal), 400);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 3 * static_cast<int>(gated_points().size()));
+  EXPECT_GE(gated_points().size(), 12u);  // setpoint, mode, controller, manual valve, reset, heartbeat, record, 5 tuning
+  runtime::Command c;
+  EXPECT_FALSE(channels.commands.try_pop(c));
+  EXPECT_TRUE(sink.entries.empty());
+}
+
+TEST(WriteGate, TheConfigurationNarrowsTheCatalogAndTheRefusalSaysWhichKey) {
+  const auto config = narrowed_config();
+  runtime::LoopChannels channels(16);
+  WriteGate gate(limits_of(config), config, paper(), channels, nullptr);
+  const PointWrite w{PointId::kSetpoint, 400.0};
+  const auto r = gate.submit({&w, 1}, kOperator);
+  EXPECT_EQ(r.refusal, Refusal::kInvalidValue);
+  EXPECT_EQ(r.reason, "setpoint_mm 400 is outside [0, 300] mm (maximum from epa.toml [limits] setpoint_max_mm)");
+}
+
+TEST(WriteGate, ConfigurationsAndMapsThatContradictTheCatalogAreRefused) {
+  runtime::RuntimeConfig c;
+  c.setpoint_max_mm = 800.0;  // beyond the stroke the catalog allows
+  const auto l = WriteLimits::from_config(c, "epa.toml");
+  ASSERT_FALSE(l.has_value());
+  EXPECT_NE(l.error().message.find("setpoint_max_mm"), std::string::npos) << l.error().message;
+  auto limits = limits_of(narrowed_config());
+  const auto s = limits.narrow(PointId::kSetpoint, 350.0, 500.0, "map.csv:2");  // nothing left of [0, 300]
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().message.find("map.csv:2"), std::string::npos) << s.error().message;
+  ASSERT_TRUE(limits.narrow(PointId::kSetpoint, 10.0, 500.0, "map.csv:2"));
+  EXPECT_EQ(limits.range(PointId::kSetpoint).min.value, 10.0);
+  EXPECT_EQ(limits.range(PointId::kSetpoint).min.source, "map.csv:2");
+  EXPECT_EQ(limits.range(PointId::kSetpoint).max.value, 300.0);
+}
+
+TEST(WriteGate, RightsLockAndAccessAreCheckedAfterTheValues) {
+  const runtime::RuntimeConfig config;
+  runtime::LoopChannels channels(16);
+  RecordingSink sink;
+  WriteGate gate(limits_of(config), config, paper(), channels, &sink);
+  const PointWrite lc{PointId::kLc, 3.0};
+  EXPECT_EQ(gate.submit({&lc, 1}, Requester{"test", true, "", false}).refusal, Refusal::kForbidden);
+  const auto no_rights = gate.submit({&lc, 1}, Requester{"test", false, "the Modbus server is read-only", true});
+  EXPECT_EQ(no_rights.refusal, Refusal::kForbidden);
+  EXPECT_EQ(no_rights.reason, "the Modbus server is read-only");
+  const PointWrite position{PointId::kPosition, 1.0}, key{PointId::kUnlock, 1.0};
+  EXPECT_EQ(gate.submit({&position, 1}, kOperator).refusal, Refusal::kNotWritable);
+  EXPECT_EQ(gate.submit({&key, 1}, kOperator).refusal, Refusal::kNotWritable);  // the key is its interface's own
+  EXPECT_TRUE(sink.entries.empty());
+  EXPECT_TRUE(gate.submit({&lc, 1}, kOperator).accepted());
+  EXPECT_DOUBLE_EQ(gate.running_tuning().lc_v, 3.0 / config.mm_per_volt);  // the gate owns the running tuning
+  ASSERT_EQ(sink.entries.size(), 1u);
+  EXPECT_EQ(sink.entries[0].point, "lc_mm");
+}
+
+TEST(WriteGate, AGroupIsTakenWholeOrNotAtAll) {
+  const runtime::RuntimeConfig config;
+  runtime::LoopChannels channels(16);
+  RecordingSink sink;
+  WriteGate gate(limits_of(config), config, paper(), channels, &sink);
+  const PointWrite bad[] = {{PointId::kSetpoint, 100.0}, {PointId::kBl, 2.0}};  // b_l > b_r: the tuning does not validate
+  const auto r = gate.submit(bad, kOperator);
+  EXPECT_EQ(r.refusal, Refusal::kInvalidValue);
+  EXPECT_NE(r.reason.find("tuning"), std::string::npos) << r.reason;
+  runtime::Command c;
+  EXPECT_FALSE(channels.commands.try_pop(c));
+  EXPECT_TRUE(sink.entries.empty());
+  const PointWrite good[] = {{PointId::kMode, 1.0}, {PointId::kSetpoint, 100.0}, {PointId::kBr, 1.3}, {PointId::kMr, 2.0}};
+  ASSERT_TRUE(gate.submit(good, kOperator).accepted());
+  std::vector<runtime::CommandKind> kinds;
+  while (channels.commands.try_pop(c)) kinds.push_back(c.kind);
+  EXPECT_EQ(kinds, (std::vector{runtime::CommandKind::kMode, runtime::CommandKind::kSetpoint, runtime::CommandKind::kTuning}));
+  EXPECT_EQ(sink.entries.size(), 4u);
+}
+
+// ---- the gate against the loop: every accept-path ----
+
+// A scan cycle on a fake DAQ in `mode`, with the narrowed configuration.
+struct Loop {
+  runtime::RuntimeConfig config = narrowed_config();
+  runtime::testing::FakeDaq daq;  // 2.0 V: 100 mm, inside every limit
+  runtime::VirtualClock clock;
+  runtime::LoopChannels channels{64};
+  std::unique_ptr<runtime::ScanCycle> loop;
+  explicit Loop(Mode mode) {
+    if (mode == Mode::kRun) config.start_mode = Mode::kRun;
+    if (mode == Mode::kFault) config.start_fault = runtime::FaultCode::kStoreDamaged;
+    loop = std::make_unique<runtime::ScanCycle>(config, *runtime::make_tuning(paper()), daq, clock, channels);
+    if (mode == Mode::kManual) channels.commands.try_push(runtime::mode_command(Mode::kManual));
+    cycle();
+  }
+  void cycle() {
+    loop->cycle(clock.now_ns());
+    clock.advance(5'000'000);
+  }
+};
+
+// Values worth trying for a point: its bounds, the middle, a fraction, just outside, NaN.
+std::vector<double> candidates(const PointRange& r) {
+  const double lo = r.min.value, hi = r.max.value;
+  return {lo, hi, std::floor((lo + hi) / 2), (lo + hi) / 2 + 0.25, lo + 0.5, beyond(lo, -1), beyond(hi, +1),
+          std::numeric_limits<double>::quiet_NaN(), 0.0, 1.0, 2.0, 3.0};
+}
+
+TEST(WriteGate, EveryWriteTheGateAcceptsIsAppliedByTheScanCycleInTheSameState) {
+  const auto config = narrowed_config();
+  runtime::LoopChannels gate_channels(16);
+  WriteGate gate(limits_of(config), config, paper(), gate_channels, nullptr);
+  int accepted = 0, refused = 0;
+  auto hold = [&](const std::vector<PointWrite>& writes, Mode mode) {
+    Loop l(mode);
+    ASSERT_EQ(l.loop->last_snapshot().mode, mode);
+    std::vector<runtime::Command> commands;
+    const GateResult r = gate.decide(writes, kOperator, l.loop->last_snapshot(), &commands);
+    if (!r.accepted()) {
+      ++refused;
+      EXPECT_FALSE(r.reason.empty());
+      return;
+    }
+    ++accepted;
+    const auto before = l.loop->last_snapshot();
+    ASSERT_TRUE(l.channels.commands.try_push_all(commands.data(), commands.size()));
+    l.cycle();
+    const auto after = l.loop->last_snapshot();
+    EXPECT_EQ(after.commands_rejected, before.commands_rejected)
+        << "the loop refused what the gate accepted in " << runtime::to_string(mode) << ": " << point(writes[0].id).name << " = "
+        << writes[0].value << " (" << runtime::describe(after.last_refusal) << ")";
+    EXPECT_EQ(after.commands_applied, before.commands_applied + commands.size());
+  };
+  for (Mode mode : {Mode::kStop, Mode::kRun, Mode::kManual, Mode::kFault}) {
+    for (const PointDef* p : gated_points())
+      for (double v : candidates(gate.limits().range(p->id))) hold({{p->id, v}}, mode);
+    // Groups as HMIs send them: mode and setpoint, a manual move, a whole dead zone.
+    hold({{PointId::kMode, 1.0}, {PointId::kSetpoint, 250.0}}, mode);
+    hold({{PointId::kMode, 2.0}, {PointId::kManualValve, 1.5}}, mode);
+    hold({{PointId::kMr, 2.0}, {PointId::kMl, 2.1}, {PointId::kBr, 1.3}, {PointId::kBl, -1.5}, {PointId::kLc, 4.0}}, mode);
+  }
+  // Neither side of the check is empty: the walk exercised both.
+  EXPECT_GT(accepted, 100);
+  EXPECT_GT(refused, 100);
+}
+
+TEST(WriteGate, ARefusalThatAroseAfterTheGateLookedIsCountedLoggedAndAuditedAsRefused) {
+  const runtime::RuntimeConfig config;
+  runtime::testing::FakeDaq daq;
+  runtime::VirtualClock clock;
+  runtime::LoopChannels channels(64);
+  runtime::ScanCycle loop(config, *runtime::make_tuning(paper()), daq, clock, channels);
+  RecordingSink sink;
+  WriteGate gate(limits_of(config), config, paper(), channels, &sink);
+  loop.cycle(clock.now_ns());
+  const runtime::Snapshot before_fault = channels.snapshot.read();  // STOP
+  ASSERT_EQ(before_fault.mode, Mode::kStop);
+  // The loop latches a fault; the gate still sees the snapshot of the cycle before (as it would
+  // when it reads between the loop's fault and its next publish).
+  daq.sensor_v = std::numeric_limits<double>::quiet_NaN();
+  clock.advance(5'000'000);
+  loop.cycle(clock.now_ns());
+  ASSERT_EQ(loop.last_snapshot().mode, Mode::kFault);
+  channels.snapshot.publish(before_fault);
+  const PointWrite run{PointId::kMode, 1.0};
+  ASSERT_TRUE(gate.submit({&run, 1}, Requester{"modbus 10.0.0.5:5020", true, "", false}).accepted());
+  ASSERT_EQ(sink.entries.size(), 1u);  // accepted: audited as the change it asked for
+
+  clock.advance(5'000'000);
+  loop.cycle(clock.now_ns());
+  const runtime::Snapshot s = loop.last_snapshot();
+  EXPECT_EQ(s.mode, Mode::kFault);
+  EXPECT_EQ(s.commands_rejected, 1u);
+  EXPECT_EQ(s.last_refusal, runtime::CommandRefusal::kFaultLatched);
+
+  std::vector<std::string> log;
+  gate.take_refusals([&](const std::string& line) { log.push_back(line); });
+  ASSERT_EQ(log.size(), 1u);
+  EXPECT_NE(log[0].find("refused mode"), std::string::npos) << log[0];
+  ASSERT_EQ(sink.entries.size(), 2u);
+  const core::AuditEntry& refusal = sink.entries[1];
+  EXPECT_EQ(refusal.point, "mode");
+  EXPECT_EQ(refusal.old_value, 1.0);  // what was asked ...
+  EXPECT_EQ(refusal.new_value, 0.0);  // ... and what the point kept
+  EXPECT_NE(refusal.source.find("modbus 10.0.0.5:5020"), std::string::npos) << refusal.source;
+  EXPECT_NE(refusal.source.find("fault"), std::string::npos) << refusal.source;
+  gate.take_refusals([&](const std::string& line) { log.push_back(line); });
+  EXPECT_EQ(log.size(), 1u);  // each refusal once
+}
+
+}  // namespace
+}  // namespace epa::points
