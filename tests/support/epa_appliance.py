@@ -79,7 +79,8 @@ class Appliance:
     """`epa serve` on a free loopback port with the given register map and extra config, its data
     (database, runs, log) in a fresh temporary folder."""
 
-    def __init__(self, epa, register_map, extra_config="", start=True, args=(), web_static_dir=None, db=None, modbus_extra=""):
+    def __init__(self, epa, register_map, extra_config="", start=True, args=(), web_static_dir=None, db=None, modbus_extra="",
+                 web_extra=""):
         """`args` are added to `epa serve`'s command line; with `web_static_dir` the status page runs on
         a free port too (`web_port`); `db` puts the database elsewhere (a small file system)."""
         self.epa = epa
@@ -91,7 +92,7 @@ class Appliance:
         self.env = None  # the environment of `epa serve` (None: this one's)
         self.web_port = free_port() if web_static_dir else None
         web = (f'[web]\naddress = "127.0.0.1"\nport = {self.web_port}\nstatic_dir = "{web_static_dir}"\n'
-               if web_static_dir else "[web]\nenabled = false\n")
+               + web_extra if web_static_dir else "[web]\nenabled = false\n")
         self.log_path = os.path.join(self.dir, "epa.log")
         self.proc = None
         self.log = None
