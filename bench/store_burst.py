@@ -21,7 +21,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "support"))
-from epa_appliance import UNIT, UNLOCK_KEY, Appliance, f32_value, f32_words, u32_value  # noqa: E402
+from epa_appliance import UNIT, Appliance, unlock, f32_value, f32_words, u32_value  # noqa: E402
 
 REPO = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 EPA = os.path.join(REPO, "build", "release", "src", "app", "epa")
@@ -51,7 +51,7 @@ def measure(seconds, burst):
         c.write_register(2, 1, slave=UNIT)
         result = {}
         if burst:
-            c.write_register(9, UNLOCK_KEY, slave=UNIT)
+            unlock(c)
             start = time.monotonic()
             busy = 0
             for i in range(WRITES):

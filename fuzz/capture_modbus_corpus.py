@@ -3,7 +3,7 @@
 
     capture_modbus_corpus.py <epa binary> <source dir> <out dir>
 
-Starts `epa serve` (tests/support/epa_appliance.py: registers/epa.csv, unlock key 4321) and a
+Starts `epa serve` (tests/support/epa_appliance.py: registers/epa.csv, unlock key UNLOCK_KEY) and a
 recording TCP proxy in front of it, then talks to it through the proxy with real clients: Debian's
 mbpoll (float reads with -B, a setpoint write, coils) and pymodbus 3.0 (every function code the
 server supports, the unlock and a tuning write, FC23, refusals, another unit id). Every ADU a
@@ -18,7 +18,7 @@ import threading
 
 SRC = sys.argv[2]
 sys.path.insert(0, os.path.join(SRC, "tests", "support"))
-from epa_appliance import UNIT, UNLOCK_KEY, Appliance, f32_words, u32_words  # noqa: E402
+from epa_appliance import UNIT, Appliance, unlock, f32_words, u32_words  # noqa: E402
 from pymodbus.client import ModbusTcpClient  # noqa: E402
 
 sessions = []  # bytes each client connection sent
@@ -90,7 +90,7 @@ def main():
         c.write_registers(6, u32_words(7), slave=UNIT)
         c.write_registers(4, f32_words(1.0, "ABCD"), slave=UNIT)
         c.write_registers(28, f32_words(7.5, "ABCD"), slave=UNIT)
-        c.write_register(9, UNLOCK_KEY, slave=UNIT)
+        unlock(c)
         c.write_registers(28, f32_words(7.5, "ABCD"), slave=UNIT)
         c.write_registers(20, f32_words(1.7627, "ABCD") + f32_words(1.0707, "ABCD") + f32_words(1.232, "ABCD")
                           + f32_words(-1.722, "ABCD") + f32_words(5.0, "ABCD"), slave=UNIT)

@@ -2,7 +2,7 @@
 // the input is a byte stream as a client sends it, cut into ADUs by the MBAP length exactly as
 // ModbusServer does, each one through RequestHandler::handle and then libmodbus' modbus_reply /
 // modbus_reply_exception (which reads the register image the handler filled). Unlocking is
-// configured (key 4321, in the dictionary and the seeds), so tuning writes are reached.
+// configured (key 5e3a9c17d24b086f, in the dictionary and the seeds), so tuning writes are reached.
 // Every input starts from a fresh handler and an empty command queue: a run replays alone.
 #include <modbus.h>
 #include <sys/socket.h>
@@ -72,9 +72,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   runtime::LoopChannels channels(16);
   CountingSink audit;
   channels.snapshot.publish(running_snapshot());
-  modbus::RequestHandler handler(fx.map, modbus::WritePolicy{.read_only = false, .unlock_key = 4321, .unlock_timeout_s = 10},
-                                 1, control::paper_controller_config(control::ControllerKind::kPpFfidz), 50.0, channels,
-                                 &audit);
+  const runtime::RuntimeConfig loop;  // the configuration's limits and mm_per_volt, as shipped
+  points::WriteGate gate(*points::WriteLimits::from_config(loop, "fuzz.toml"), loop,
+                         control::paper_controller_config(control::ControllerKind::kPpFfidz), channels, &audit);
+  modbus::RequestHandler handler(fx.map, modbus::WritePolicy{.read_only = false, .unlock_key = 0x5e3a9c17d24b086f, .unlock_timeout_s = 10},
+                                 1, gate, channels);
+  modbus::Session session{"127.0.0.1", "127.0.0.1:50000", 0};
   std::int64_t now_ns = 0;
   std::size_t pos = 0;
   while (size - pos >= static_cast<std::size_t>(kMbapLength + 1)) {
@@ -88,7 +91,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // ASan see a read past the frame.
     std::unique_ptr<std::uint8_t[]> req(new std::uint8_t[total]);
     std::copy(frame, frame + total, req.get());
-    const std::uint8_t exception = handler.handle(req.get(), static_cast<int>(total), "127.0.0.1", now_ns, fx.image);
+    const std::uint8_t exception = handler.handle(req.get(), static_cast<int>(total), session, now_ns, fx.image);
     if (exception) modbus_reply_exception(fx.ctx, req.get(), exception);
     else modbus_reply(fx.ctx, req.get(), static_cast<int>(total), fx.image);
     runtime::Command c;

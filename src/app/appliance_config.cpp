@@ -1,6 +1,8 @@
 #include "app/appliance_config.hpp"
 
+#include "core/format.hpp"
 #include "core/text_file.hpp"
+#include "modbus/unlock_guard.hpp"
 
 #include "plant/effects.hpp"
 
@@ -14,6 +16,22 @@ namespace epa::app {
 
 namespace {
 
+// The values a numeric key may take: [lo, hi], or (lo, hi] when lo is open; in `unit`.
+struct Range {
+  double lo, hi;
+  bool lo_open = false;
+  const char* unit = "";
+  bool contains(double v) const { return (lo_open ? v > lo : v >= lo) && v <= hi; }
+  std::string text() const {
+    return std::string(lo_open ? "(" : "[") + core::format_number(lo) + ", " + core::format_number(hi) + "]" +
+           (*unit ? std::string(" ") + unit : std::string());
+  }
+};
+Range closed(double lo, double hi, const char* unit) { return {lo, hi, false, unit}; }
+Range above(double lo, double hi, const char* unit) { return {lo, hi, true, unit}; }
+
+constexpr double kDay_s = 86400.0;
+
 // Reads one TOML table: typed getters that remember which keys were used, and a final check
 // that refuses keys nobody asked for. The first error wins; later calls are no-ops.
 class TableReader {
@@ -21,12 +39,14 @@ class TableReader {
   TableReader(const toml::table* table, std::string name, const std::string& file, std::optional<core::Error>& error)
       : table_(table), name_(std::move(name)), file_(file), error_(error) {}
 
-  void number(const char* key, double& out, std::function<bool(double)> ok = {}, const char* expected = "") {
+  // Every number is bounded: a duration, size or limit far outside what an appliance can use is
+  // a typo (1e300 s overflows a nanosecond clock, 1e12 s of buffer cannot be allocated).
+  void number(const char* key, double& out, Range range) {
     const toml::node* n = find(key);
     if (!n) return;
     const auto v = n->value<double>();
-    if (!v || !std::isfinite(*v)) return fail(*n, key, "must be a number");
-    if (ok && !ok(*v)) return fail(*n, key, std::string("must be ") + expected);
+    if (!v || !std::isfinite(*v)) return fail(*n, key, "must be a number within " + range.text());
+    if (!range.contains(*v)) return fail(*n, key, core::format_number(*v) + " is outside " + range.text());
     out = *v;
   }
   void integer(const char* key, int& out, long lo, long hi) {
@@ -102,8 +122,6 @@ class TableReader {
   std::set<std::string> used_;
 };
 
-const auto kPositive = [](double v) { return v > 0.0; };
-const auto kNonNegative = [](double v) { return v >= 0.0; };
 
 core::Result<HalBackend> parse_backend(std::string_view s) {
   if (s == "sim") return HalBackend::kSim;
@@ -140,9 +158,9 @@ void read_analog_point(TableReader& parent, const char* key, hal::AnalogPoint& p
   t.choice<hal::AnalogEncoding>("encoding", p.encoding, parse_encoding);
   t.choice<core::WordOrder>("word_order", p.word_order, core::parse_word_order);
   double full_scale_v = p.volts_per_count * hal::kInt16FullScaleCounts;
-  t.number("full_scale_v", full_scale_v, kPositive, "> 0 V");
+  t.number("full_scale_v", full_scale_v, above(0, 100, "V"));
   p.volts_per_count = full_scale_v / hal::kInt16FullScaleCounts;
-  t.number("offset_v", p.offset_v);
+  t.number("offset_v", p.offset_v, closed(-100, 100, "V"));
   t.refuse_unknown_keys();
 }
 
@@ -151,8 +169,8 @@ void read_comedi_channel(TableReader& parent, const char* key, hal::ComediChanne
   TableReader t(parent.subtable(key), parent.key_path(key), file, error);
   t.integer("subdevice", c.subdevice, -1, 255);
   t.integer("channel", c.channel, 0, 4095);
-  t.number("range_min_v", c.range_min_v);
-  t.number("range_max_v", c.range_max_v);
+  t.number("range_min_v", c.range_min_v, closed(-100, 100, "V"));
+  t.number("range_max_v", c.range_max_v, closed(-100, 100, "V"));
   t.choice<hal::AnalogReference>("aref", c.aref, parse_aref);
   t.refuse_unknown_keys();
 }
@@ -181,7 +199,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   TableReader top(&root, "", file, error);
 
   TableReader loop(top.subtable("loop"), "loop", file, error);
-  loop.number("period_s", r.period_s, kPositive, "> 0 s");
+  loop.number("period_s", r.period_s, closed(0.0001, 1.0, "s"));
   loop.integer("realtime_priority", c.realtime.fifo_priority, 0, 99);
   loop.boolean("lock_memory", c.realtime.lock_memory);
   loop.integer("cpu_dma_latency_us", c.realtime.cpu_dma_latency_us, -1, 100000);
@@ -192,42 +210,42 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   ctl.choice<control::ControllerKind>("kind", r.controller, control::parse_controller_kind);
   ctl.text("model", c.model_path);
   ctl.text("design", c.design_path);
-  ctl.number("lc_mm", c.lc_mm, kNonNegative, ">= 0 mm");
-  ctl.number("valve_limit_v", c.valve_limit_v, [](double v) { return v > 0.0 && v <= 10.0; }, "within (0, 10] V");
+  ctl.number("lc_mm", c.lc_mm, closed(0, 100, "mm"));
+  ctl.number("valve_limit_v", c.valve_limit_v, above(0, 10, "V"));
   ctl.refuse_unknown_keys();
 
   TableReader lim(top.subtable("limits"), "limits", file, error);
-  lim.number("sensor_min_v", r.sensor_min_v);
-  lim.number("sensor_max_v", r.sensor_max_v);
-  lim.number("soft_min_mm", r.soft_min_mm);
-  lim.number("soft_max_mm", r.soft_max_mm);
-  lim.number("setpoint_min_mm", r.setpoint_min_mm);
-  lim.number("setpoint_max_mm", r.setpoint_max_mm);
-  lim.number("manual_valve_limit_v", r.manual_valve_limit_v, kPositive, "> 0 V");
-  lim.number("safe_valve_v", r.safe_valve_v);
-  lim.number("following_error_mm", r.following_error_mm, kPositive, "> 0 mm");
-  lim.number("following_error_time_s", r.following_error_time_s, kNonNegative, ">= 0 s (0: off)");
+  lim.number("sensor_min_v", r.sensor_min_v, closed(-100, 100, "V"));
+  lim.number("sensor_max_v", r.sensor_max_v, closed(-100, 100, "V"));
+  lim.number("soft_min_mm", r.soft_min_mm, closed(-10000, 10000, "mm"));
+  lim.number("soft_max_mm", r.soft_max_mm, closed(-10000, 10000, "mm"));
+  lim.number("setpoint_min_mm", r.setpoint_min_mm, closed(-10000, 10000, "mm"));
+  lim.number("setpoint_max_mm", r.setpoint_max_mm, closed(-10000, 10000, "mm"));
+  lim.number("manual_valve_limit_v", r.manual_valve_limit_v, above(0, 10, "V"));
+  lim.number("safe_valve_v", r.safe_valve_v, closed(-10, 10, "V"));
+  lim.number("following_error_mm", r.following_error_mm, above(0, 10000, "mm"));
+  lim.number("following_error_time_s", r.following_error_time_s, closed(0, 3600, "s (0: off)"));
   lim.integer("max_consecutive_io_errors", r.max_consecutive_io_errors, 1, 1000000);
-  lim.number("heartbeat_timeout_s", r.heartbeat_timeout_s, kNonNegative, ">= 0 s (0: off)");
-  lim.number("sensor_frozen_time_s", r.sensor_frozen_time_s, kNonNegative, ">= 0 s (0: off)");
-  lim.number("sensor_frozen_drive_v", r.sensor_frozen_drive_v, kPositive, "> 0 V");
+  lim.number("heartbeat_timeout_s", r.heartbeat_timeout_s, closed(0, 3600, "s (0: off)"));
+  lim.number("sensor_frozen_time_s", r.sensor_frozen_time_s, closed(0, 3600, "s (0: off)"));
+  lim.number("sensor_frozen_drive_v", r.sensor_frozen_drive_v, above(0, 10, "V"));
   lim.refuse_unknown_keys();
 
   TableReader cal(top.subtable("calibration"), "calibration", file, error);
-  cal.number("sensor_offset_v", r.sensor_offset_v);
-  cal.number("sensor_gain", r.sensor_gain, kPositive, "> 0");
+  cal.number("sensor_offset_v", r.sensor_offset_v, closed(-100, 100, "V"));
+  cal.number("sensor_gain", r.sensor_gain, above(0, 1000, ""));
   cal.refuse_unknown_keys();
 
   TableReader start(top.subtable("startup"), "startup", file, error);
   start.choice<runtime::Mode>("mode", r.start_mode, runtime::parse_mode);
-  start.number("setpoint_mm", r.start_setpoint_mm);
+  start.number("setpoint_mm", r.start_setpoint_mm, closed(-10000, 10000, "mm"));
   start.refuse_unknown_keys();
 
   TableReader rec(top.subtable("recorder"), "recorder", file, error);
   rec.text("directory", c.record_directory);
   rec.boolean("per_move", c.record_per_move);
-  rec.number("buffer_s", r.record_buffer_s, kPositive, "> 0 s");
-  rec.number("move_window_s", r.move_window_s, kPositive, "> 0 s");
+  rec.number("buffer_s", r.record_buffer_s, above(0, 600, "s"));
+  rec.number("move_window_s", r.move_window_s, above(0, 600, "s"));
   rec.refuse_unknown_keys();
 
   TableReader st(top.subtable("store"), "store", file, error);
@@ -235,7 +253,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   st.refuse_unknown_keys();
 
   TableReader log(top.subtable("log"), "log", file, error);
-  log.number("status_interval_s", c.status_interval_s, kNonNegative, ">= 0 s (0: off)");
+  log.number("status_interval_s", c.status_interval_s, closed(0, kDay_s, "s (0: off)"));
   log.refuse_unknown_keys();
 
   TableReader mbs(top.subtable("modbus"), "modbus", file, error);
@@ -244,13 +262,18 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   mbs.integer("port", c.modbus.port, 0, 65535);
   mbs.integer("unit_id", c.modbus.unit_id, 0, 247);
   mbs.integer("max_clients", c.modbus.max_clients, 1, 1000);
-  mbs.number("idle_timeout_s", c.modbus.idle_timeout_s, kPositive, "> 0 s");
+  mbs.number("idle_timeout_s", c.modbus.idle_timeout_s, above(0, kDay_s, "s"));
+  mbs.number("frame_timeout_s", c.modbus.frame_timeout_s, above(0, 60, "s"));
   mbs.text("register_map", c.register_map_path);
   mbs.boolean("read_only", c.modbus.policy.read_only);
-  int unlock_key = c.modbus.policy.unlock_key;
-  mbs.integer("unlock_key", unlock_key, 0, 65535);
-  c.modbus.policy.unlock_key = static_cast<std::uint16_t>(unlock_key);
-  mbs.number("unlock_timeout_s", c.modbus.policy.unlock_timeout_s, kPositive, "> 0 s");
+  mbs.choice<std::optional<std::uint64_t>>("unlock_key", c.modbus.policy.unlock_key,
+                                            [](std::string_view v) -> core::Result<std::optional<std::uint64_t>> {
+                                              if (v.empty()) return std::optional<std::uint64_t>{};  // never unlocks
+                                              auto key = modbus::parse_unlock_key(v);
+                                              if (!key) return key.error();
+                                              return std::optional<std::uint64_t>{*key};
+                                            });
+  mbs.number("unlock_timeout_s", c.modbus.policy.unlock_timeout_s, above(0, kDay_s, "s"));
   mbs.text_list("write_clients", c.modbus.policy.write_clients);
   mbs.refuse_unknown_keys();
 
@@ -265,8 +288,8 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   TableReader hal_table(top.subtable("hal"), "hal", file, error);
   hal_table.choice<HalBackend>("backend", c.backend, parse_backend);
   TableReader sim(hal_table.subtable("sim"), "hal.sim", file, error);
-  sim.number("initial_position_mm", c.sim.initial_position_mm);
-  sim.number("noise_mm", c.sim.noise_std_mm, kNonNegative, ">= 0 mm");
+  sim.number("initial_position_mm", c.sim.initial_position_mm, closed(-10000, 10000, "mm"));
+  sim.number("noise_mm", c.sim.noise_std_mm, closed(0, 100, "mm"));
   int seed = static_cast<int>(c.sim.seed);
   sim.integer("seed", seed, 0, 2147483647);
   c.sim.seed = static_cast<std::uint64_t>(seed);
@@ -276,7 +299,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   });
   sim.text("physics_config", c.physics_config);
   sim.integer("sensor_bits", c.sim_sensor_bits, 0, 24);
-  sim.number("initial_pressure_bar", c.sim_initial_pressure_bar, kNonNegative, ">= 0 bar");
+  sim.number("initial_pressure_bar", c.sim_initial_pressure_bar, closed(0, 100, "bar"));
   sim.text_list("effects", c.sim_effects);
   sim.refuse_unknown_keys();
   TableReader mb(hal_table.subtable("modbus_io"), "hal.modbus_io", file, error);

@@ -40,6 +40,11 @@ void add_serve_command(CLI::App& app, ServeOptions& o) {
 
 namespace {
 
+// Every thread of the appliance (scan cycle, store, Modbus, HTTP workers, recorder): deep enough
+// for SQLite, JSON and the HTTP parser, small enough that the stacks locked with the loop's
+// memory stay small.
+constexpr std::size_t kThreadStackBytes = 512 * 1024;
+
 // Applies the command-line overrides on top of the file, re-validating what they touch.
 core::Status apply_overrides(const ServeOptions& o, ApplianceConfig& c) {
   if (!o.hal.empty()) {
@@ -240,6 +245,7 @@ struct DaqCloser {
 
 int run_serve(const ServeOptions& o, std::ostream& err) {
   auto fail = [&err](const core::Error& e) { return err << "epa serve: " << e.message << "\n", 1; };
+  hal::set_default_thread_stack(kThreadStackBytes);
   auto config = read_appliance_config(o.config_path);
   if (!config) return fail(config.error());
   if (auto s = apply_overrides(o, *config); !s) return fail(s.error());

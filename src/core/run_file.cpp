@@ -179,6 +179,9 @@ Result<Run> parse_run_impl(std::istream& in, const std::string& src, std::option
                                           " (found columns: " + quoted_list(fields) + ")");
       continue;
     }
+    if (row_lines.size() >= kMaxRunSamples)
+      return error_at(src, line_no, "more than " + std::to_string(kMaxRunSamples) +
+                                        " samples (the most a run file may hold, 2.8 h at 5 ms): split the recording");
     if (fields.size() != targets.size())
       return error_at(src, line_no, "expected " + std::to_string(targets.size()) + " fields as in the header, got " +
                                         std::to_string(fields.size()));

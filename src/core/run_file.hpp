@@ -25,6 +25,10 @@ void write_run(std::ostream& out, const Run& run);
 // time, metadata keys that are not [A-Za-z0-9_.-]+ or values with line breaks, unknown controller.
 Status write_run_file(const std::string& path, const Run& run);
 
+// The most samples a run file may hold: 2,000,000 (2.8 h at Ts = 5 ms, about 100 MB read), so
+// `identify` and `diagnose` have bounded memory whatever file they are given.
+inline constexpr std::size_t kMaxRunSamples = 2'000'000;
+
 // Parses epa-run/1. `source_name` is used in messages ("runs/a.csv:14: ..."). If expected_Ts is
 // given, the file's Ts must equal it (relative tolerance 1e-9) and a mismatch is an error naming
 // both values. A file without `# Ts=` is checked against expected_Ts when given (and takes it as

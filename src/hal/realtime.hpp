@@ -5,6 +5,7 @@
 // 13 us with it; cyclictest does the same by default). Any of these may be refused (no
 // privilege, containers): the appliance then runs best-effort, and each refusal is returned as a
 // warning for the log, never as a failure.
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -18,5 +19,10 @@ struct RealtimeRequest {
 
 // The PM QoS request lasts as long as the process (the kernel drops it when the file closes).
 std::vector<std::string> request_realtime(const RealtimeRequest& request);
+
+// The stack size of threads created from now on (std::thread included). glibc's default is the
+// stack rlimit, usually 8 MiB; the appliance's threads need far less, and every stack that
+// exists when the loop locks memory is locked whole.
+void set_default_thread_stack(std::size_t bytes);
 
 }  // namespace epa::hal

@@ -23,10 +23,24 @@ constexpr int kMaxAdu = MODBUS_TCP_MAX_ADU_LENGTH;
 
 struct Client {
   int fd = -1;
-  std::string peer;  // "127.0.0.1" (what write_clients lists)
+  Session session;   // address, "ip:port", this connection's unlock
   std::vector<std::uint8_t> buffer;
-  std::int64_t last_activity_ns = 0;
+  std::int64_t idle_since_ns = 0;        // connected, or last request answered: bytes alone do not count
+  std::int64_t frame_started_ns = -1;    // the first byte of the frame still incomplete; -1: none
+  bool served = false;                   // has completed a request
+  short revents = 0;                     // of this round's poll
 };
+
+// Which client makes room for a new one: those that never completed a request first (a crowd of
+// fresh idle sockets cannot push out a working HMI), then the one idle the longest.
+std::size_t eviction_candidate(const std::vector<Client>& clients) {
+  std::size_t pick = 0;
+  for (std::size_t i = 1; i < clients.size(); ++i) {
+    const Client &a = clients[i], &b = clients[pick];
+    if (a.served != b.served ? !a.served : a.idle_since_ns < b.idle_since_ns) pick = i;
+  }
+  return pick;
+}
 }  // namespace
 
 struct ModbusServer::Impl {
@@ -40,7 +54,7 @@ struct ModbusServer::Impl {
   Log log;
 
   Impl(const ServerConfig& c, const RegisterMap& map, points::WriteGate& gate, runtime::LoopChannels& ch, Log l)
-      : config(c), handler(map, c.policy, c.unit_id, gate, ch), log(std::move(l)) {}
+      : config(c), handler(map, c.policy, c.unit_id, gate, ch, l), log(std::move(l)) {}
   ~Impl() {
     for (auto& cl : clients) ::close(cl.fd);
     if (listener >= 0) ::close(listener);
@@ -86,8 +100,9 @@ void ModbusServer::serve() {
   std::vector<pollfd> fds;
   std::uint8_t chunk[4096];
   const auto idle_ns = static_cast<std::int64_t>(m.config.idle_timeout_s * 1e9);
+  const auto frame_ns = static_cast<std::int64_t>(m.config.frame_timeout_s * 1e9);
   auto drop = [&](std::size_t i, const char* why) {
-    if (m.log) m.log("modbus: client " + m.clients[i].peer + " disconnected (" + why + ")");
+    if (m.log) m.log("modbus: client " + m.clients[i].session.peer + " disconnected (" + why + ")");
     ::close(m.clients[i].fd);
     m.clients.erase(m.clients.begin() + static_cast<std::ptrdiff_t>(i));
   };
@@ -97,6 +112,8 @@ void ModbusServer::serve() {
     for (const auto& cl : m.clients) fds.push_back({cl.fd, POLLIN, 0});
     if (poll(fds.data(), fds.size(), 100) < 0 && errno != EINTR) break;
     const std::int64_t now = m.clock.now_ns();
+    // Each client keeps its own poll result, so accepting and evicting below cannot mix them up.
+    for (std::size_t i = 0; i < m.clients.size(); ++i) m.clients[i].revents = fds[i + 1].revents;
 
     if (fds[0].revents & POLLIN) {
       for (;;) {
@@ -106,28 +123,30 @@ void ModbusServer::serve() {
         if (fd < 0) break;
         char ip[INET_ADDRSTRLEN] = "?";
         inet_ntop(AF_INET, &peer.sin_addr, ip, sizeof ip);
-        if (static_cast<int>(m.clients.size()) >= m.config.max_clients) {
-          ::close(fd);  // over the cap: refused at once, so it knows
-          if (m.log) m.log(std::string("modbus: refused client ") + ip + " (" + std::to_string(m.config.max_clients) + " connected)");
-          continue;
-        }
+        if (static_cast<int>(m.clients.size()) >= m.config.max_clients)
+          drop(eviction_candidate(m.clients), "evicted: max_clients reached and it was idle the longest");
         const int one = 1;
         setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-        m.clients.push_back({fd, ip, {}, now});
+        m.clients.push_back({fd, {ip, std::string(ip) + ":" + std::to_string(ntohs(peer.sin_port)), 0}, {}, now, -1, false, 0});
       }
     }
 
     // Clients in reverse, so dropping one does not disturb the indices still to visit.
     for (std::size_t i = m.clients.size(); i-- > 0;) {
       Client& cl = m.clients[i];
-      const short revents = i + 1 < fds.size() && fds[i + 1].fd == cl.fd ? fds[i + 1].revents : 0;
+      const short revents = cl.revents;
       if (revents & (POLLERR | POLLHUP | POLLNVAL)) { drop(i, "connection closed"); continue; }
       if (revents & POLLIN) {
         const ssize_t n = recv(cl.fd, chunk, sizeof chunk, 0);
         if (n <= 0) { drop(i, n == 0 ? "closed by the client" : std::strerror(errno)); continue; }
+        if (cl.buffer.empty()) cl.frame_started_ns = now;
         cl.buffer.insert(cl.buffer.end(), chunk, chunk + n);
-        cl.last_activity_ns = now;
-      } else if (now - cl.last_activity_ns > idle_ns) {
+      }
+      if (cl.frame_started_ns >= 0 && now - cl.frame_started_ns > frame_ns) {
+        drop(i, "a frame not completed within frame_timeout_s of its first byte");
+        continue;
+      }
+      if (cl.frame_started_ns < 0 && now - cl.idle_since_ns > idle_ns) {
         drop(i, "idle");
         continue;
       }
@@ -140,7 +159,7 @@ void ModbusServer::serve() {
         const auto total = static_cast<std::size_t>(kMbapLength + count);
         if (cl.buffer.size() < total) break;
         m.handler.set_clients(static_cast<int>(m.clients.size()));
-        const std::uint8_t exception = m.handler.handle(cl.buffer.data(), static_cast<int>(total), cl.peer, now, m.image);
+        const std::uint8_t exception = m.handler.handle(cl.buffer.data(), static_cast<int>(total), cl.session, now, m.image);
         modbus_set_socket(m.ctx, cl.fd);
         const int rc = exception ? modbus_reply_exception(m.ctx, cl.buffer.data(), exception)
                                  : modbus_reply(m.ctx, cl.buffer.data(), static_cast<int>(total), m.image);
@@ -148,6 +167,9 @@ void ModbusServer::serve() {
         if (exception) exceptions_++;
         if (rc < 0) { drop(i, "send failed"); dropped = true; break; }
         cl.buffer.erase(cl.buffer.begin(), cl.buffer.begin() + static_cast<std::ptrdiff_t>(total));
+        cl.idle_since_ns = now;
+        cl.served = true;
+        cl.frame_started_ns = cl.buffer.empty() ? -1 : now;  // a pipelined frame's clock starts now
       }
       if (dropped) continue;
     }

@@ -2,8 +2,10 @@
 // The Modbus TCP server: one thread, poll() over non-blocking sockets, our own framing per client
 // (so a client that sends one byte a second, or nothing, never blocks the others), libmodbus to
 // build every answer and exception (modbus_reply / modbus_reply_exception), and the
-// RequestHandler for what the answer says. A cap on clients (the one over the cap is accepted
-// and closed at once) and an idle timeout keep a crowd of dead connections from starving it.
+// RequestHandler for what the answer says. A crowd of dead or slow connections cannot starve it:
+// a frame must be complete within frame_timeout_s of its first byte, a client without a request
+// for idle_timeout_s is closed, and at max_clients a new client evicts a connection that never
+// completed a request, else the one idle the longest.
 #include <atomic>
 #include <functional>
 #include <memory>
@@ -19,7 +21,8 @@ struct ServerConfig {
   int port = 502;                    // 0: any free port (see port())
   int unit_id = 1;
   int max_clients = 16;
-  double idle_timeout_s = 60.0;      // a client silent this long is disconnected
+  double idle_timeout_s = 60.0;      // a client without a complete request this long is disconnected
+  double frame_timeout_s = 1.0;      // a frame not complete this long after its first byte: disconnected
   WritePolicy policy;
 };
 

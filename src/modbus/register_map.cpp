@@ -19,7 +19,8 @@ constexpr std::pair<Table, std::string_view> kTables[] = {
     {Table::kCoil, "coil"}, {Table::kDiscreteInput, "discrete"}, {Table::kInputRegister, "input"}, {Table::kHoldingRegister, "holding"}};
 constexpr std::pair<DataType, std::string_view> kTypes[] = {{DataType::kBool, "bool"},   {DataType::kUint16, "uint16"},
                                                              {DataType::kInt16, "int16"}, {DataType::kUint32, "uint32"},
-                                                             {DataType::kInt32, "int32"}, {DataType::kFloat32, "float32"}};
+                                                             {DataType::kInt32, "int32"}, {DataType::kFloat32, "float32"},
+                                                             {DataType::kKey64, "key64"}};
 
 std::string trim(std::string s) {
   const auto b = s.find_first_not_of(" \t\r");
@@ -62,6 +63,7 @@ std::pair<double, double> representable(DataType t, double scale) {
     case DataType::kUint32: return {0, 4294967295.0 / scale};
     case DataType::kInt32: return {-2147483648.0 / scale, 2147483647.0 / scale};
     case DataType::kFloat32: return {-3.4e38, 3.4e38};
+    case DataType::kKey64: return {0, 0};  // a key, never a number
   }
   return {0, 0};
 }
@@ -95,6 +97,11 @@ core::Result<RegisterMap> RegisterMap::parse(const std::string& text, const std:
 
   while (std::getline(in, raw)) {
     ++line_no;
+    // Spreadsheets save "CSV UTF-8" with a byte-order mark, and Windows ends lines with CR LF.
+    if (line_no == 1 && raw.rfind("\xEF\xBB\xBF", 0) == 0) raw.erase(0, 3);
+    if (!raw.empty() && raw.back() == '\r') raw.pop_back();
+    if (const auto nul = raw.find('\0'); nul != std::string::npos)
+      return fail("column " + std::to_string(nul + 1) + ": a NUL byte (the file is not text: save it as CSV)");
     const std::string line = trim(raw);
     if (line.empty() || line[0] == '#') continue;
     const auto f = split_csv(line);
@@ -125,8 +132,13 @@ core::Result<RegisterMap> RegisterMap::parse(const std::string& text, const std:
       return fail("address '" + get("address") + "' is not a whole number within 0..65535");
     e.address = static_cast<int>(*address);
     const auto type = std::find_if(std::begin(kTypes), std::end(kTypes), [&](auto& t) { return t.second == get("type"); });
-    if (type == std::end(kTypes)) return fail("type '" + get("type") + "' is not one of bool, uint16, int16, uint32, int32, float32");
+    if (type == std::end(kTypes)) return fail("type '" + get("type") + "' is not one of bool, uint16, int16, uint32, int32, float32, key64");
     e.type = type->first;
+    const bool key_point = e.point->access == points::Access::kKey;
+    if (key_point != (e.type == DataType::kKey64))
+      return fail(key_point ? "'" + std::string(e.point->name) + "' is a 64-bit key: its type must be key64 (4 holding registers, most significant first)"
+                            : std::string("key64 is the type of the unlock key only"));
+    if (e.type == DataType::kKey64 && e.table != Table::kHoldingRegister) return fail("a key64 lives in the holding table");
     if (is_bit_table(e.table) != (e.type == DataType::kBool))
       return fail(std::string("type ") + std::string(to_string(e.type)) + " does not fit the " + std::string(to_string(e.table)) +
                   " table (bool goes in coils and discrete inputs, numbers in input and holding registers)");
@@ -134,7 +146,7 @@ core::Result<RegisterMap> RegisterMap::parse(const std::string& text, const std:
     if (const auto wo = get("word_order"); !wo.empty()) {
       auto order = core::parse_word_order(wo);
       if (!order) return fail(order.error().message);
-      if (e.width() != 2) return fail("word_order applies to 32-bit types only");
+      if (e.width() != 2) return fail("word_order applies to 32-bit types only (a key64 is most significant first)");
       e.word_order = *order;
     }
     if (const auto sc = get("scale"); !sc.empty()) {
@@ -163,11 +175,12 @@ core::Result<RegisterMap> RegisterMap::parse(const std::string& text, const std:
       (c[1] == 'i' ? e.min : e.max) = *v;
     }
     if (e.min > e.max) return fail("min " + core::format_number(e.min) + " exceeds max " + core::format_number(e.max));
-    if (e.writable && (e.min < type_lo || e.max > type_hi))
+    if (e.type == DataType::kKey64) e.min = e.max = 0;  // not a number: the handler takes its words
+    else if (e.writable && (e.min < type_lo || e.max > type_hi))
       return fail("range [" + core::format_number(e.min) + ", " + core::format_number(e.max) + "] does not fit a " +
                   std::string(to_string(e.type)) + " with scale " + core::format_number(e.scale) + " ([" +
                   core::format_number(type_lo) + ", " + core::format_number(type_hi) + "])");
-    if (e.writable && (e.min < e.point->min || e.max > e.point->max))
+    if (e.writable && e.type != DataType::kKey64 && (e.min < e.point->min || e.max > e.point->max))
       return fail("range [" + core::format_number(e.min) + ", " + core::format_number(e.max) + "] goes beyond what '" +
                   std::string(e.point->name) + "' accepts ([" + core::format_number(e.point->min) + ", " + core::format_number(e.point->max) + "])");
     if (const auto d = get("default"); !d.empty()) {
@@ -231,6 +244,7 @@ void encode_value(const RegisterEntry& e, double v, std::uint16_t* w) noexcept {
       w[0] = r[0], w[1] = r[1];
       break;
     }
+    case DataType::kKey64: w[0] = w[1] = w[2] = w[3] = 0; break;  // a key reads back as zeros
   }
 }
 
@@ -242,8 +256,13 @@ double decode_value(const RegisterEntry& e, const std::uint16_t* w) noexcept {
     case DataType::kUint32: return core::decode_u32({w[0], w[1]}, e.word_order) / e.scale;
     case DataType::kInt32: return core::decode_i32({w[0], w[1]}, e.word_order) / e.scale;
     case DataType::kFloat32: return core::decode_f32({w[0], w[1]}, e.word_order);
+    case DataType::kKey64: return 0.0;  // see key_value()
   }
   return 0.0;
+}
+
+std::uint64_t key_value(const std::uint16_t* w) noexcept {
+  return (std::uint64_t{w[0]} << 48) | (std::uint64_t{w[1]} << 32) | (std::uint64_t{w[2]} << 16) | w[3];
 }
 
 core::Status narrow_limits(const RegisterMap& map, points::WriteLimits& limits) {

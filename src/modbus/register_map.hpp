@@ -24,7 +24,8 @@
 namespace epa::modbus {
 
 enum class Table : std::uint8_t { kCoil, kDiscreteInput, kInputRegister, kHoldingRegister };
-enum class DataType : std::uint8_t { kBool, kUint16, kInt16, kUint32, kInt32, kFloat32 };
+// key64: the unlock key, 4 holding registers, most significant first; never read as a number.
+enum class DataType : std::uint8_t { kBool, kUint16, kInt16, kUint32, kInt32, kFloat32, kKey64 };
 
 std::string_view to_string(Table t);     // "coil", "discrete", "input", "holding"
 std::string_view to_string(DataType t);  // "bool", "uint16", ...
@@ -45,7 +46,10 @@ struct RegisterEntry {
   std::string description;
   int line = 0;  // in the map file, for messages
 
-  int width() const { return type == DataType::kUint32 || type == DataType::kInt32 || type == DataType::kFloat32 ? 2 : 1; }
+  int width() const {
+    if (type == DataType::kKey64) return 4;
+    return type == DataType::kUint32 || type == DataType::kInt32 || type == DataType::kFloat32 ? 2 : 1;
+  }
 };
 
 class RegisterMap {
@@ -78,6 +82,8 @@ class RegisterMap {
 core::Status narrow_limits(const RegisterMap& map, points::WriteLimits& limits);
 
 void encode_value(const RegisterEntry& e, double value, std::uint16_t* words) noexcept;
+// The 64-bit key of a key64's four words.
+std::uint64_t key_value(const std::uint16_t* words) noexcept;
 double decode_value(const RegisterEntry& e, const std::uint16_t* words) noexcept;
 
 }  // namespace epa::modbus

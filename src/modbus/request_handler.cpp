@@ -27,16 +27,17 @@ std::uint8_t* table_bits(_modbus_mapping_t* m, Table t) { return t == Table::kCo
 }  // namespace
 
 RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, int unit_id, points::WriteGate& gate,
-                               runtime::LoopChannels& channels)
-    : map_(map), policy_(std::move(policy)), unit_id_(unit_id), gate_(gate), channels_(channels) {}
+                               runtime::LoopChannels& channels, Log log)
+    : map_(map), policy_(std::move(policy)), unit_id_(unit_id), gate_(gate), channels_(channels), log_(std::move(log)),
+      unlock_(policy_.unlock_key) {}
 
-points::InterfaceStatus RequestHandler::status(std::int64_t now_ns) const {
+points::InterfaceStatus RequestHandler::status(const Session& session, std::int64_t now_ns) const {
   const core::ChangeCounters changes = gate_.counters();
   return {static_cast<std::uint32_t>(changes.accepted), static_cast<std::uint32_t>(changes.saved), changes.saving, requests_,
-          clients_, now_ns >= unlocked_until_ns_};
+          clients_, now_ns >= session.unlocked_until_ns, unlock_.failures()};
 }
 
-std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, const std::string& client, std::int64_t now_ns,
+std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, Session& session, std::int64_t now_ns,
                                     _modbus_mapping_t* image) {
   ++requests_;
   if (length < kHeader + 1) return kIllegalFunction;
@@ -55,7 +56,7 @@ std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, const s
     case MODBUS_FC_READ_INPUT_REGISTERS: {
       if (data_length < 4) return kIllegalValue;
       const Table t = fc == 1 ? Table::kCoil : fc == 2 ? Table::kDiscreteInput : fc == 3 ? Table::kHoldingRegister : Table::kInputRegister;
-      return read_into(t, be16(d), be16(d + 2), snap, now_ns, image);
+      return read_into(t, be16(d), be16(d + 2), snap, session, now_ns, image);
     }
     case MODBUS_FC_WRITE_SINGLE_COIL: {
       if (data_length < 4) return kIllegalValue;
@@ -63,12 +64,12 @@ std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, const s
       if (v != 0xFF00 && v != 0x0000) return kIllegalValue;
       const std::uint8_t bit[1] = {static_cast<std::uint8_t>(v == 0xFF00 ? 1 : 0)};
       if (auto e = collect_coil_writes(be16(d), 1, bit, writes)) return e;
-      return apply_writes(writes, client, snap, now_ns);
+      return apply_writes(writes, session, now_ns);
     }
     case MODBUS_FC_WRITE_SINGLE_REGISTER: {
       if (data_length < 4) return kIllegalValue;
       if (auto e = collect_register_writes(be16(d), 1, d + 2, writes)) return e;
-      return apply_writes(writes, client, snap, now_ns);
+      return apply_writes(writes, session, now_ns);
     }
     case MODBUS_FC_WRITE_MULTIPLE_COILS: {
       if (data_length < 5) return kIllegalValue;
@@ -77,14 +78,14 @@ std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, const s
       std::vector<std::uint8_t> bits(static_cast<std::size_t>(quantity));
       for (int i = 0; i < quantity; ++i) bits[static_cast<std::size_t>(i)] = (d[5 + i / 8] >> (i % 8)) & 1;
       if (auto e = collect_coil_writes(be16(d), quantity, bits.data(), writes)) return e;
-      return apply_writes(writes, client, snap, now_ns);
+      return apply_writes(writes, session, now_ns);
     }
     case MODBUS_FC_WRITE_MULTIPLE_REGISTERS: {
       if (data_length < 5) return kIllegalValue;
       const int quantity = be16(d + 2);
       if (quantity < 1 || quantity > MODBUS_MAX_WRITE_REGISTERS || d[4] != quantity * 2 || data_length < 5 + d[4]) return kIllegalValue;
       if (auto e = collect_register_writes(be16(d), quantity, d + 5, writes)) return e;
-      return apply_writes(writes, client, snap, now_ns);
+      return apply_writes(writes, session, now_ns);
     }
     case MODBUS_FC_WRITE_AND_READ_REGISTERS: {
       if (data_length < 9) return kIllegalValue;
@@ -96,20 +97,20 @@ std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, const s
       // The read part must be valid too before anything is applied.
       for (int a = be16(d); a < be16(d) + read_quantity; ++a)
         if (!map_.find(Table::kHoldingRegister, a).entry) return kIllegalAddress;
-      if (auto e = apply_writes(writes, client, snap, now_ns)) return e;
+      if (auto e = apply_writes(writes, session, now_ns)) return e;
       // modbus_reply writes first, then reads: the answer shows the written values.
-      return read_into(Table::kHoldingRegister, be16(d), read_quantity, snap, now_ns, image);
+      return read_into(Table::kHoldingRegister, be16(d), read_quantity, snap, session, now_ns, image);
     }
     default: return kIllegalFunction;
   }
 }
 
-std::uint8_t RequestHandler::read_into(Table t, int address, int quantity, const runtime::Snapshot& snap, std::int64_t now_ns,
-                                       _modbus_mapping_t* image) {
+std::uint8_t RequestHandler::read_into(Table t, int address, int quantity, const runtime::Snapshot& snap,
+                                       const Session& session, std::int64_t now_ns, _modbus_mapping_t* image) {
   const int max = is_bit_table(t) ? MODBUS_MAX_READ_BITS : MODBUS_MAX_READ_REGISTERS;
   if (quantity < 1 || quantity > max) return kIllegalValue;
   if (address + quantity > 65536) return kIllegalAddress;
-  const points::InterfaceStatus server = status(now_ns);
+  const points::InterfaceStatus server = status(session, now_ns);
   const points::PointContext ctx{snap, server};
   for (int a = address; a < address + quantity;) {
     const auto hit = map_.find(t, a);
@@ -134,9 +135,9 @@ std::uint8_t RequestHandler::collect_register_writes(int address, int quantity, 
     if (!hit.entry || !hit.entry->writable) return kIllegalAddress;
     const RegisterEntry& e = *hit.entry;
     if (hit.offset != 0 || e.address + e.width() > address + quantity) return kIllegalValue;  // half a 32-bit value
-    std::uint16_t words[2] = {};
+    std::uint16_t words[4] = {};
     for (int i = 0; i < e.width(); ++i) words[i] = static_cast<std::uint16_t>(be16(bytes + 2 * (a - address + i)));
-    out.push_back({&e, decode_value(e, words)});
+    out.push_back({&e, decode_value(e, words), e.type == DataType::kKey64 ? key_value(words) : 0});
     a += e.width();
   }
   return 0;
@@ -152,14 +153,28 @@ std::uint8_t RequestHandler::collect_coil_writes(int address, int quantity, cons
   return 0;
 }
 
-std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, const std::string& client,
-                                          const runtime::Snapshot&, std::int64_t now_ns) {
+std::uint8_t RequestHandler::take_key(const Write& key, const Session& session, std::int64_t now_ns) {
+  const UnlockGuard::Attempt a = unlock_.attempt(session.address, key.key, now_ns);
+  if (a.verdict == UnlockGuard::Verdict::kUnlocked) return 0;
+  if (a.verdict == UnlockGuard::Verdict::kNoKey) return kIllegalValue;  // none configured: nothing to guess
+  // A wrong key is logged and audited each time (at most kFreeAttempts before a back-off), the
+  // start of a back-off too; attempts during one are refused unseen and only counted.
+  if (a.verdict == UnlockGuard::Verdict::kLockedOut) return kCannotApply;
+  std::string what = "wrong unlock key";
+  if (a.lockout_started)
+    what += "; unlock writes from " + session.address + " refused for " + std::to_string(a.backoff_ns / 1'000'000'000) + " s";
+  if (log_) log_("modbus: " + session.peer + ": " + what + " (" + std::to_string(unlock_.failures()) + " refused attempts since start)");
+  gate_.record_event({{core::unix_time_ms(), "modbus " + session.peer + ": " + what, std::string(key.entry->point->name), 0, 0}});
+  return kIllegalValue;
+}
+
+std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, Session& session, std::int64_t now_ns) {
   // The unlock key is this interface's own; everything else goes through the gate as one group.
-  points::Requester who{"modbus " + client, true, "", now_ns < unlocked_until_ns_};
+  points::Requester who{"modbus " + session.peer, true, "", now_ns < session.unlocked_until_ns};
   if (policy_.read_only) who.may_write = false, who.no_write_reason = "the Modbus server is read-only";
   if (!policy_.write_clients.empty() &&
-      std::find(policy_.write_clients.begin(), policy_.write_clients.end(), client) == policy_.write_clients.end())
-    who.may_write = false, who.no_write_reason = "client " + client + " is not in [modbus] write_clients";
+      std::find(policy_.write_clients.begin(), policy_.write_clients.end(), session.address) == policy_.write_clients.end())
+    who.may_write = false, who.no_write_reason = "client " + session.address + " is not in [modbus] write_clients";
   std::vector<points::PointWrite> group;
   bool unlock = false;
   for (const auto& w : writes) {
@@ -167,14 +182,13 @@ std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, cons
       group.push_back({w.entry->point->id, w.value});
       continue;
     }
-    if (!(w.value >= w.entry->min && w.value <= w.entry->max) || w.value != std::floor(w.value)) return kIllegalValue;
     if (!who.may_write) return kCannotApply;
-    if (policy_.unlock_key == 0 || w.value != policy_.unlock_key) return kIllegalValue;
+    if (auto e = take_key(w, session, now_ns)) return e;
     unlock = true;
   }
   if (!group.empty())
     if (const auto r = gate_.submit(group, who); !r.accepted()) return points::modbus_exception(r.refusal);
-  if (unlock) unlocked_until_ns_ = now_ns + static_cast<std::int64_t>(policy_.unlock_timeout_s * 1e9);
+  if (unlock) session.unlocked_until_ns = now_ns + static_cast<std::int64_t>(policy_.unlock_timeout_s * 1e9);
   return 0;
 }
 

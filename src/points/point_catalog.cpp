@@ -58,9 +58,12 @@ std::vector<PointDef> build() {
       {P::kHeartbeat, "heartbeat", "", "the supervising client increments this; if it stops, the appliance faults", A::kWrite, 0, 4294967295.0, true,
        false, [](const Ctx& c, int) { return double(c.snapshot.heartbeat); }},
       {P::kRecord, "record_s", "s", "write N: save the last N seconds as a run file", A::kWrite, 0.1, 3600, false, true, [](const Ctx&, int) { return 0.0; }},
-      {P::kUnlock, "unlock", "", "write the configured key: tuning registers writable until the unlock timeout", A::kKey, 0, 65535, true, false,
+      {P::kUnlock, "unlock", "", "write the configured 64-bit key (key64: 4 registers, most significant first): tuning registers "
+                                 "writable for this connection until the unlock timeout or until it closes; after 5 wrong keys the "
+                                 "address is refused for a back-off that doubles up to 5 minutes", A::kKey, 0, 0, true, false,
        [](const Ctx&, int) { return 0.0; }},
-      {P::kLocked, "locked", "", "1 while tuning registers refuse writes", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return b(c.status.locked); }},
+      {P::kLocked, "locked", "", "1 while tuning registers refuse this connection's writes", A::kRead, 0, 0, true, true,
+       [](const Ctx& c, int) { return b(c.status.locked); }},
       {P::kStoreOk, "store_ok", "", "1 while the tuning store saves changes; 0 while its writes fail (disk full, read-only): saved_counter stands still until they succeed",
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return b(c.status.saving); }},
       {P::kChangeCounter, "change_counter", "", "accepted changes since start (Modbus and web); the heartbeat and the unlock key do not count",
@@ -69,6 +72,8 @@ std::vector<PointDef> build() {
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.saved_counter); }},
       {P::kModbusRequests, "modbus_requests", "", "requests served since start", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.requests); }},
       {P::kModbusClients, "modbus_clients", "", "connected Modbus clients", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.clients); }},
+      {P::kUnlockFailures, "unlock_failures", "", "refused unlock attempts since start: wrong keys and attempts during a back-off", A::kRead, 0, 0,
+       true, true, [](const Ctx& c, int) { return double(c.status.unlock_failures); }},
       // tuning
       {P::kTs, "Ts_s", "s", "sample time", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.Ts; }},
       {P::kMr, "m_r", "", "dead zone right slope", A::kTuning, 1e-6, 100, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.m_r; }},

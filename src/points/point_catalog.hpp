@@ -23,6 +23,7 @@ struct InterfaceStatus {
   std::uint64_t requests = 0;        // Modbus requests served
   int clients = 0;                   // connected Modbus clients
   bool locked = true;                // tuning points refuse this client's writes
+  std::uint64_t unlock_failures = 0; // refused unlock attempts since start (wrong key, back-off)
 };
 
 struct PointContext {

@@ -18,7 +18,7 @@ enum class PointId : std::uint16_t {
   // commands
   kReset, kHeartbeat, kRecord, kUnlock,
   // the interfaces and the store
-  kLocked, kStoreOk, kChangeCounter, kSavedCounter, kModbusRequests, kModbusClients,
+  kLocked, kStoreOk, kChangeCounter, kSavedCounter, kModbusRequests, kModbusClients, kUnlockFailures,
   // tuning
   kTs, kMr, kMl, kBr, kBl, kLc,
   // the last move

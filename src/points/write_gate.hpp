@@ -72,6 +72,12 @@ class WriteGate {
   GateResult decide(std::span<const PointWrite> writes, const Requester& who, const runtime::Snapshot& snap,
                     std::vector<runtime::Command>* commands = nullptr) const;
 
+  // An event an interface decided on its own that belongs in the same audit trail (a refused
+  // unlock attempt): recorded as it is, nothing queued.
+  void record_event(const std::vector<core::AuditEntry>& entries) {
+    if (audit_) audit_->record(entries);
+  }
+
   // Logs and audits the commands the loop refused after the gate accepted them. Off the loop.
   void take_refusals(const std::function<void(const std::string&)>& log);
 

@@ -20,6 +20,14 @@ core::Status validate(const RuntimeConfig& c) {
     if (ch.positive && !(ch.value > 0.0)) return core::invalid_argument(std::string(ch.name) + " must be > 0, got " + core::format_number(ch.value));
   }
   if (c.period_s < 0.0002 || c.period_s > 1.0) return core::invalid_argument("period_s must be within [0.0002, 1] s, got " + core::format_number(c.period_s));
+  // Buffers sized from a duration over the period: bounded, so a typo cannot take the memory.
+  constexpr double kMaxBufferSamples = 1e6;
+  if (c.record_buffer_s / c.period_s > kMaxBufferSamples)
+    return core::invalid_argument("record_buffer_s / period_s is " + core::format_number(c.record_buffer_s / c.period_s) +
+                                  " samples, more than the recorder keeps (" + core::format_number(kMaxBufferSamples) + ")");
+  if (c.move_window_s / c.period_s > kMaxBufferSamples)
+    return core::invalid_argument("move_window_s / period_s is " + core::format_number(c.move_window_s / c.period_s) +
+                                  " samples, more than a move is measured over (" + core::format_number(kMaxBufferSamples) + ")");
   if (!(c.sensor_min_v < c.sensor_max_v)) return core::invalid_argument("sensor_min_v must be below sensor_max_v");
   if (!(c.soft_min_mm < c.soft_max_mm)) return core::invalid_argument("soft_min_mm must be below soft_max_mm");
   if (!(c.setpoint_min_mm <= c.setpoint_max_mm)) return core::invalid_argument("setpoint_min_mm must not exceed setpoint_max_mm");

@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
+
+#include "points/point_catalog.hpp"
 
 namespace epa::web {
 
@@ -9,6 +12,11 @@ namespace {
 
 class Writer {
  public:
+  // A point's value under its catalog name: epa_<point>, the catalog's description as help.
+  void point(points::PointId id, double value) {
+    const auto& p = points::point(id);
+    metric(("epa_" + std::string(p.name)).c_str(), "gauge", (std::string(p.description) + ".").c_str(), value);
+  }
   void metric(const char* name, const char* type, const char* help, double value) {
     out_ += "# HELP ";
     out_ += name;
@@ -42,14 +50,15 @@ class Writer {
 std::string prometheus_text(const runtime::Snapshot& s, const ModbusStats& modbus, std::uint64_t web_requests) {
   Writer w;
   const auto d = [](std::uint64_t v) { return static_cast<double>(v); };
-  w.metric("epa_position_mm", "gauge", "Piston position, mm.", s.position_mm);
-  w.metric("epa_setpoint_mm", "gauge", "Setpoint, mm.", s.setpoint_mm);
-  w.metric("epa_error_mm", "gauge", "Setpoint minus position, mm.", s.error_mm);
+  using P = points::PointId;
+  w.point(P::kPosition, s.position_mm);
+  w.point(P::kSetpoint, s.setpoint_mm);
+  w.point(P::kError, s.error_mm);
   w.metric("epa_valve_volts", "gauge", "Valve command written to the DAQ, V.", s.valve_v);
   w.metric("epa_sensor_volts", "gauge", "Position sensor reading, V.", s.sensor_v);
-  w.metric("epa_mode", "gauge", "Operating mode: 0 stop, 1 run, 2 manual, 3 fault.", static_cast<double>(s.mode));
-  w.metric("epa_fault_code", "gauge", "Latched fault code (0: none).", static_cast<double>(s.fault));
-  w.metric("epa_controller", "gauge", "Active controller: 0 pp, 1 pp-ngidz, 2 pp-ffidz.", static_cast<double>(s.controller));
+  w.point(P::kMode, static_cast<double>(s.mode));
+  w.point(P::kFaultCode, static_cast<double>(s.fault));
+  w.point(P::kController, static_cast<double>(s.controller));
   w.metric("epa_uptime_seconds", "gauge", "Time since the scan cycle started, s.", s.time_s);
   w.metric("epa_loop_cycles_total", "counter", "Scan cycles run.", d(s.loop.cycles));
   w.metric("epa_loop_overruns_total", "counter", "Scan cycles that missed their deadline.", d(s.loop.overruns));

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <regex>
+
 namespace epa::app {
 namespace {
 
@@ -30,7 +33,7 @@ TEST(ApplianceConfig, ShippedFileParsesToTheDocumentedDefaults) {
   EXPECT_EQ(c->register_map_path, std::string(EPA_SOURCE_DIR) + "/registers/epa.csv");  // next to the config
   EXPECT_TRUE(c->modbus_enabled);
   EXPECT_EQ(c->modbus.port, 502);
-  EXPECT_EQ(c->modbus.policy.unlock_key, 0);  // no default key: tuning stays locked until one is set
+  EXPECT_FALSE(c->modbus.policy.unlock_key.has_value());  // no default key: tuning stays locked until one is set
   EXPECT_EQ(c->store_path, "epa.db");          // the appliance's data: relative to the working directory
   EXPECT_EQ(c->sim_plant, "hammerstein");
   EXPECT_EQ(c->physics_config, "");
@@ -91,6 +94,46 @@ TEST(ApplianceConfig, ScalingIsGivenAsFullScaleVolts) {
   auto c = parse_appliance_config("[hal.modbus_io]\nsensor = { full_scale_v = 5.0 }\n", "t.toml");
   ASSERT_TRUE(c.has_value()) << c.error().message;
   EXPECT_DOUBLE_EQ(c->modbus_io.layout.sensor.volts_per_count, 5.0 / 32767);
+}
+
+// Every numeric key of the shipped configuration, one at a time, set to values a typo or an
+// attacker could write: 1e300 is refused for every key (each is bounded), and whatever is refused
+// names the file, the key's line and the key. A float never reaches an integer unchecked.
+TEST(ApplianceConfig, EveryNumericKeyIsBoundedAndARefusalNamesFileLineAndKey) {
+  std::ifstream in(std::string(EPA_SOURCE_DIR) + "/config/epa.toml");
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  const std::regex number_key(R"((\b[a-z_]+) = (-?[0-9][0-9.e+-]*))");
+  int keys = 0;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const std::string code = lines[i].substr(0, lines[i].find('#'));
+    for (std::sregex_iterator it(code.begin(), code.end(), number_key), end; it != end; ++it) {
+      const std::string key = (*it)[1].str();
+      ++keys;
+      for (const char* value : {"1e300", "-1e300", "nan", "inf", "-1", "0", "0.5"}) {
+        std::vector<std::string> edited = lines;
+        edited[i] = code.substr(0, static_cast<std::size_t>(it->position(2))) + value +
+                    code.substr(static_cast<std::size_t>(it->position(2) + it->length(2)));
+        std::string text;
+        for (const auto& l : edited) text += l + "\n";
+        const auto c = parse_appliance_config(text, "epa.toml");
+        const bool must_refuse = std::string(value).find("e300") != std::string::npos || std::string(value).find("n") != std::string::npos;
+        if (must_refuse) {
+          EXPECT_FALSE(c.has_value()) << key << " = " << value << " was accepted";
+        }
+        if (!c.has_value()) {
+          const std::string& m = c.error().message;
+          const bool names_line = m.find("epa.toml:" + std::to_string(i + 1) + ":") != std::string::npos;
+          const bool cross_field = m.find("epa.toml: ") != std::string::npos;  // a rule between keys, named in words
+          EXPECT_TRUE(names_line || cross_field) << key << " = " << value << ": " << m;
+          if (names_line) {
+            EXPECT_NE(m.find(key), std::string::npos) << key << " = " << value << ": " << m;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GE(keys, 40);
 }
 
 }  // namespace

@@ -356,3 +356,21 @@ TEST(RunFile, ReadRunFileErrorsNameThePath) {
 
 }  // namespace
 }  // namespace epa::core
+
+namespace epa::core {
+namespace {
+
+// A run file larger than the cap is refused at the first sample past it, naming the line, so a
+// 10^7-row file costs a bounded amount of memory, not gigabytes.
+TEST(RunFile, MoreSamplesThanTheCapAreRefusedNamingTheLine) {
+  std::stringstream in;
+  in << "# epa-run/1\n# Ts=0.005\nt_s,y_mm,u_V\n";
+  for (std::size_t k = 0; k <= kMaxRunSamples; ++k) in << k * 0.005 << ",1,0\n";
+  const auto r = parse_run(in, "big.csv");
+  ASSERT_FALSE(r.has_value());
+  EXPECT_NE(r.error().message.find("big.csv:" + std::to_string(kMaxRunSamples + 4) + ":"), std::string::npos) << r.error().message;
+  EXPECT_NE(r.error().message.find("2000000"), std::string::npos) << r.error().message;
+}
+
+}  // namespace
+}  // namespace epa::core

@@ -31,7 +31,7 @@ import time
 import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from epa_appliance import UNIT, UNLOCK_KEY, Appliance, f32_value, f32_words, free_port, u32_value, u32_words  # noqa: E402
+from epa_appliance import UNIT, UNLOCK_ADDRESS, Appliance, key_words, f32_value, f32_words, free_port, u32_value, u32_words  # noqa: E402
 
 
 class PlantServer:
@@ -235,7 +235,7 @@ def fill(path):
 def run_disk(rig, mount, failures, rows):
     """Disk full (when `mount` is a tmpfs of ours) and read-only (the shim), while writing tuning."""
     written = []
-    rig.write(9, [UNLOCK_KEY])
+    rig.write(UNLOCK_ADDRESS, key_words())
 
     def write_some(n, base):
         for i in range(n):
@@ -248,7 +248,7 @@ def run_disk(rig, mount, failures, rows):
         cases.append(("disk full", lambda: fill(os.path.join(mount, "filler")), lambda: os.remove(os.path.join(mount, "filler"))))
     cases.append(("read-only file system", lambda: open(rig.read_only_trigger, "w").close(), lambda: os.remove(rig.read_only_trigger)))
     for label, breaks, heals in cases:
-        rig.write(9, [UNLOCK_KEY])
+        rig.write(UNLOCK_ADDRESS, key_words())
         breaks()
         write_some(20, len(written) * 0.01)
         failing = wait_until(lambda: not rig.store_ok(), 3.0)

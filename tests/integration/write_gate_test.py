@@ -23,7 +23,7 @@ import urllib.error
 import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from epa_appliance import UNIT, UNLOCK_KEY, Appliance, f32_value, f32_words, pymodbus  # noqa: E402
+from epa_appliance import UNIT, Appliance, f32_value, f32_words, pymodbus, unlock  # noqa: E402
 
 TOKEN = "a-token-for-the-write-gate-test"
 ILLEGAL_VALUE = 0x03
@@ -69,7 +69,7 @@ def main():
         check(status == 400 and "setpoint_max_mm" in body.get("error", ""), f"POST /api/setpoint 400 -> 400 naming the limit ({status} {body})")
 
         # Every writable point, just beyond its range, through both interfaces.
-        c.write_register(9, UNLOCK_KEY, slave=UNIT)  # unlocked: only the range can refuse tuning writes
+        unlock(c)  # unlocked: only the range can refuse tuning writes
         _, catalog = http(app, "GET", "/api/points")
         holding = {}  # point -> (address, type) of the shipped map's float32 / uint16 holding registers
         for line in open(reg_map):

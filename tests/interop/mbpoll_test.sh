@@ -46,7 +46,7 @@ cat >"$tmp/epa.toml" <<EOF
 address = "127.0.0.1"
 port = $port
 register_map = "$src/registers/epa.csv"
-unlock_key = 4321
+unlock_key = "5e3a9c17d24b086f"
 
 [web]
 enabled = false

@@ -23,7 +23,7 @@ import time
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from epa_appliance import (UNIT, UNLOCK_KEY, Appliance, f32_value, f32_words, i16_value, pymodbus,  # noqa: E402
+from epa_appliance import (UNIT, UNLOCK_ADDRESS, Appliance, unlock, f32_value, f32_words, i16_value, pymodbus,  # noqa: E402
                            u32_value, u32_words)
 
 VERSION = (0, 2, 0)  # src/points/point_catalog.hpp kVersionMajor/Minor/Patch
@@ -146,15 +146,15 @@ class EpaMapTest(ApplianceTest):
         self.assertGreaterEqual(len(rr.bits), 4)
         self.assertEqual(rr.bits[:4], [False, False, True, True], "fault_active, saturated, io_ok, locked at start")
         # Holding registers, both blocks whole.
-        h = self.regs(3, 0, 12, "holding 0-11")
+        h = self.regs(3, 0, 15, "holding 0-14")
         self.assertEqual(f32_value(h[0:2], "ABCD"), 0.0, "setpoint_mm at start")
         self.assertEqual(h[2], 0, "mode: stop")
         self.assertEqual(h[3], 2, "controller: pp-ffidz")
         self.assertEqual(f32_value(h[4:6], "ABCD"), 0.0, "manual_valve_v")
         self.assertEqual(u32_value(h[6:8]), 0, "heartbeat")
         self.assertEqual(h[8], 0, "reset reads 0")
-        self.assertEqual(h[9], 0, "unlock reads 0 (never the key)")
-        self.assertEqual(f32_value(h[10:12], "ABCD"), 0.0, "record_s reads 0")
+        self.assertEqual(h[9:13], [0, 0, 0, 0], "unlock reads 0 (never the key)")
+        self.assertEqual(f32_value(h[13:15], "ABCD"), 0.0, "record_s reads 0")
         t = self.regs(3, 20, 10, "holding 20-29")
         for name, i, expected in [("m_r", 0, 1.7627), ("m_l", 2, 1.0707), ("b_r", 4, 1.232), ("b_l", 6, -1.722),
                                   ("lc_mm", 8, 5.0)]:
@@ -219,10 +219,10 @@ class EpaMapTest(ApplianceTest):
 
     def test_3_unlock_and_tune(self):
         c = self.c
-        self.ok(c.write_register(9, UNLOCK_KEY, slave=UNIT), "unlock with the key")
+        self.ok(unlock(c), "unlock with the key")
         self.assertEqual(self.ok(c.read_discrete_inputs(3, 1, slave=UNIT), "locked").bits[0], False,
                          "locked discrete input after the key")
-        self.assertEqual(self.regs(3, 9, 1)[0], 0, "unlock reads 0, not the key")
+        self.assertEqual(self.regs(3, UNLOCK_ADDRESS, 4), [0, 0, 0, 0], "unlock reads 0, not the key")
         self.ok(c.write_registers(28, f32_words(7.5, "ABCD"), slave=UNIT), "lc_mm 7.5 while unlocked")
         self.wait_until(lambda: (f32_value(self.regs(3, 28, 2), "ABCD") == 7.5, f32_value(self.regs(3, 28, 2), "ABCD")),
                         2.0, "lc_mm reads back 7.5", every_s=0.02)

@@ -47,7 +47,7 @@ class Server : public ::testing::Test {
     ServerConfig c;
     c.max_clients = 3;
     c.idle_timeout_s = 0.3;
-    c.policy.unlock_key = 4321;
+    c.policy.unlock_key = 0x5e3a9c17d24b086f;
     start(c);
   }
   modbus_t* client(int unit = 1) {
@@ -142,7 +142,8 @@ TEST_F(Server, EveryExceptionPath) {
 
 TEST_F(Server, TuningWritesAfterUnlock) {
   modbus_t* c = client();
-  EXPECT_EQ(modbus_write_register(c, 9, 4321), 1);
+  const std::uint16_t key[4] = {0x5e3a, 0x9c17, 0xd24b, 0x086f};
+  EXPECT_EQ(modbus_write_registers(c, 9, 4, key), 4);
   const auto lc_words = core::encode_f32(3.0f, core::WordOrder::kABCD);
   std::uint16_t lc[2] = {lc_words[0], lc_words[1]};
   EXPECT_EQ(modbus_write_registers(c, 28, 2, lc), 2);
@@ -161,18 +162,27 @@ TEST_F(Server, OtherUnitIdGetsGatewayException) {
   EXPECT_EQ(errno, EMBXGTAR);
 }
 
-TEST_F(Server, ClientsOverTheCapAreRefusedAndTheOthersKeepWorking) {
+TEST_F(Server, ANewClientOverTheCapEvictsTheOneIdleTheLongest) {
   modbus_t* a = client();
   modbus_t* b = client();
   modbus_t* c = client();
   std::uint16_t r[2];
-  for (auto* ctx : {a, b, c}) ASSERT_EQ(modbus_read_input_registers(ctx, 0, 2, r), 2);
-  modbus_t* d = modbus_new_tcp("127.0.0.1", server_->port());
-  clients_.push_back(d);
-  modbus_set_response_timeout(d, 0, 500000);
-  modbus_connect(d);  // the TCP handshake completes; the server then closes it
-  EXPECT_EQ(modbus_read_input_registers(d, 0, 2, r), -1);
-  EXPECT_EQ(modbus_read_input_registers(a, 0, 2, r), 2);
+  for (auto* ctx : {a, b, c}) ASSERT_EQ(modbus_read_input_registers(ctx, 0, 2, r), 2);  // a is now idle the longest
+  for (auto* ctx : {b, c}) ASSERT_EQ(modbus_read_input_registers(ctx, 0, 2, r), 2);
+  modbus_t* d = client();
+  EXPECT_EQ(modbus_read_input_registers(d, 0, 2, r), 2);  // served, not refused
+  EXPECT_EQ(modbus_read_input_registers(b, 0, 2, r), 2);
+  EXPECT_EQ(modbus_read_input_registers(a, 0, 2, r), -1);  // a made room
+  EXPECT_EQ(server_->clients(), 3);
+}
+
+TEST_F(Server, FreshIdleSocketsAreEvictedBeforeAWorkingClient) {
+  modbus_t* hmi = client();
+  std::uint16_t r[2];
+  ASSERT_EQ(modbus_read_input_registers(hmi, 0, 2, r), 2);
+  for (int i = 0; i < 10; ++i) raw_socket();  // a crowd that connects and says nothing, after the HMI
+  std::this_thread::sleep_for(100ms);
+  EXPECT_EQ(modbus_read_input_registers(hmi, 0, 2, r), 2);  // still connected: the silent ones made room
   EXPECT_EQ(server_->clients(), 3);
 }
 
@@ -203,6 +213,26 @@ TEST_F(Server, AClientSendingOneByteAtATimeDoesNotBlockOthers) {
   setsockopt(slow, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
   EXPECT_EQ(recv(slow, rsp, sizeof rsp, MSG_WAITALL), 13);  // then it is answered like anyone
   EXPECT_EQ(rsp[8], 4);  // byte count of two registers
+}
+
+TEST_F(Server, AFrameNotCompletedWithinTheFrameTimeoutIsClosedEvenIfBytesKeepComing) {
+  server_->stop();
+  ServerConfig c;
+  c.frame_timeout_s = 0.3;
+  c.idle_timeout_s = 60;
+  start(c);
+  const int slow = raw_socket();
+  const std::uint8_t frame[] = {0x00, 0x01, 0x00, 0x00, 0x00, 0x06, 0x01, 0x04, 0x00, 0x00, 0x00, 0x02};
+  const auto t0 = Clock::now();
+  bool closed = false;
+  for (std::size_t i = 0; i < sizeof frame && !closed; ++i) {  // one byte every 100 ms: 1.2 s for the frame
+    if (send(slow, frame + i, 1, MSG_NOSIGNAL) != 1) closed = true;
+    std::uint8_t byte = 0;
+    if (recv(slow, &byte, 1, MSG_DONTWAIT) == 0) closed = true;
+    std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_TRUE(closed) << "a one-byte-a-tick client was served after all";
+  EXPECT_LT(Clock::now() - t0, 1s);
 }
 
 TEST_F(Server, GarbageClosesOnlyThatClient) {

@@ -65,6 +65,31 @@ TEST(RegisterMap, UnknownColumnAndMissingColumnAreRefused) {
 
 // Found by fuzz_register_map: with a column named twice the row was checked against the number of
 // distinct names, and the second name's index read past the end of a row that short.
+TEST(RegisterMap, ASpreadsheetsByteOrderMarkAndCrLfLineEndsAreRead) {
+  // Excel's "CSV UTF-8" and Windows line ends: the same map as the plain file.
+  const std::string plain = "name,table,address,type\nsetpoint_mm,holding,0,float32\nmode,holding,2,uint16\n";
+  std::string excel = "\xEF\xBB\xBF";
+  for (char ch : plain) excel += ch == '\n' ? std::string("\r\n") : std::string(1, ch);
+  auto a = RegisterMap::parse(plain, "plain.csv");
+  auto b = RegisterMap::parse(excel, "excel.csv");
+  ASSERT_TRUE(a.has_value()) << a.error().message;
+  ASSERT_TRUE(b.has_value()) << b.error().message;
+  ASSERT_EQ(b->entries().size(), a->entries().size());
+  for (std::size_t i = 0; i < a->entries().size(); ++i) {
+    EXPECT_EQ(b->entries()[i].point, a->entries()[i].point);
+    EXPECT_EQ(b->entries()[i].address, a->entries()[i].address);
+    EXPECT_EQ(b->entries()[i].type, a->entries()[i].type);
+  }
+}
+
+TEST(RegisterMap, ANulByteIsRefusedNamingLineAndColumn) {
+  const std::string text = std::string("name,table,address,type\nsetpoint_mm,hol") + '\0' + "ding,0,float32\n";
+  auto m = RegisterMap::parse(text, "nul.csv");
+  ASSERT_FALSE(m.has_value());
+  EXPECT_NE(m.error().message.find("nul.csv:2: column 16"), std::string::npos) << m.error().message;
+  EXPECT_NE(m.error().message.find("NUL"), std::string::npos) << m.error().message;
+}
+
 TEST(RegisterMap, ARepeatedColumnIsRefused) {
   auto m = RegisterMap::parse("name,table,address,type,min,min,max\nsetpoint_mm,holding,0,float32,0,500\n", "m.csv");
   ASSERT_FALSE(m.has_value());

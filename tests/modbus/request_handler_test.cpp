@@ -6,6 +6,7 @@
 #include <modbus.h>
 
 #include <cmath>
+#include <map>
 
 #include "control/paper_controller.hpp"
 
@@ -13,11 +14,14 @@ namespace epa::modbus {
 namespace {
 
 using Bytes = std::vector<std::uint8_t>;
+constexpr std::uint64_t kKey = 0x5e3a9c17d24b086f;
 constexpr std::int64_t kSecond = 1'000'000'000;
 
 Bytes adu(const Bytes& pdu, std::uint8_t unit = 1) {
-  Bytes a = {0x00, 0x01, 0x00, 0x00, 0x00, static_cast<std::uint8_t>(pdu.size() + 1), unit};
-  a.insert(a.end(), pdu.begin(), pdu.end());
+  Bytes a(7 + pdu.size());  // sized first: g++ 12 warns (array-bounds) about inserting into a 7-byte list
+  const std::uint8_t header[7] = {0x00, 0x01, 0x00, 0x00, 0x00, static_cast<std::uint8_t>(pdu.size() + 1), unit};
+  std::copy(header, header + 7, a.begin());
+  std::copy(pdu.begin(), pdu.end(), a.begin() + 7);
   return a;
 }
 
@@ -34,7 +38,7 @@ struct RecordingSink final : core::AuditSink {
 
 class Handler : public ::testing::Test {
  protected:
-  void SetUp() override { make(WritePolicy{.read_only = false, .unlock_key = 4321, .unlock_timeout_s = 10, .write_clients = {}}); }
+  void SetUp() override { make(WritePolicy{.read_only = false, .unlock_key = kKey, .unlock_timeout_s = 10, .write_clients = {}}); }
   void make(WritePolicy policy) {
     auto m = RegisterMap::load(std::string(EPA_SOURCE_DIR) + "/registers/epa.csv");
     ASSERT_TRUE(m.has_value()) << m.error().message;
@@ -45,7 +49,8 @@ class Handler : public ::testing::Test {
     gate_ = std::make_unique<points::WriteGate>(std::move(*limits), loop_,
                                                 control::paper_controller_config(control::ControllerKind::kPpFfidz), channels_,
                                                 &sink_);
-    handler_ = std::make_unique<RequestHandler>(*map_, std::move(policy), 1, *gate_, channels_);
+    handler_ = std::make_unique<RequestHandler>(*map_, std::move(policy), 1, *gate_, channels_,
+                                                [this](const std::string& line) { log_.push_back(line); });
     if (image_) modbus_mapping_free(image_);
     image_ = modbus_mapping_new_start_address(0, map_->end_address(Table::kCoil), 0, map_->end_address(Table::kDiscreteInput), 0,
                                               map_->end_address(Table::kHoldingRegister), 0, map_->end_address(Table::kInputRegister));
@@ -55,7 +60,14 @@ class Handler : public ::testing::Test {
   void publish() { channels_.snapshot.publish(snap_); }
   std::uint8_t send(const Bytes& pdu, std::uint8_t unit = 1, const std::string& client = "127.0.0.1", std::int64_t now = 0) {
     const Bytes a = adu(pdu, unit);
-    return handler_->handle(a.data(), static_cast<int>(a.size()), client, now, image_);
+    Session& session = sessions_.try_emplace(client, Session{client, client + ":50000", 0}).first->second;
+    return handler_->handle(a.data(), static_cast<int>(a.size()), session, now, image_);
+  }
+  // FC16 of a key64 to `unlock` (holding 9-12), most significant word first.
+  static Bytes unlock_pdu(std::uint64_t key) {
+    Bytes p = {0x10, 0x00, 0x09, 0x00, 0x04, 0x08, 0, 0, 0, 0, 0, 0, 0, 0};
+    for (int i = 0; i < 8; ++i) p[6 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(key >> (56 - 8 * i));
+    return p;
   }
   std::vector<runtime::Command> drain() {
     std::vector<runtime::Command> out;
@@ -78,6 +90,8 @@ class Handler : public ::testing::Test {
   RecordingSink sink_;
   std::unique_ptr<RegisterMap> map_;
   std::unique_ptr<points::WriteGate> gate_;
+  std::map<std::string, Session> sessions_;  // one connection per client address
+  std::vector<std::string> log_;
   std::unique_ptr<RequestHandler> handler_;
   modbus_mapping_t* image_ = nullptr;
 };
@@ -108,12 +122,12 @@ TEST_F(Handler, SetpointWriteQueuesOneCommandAndIsAudited) {
   ASSERT_EQ(c.size(), 1u);
   EXPECT_EQ(c[0].kind, runtime::CommandKind::kSetpoint);
   EXPECT_EQ(c[0].value, 50.0);
-  EXPECT_EQ(handler_->status(0).change_counter, 1u);
+  EXPECT_EQ(handler_->status(Session{}, 0).change_counter, 1u);
   ASSERT_EQ(sink_.entries.size(), 1u);
   EXPECT_EQ(sink_.entries[0].point, "setpoint_mm");
   EXPECT_EQ(sink_.entries[0].old_value, 100.0);
   EXPECT_EQ(sink_.entries[0].new_value, 50.0);
-  EXPECT_EQ(sink_.entries[0].source, "modbus 127.0.0.1");
+  EXPECT_EQ(sink_.entries[0].source, "modbus 127.0.0.1:50000");  // ip:port of the connection
 }
 
 TEST_F(Handler, TheCountersSayHowManyChangesAreAcceptedAndHowManyAreOnDisk) {
@@ -134,7 +148,7 @@ TEST_F(Handler, HalfAFloatIsRefusedAndNothingIsQueued) {
   EXPECT_EQ(send({0x06, 0x00, 0x00, 0x42, 0x48}), 0x03);                    // FC6 on the first half
   EXPECT_EQ(send({0x10, 0x00, 0x01, 0x00, 0x01, 0x02, 0x00, 0x00}), 0x03);  // FC16 on the second half
   EXPECT_TRUE(drain().empty());
-  EXPECT_EQ(handler_->status(0).change_counter, 0u);
+  EXPECT_EQ(handler_->status(Session{}, 0).change_counter, 0u);
 }
 
 TEST_F(Handler, ValueOutsideTheRangeIs03) {
@@ -147,11 +161,11 @@ TEST_F(Handler, TheConfigurationsLimitsNarrowTheMapsForModbusToo) {
   // [limits] setpoint_max_mm = 300 while the map keeps 0..500: 400 is refused (03), nothing is
   // queued and nothing audited; 300 is taken.
   loop_.setpoint_max_mm = 300;
-  make(WritePolicy{.read_only = false, .unlock_key = 4321, .unlock_timeout_s = 10, .write_clients = {}});
+  make(WritePolicy{.read_only = false, .unlock_key = kKey, .unlock_timeout_s = 10, .write_clients = {}});
   EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x43, 0xC8, 0x00, 0x00}), 0x03);  // 400.0f
   EXPECT_TRUE(drain().empty());
   EXPECT_TRUE(sink_.entries.empty());
-  EXPECT_EQ(handler_->status(0).change_counter, 0u);
+  EXPECT_EQ(handler_->status(Session{}, 0).change_counter, 0u);
   EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x43, 0x96, 0x00, 0x00}), 0);  // 300.0f
   EXPECT_EQ(drain().size(), 1u);
   EXPECT_EQ(sink_.entries.size(), 1u);
@@ -162,8 +176,8 @@ TEST_F(Handler, TheConfigurationsLimitsNarrowTheMapsForModbusToo) {
 // nothing queued, nothing audited. Values the register type cannot carry are skipped.
 TEST_F(Handler, EveryWritablePointBeyondItsLimitsIs03AndLeavesNoTrace) {
   loop_.setpoint_max_mm = 300;
-  make(WritePolicy{.read_only = false, .unlock_key = 4321, .unlock_timeout_s = 10, .write_clients = {}});
-  ASSERT_EQ(send({0x06, 0x00, 0x09, 0x10, 0xE1}), 0);  // unlocked: the range must refuse tuning writes too
+  make(WritePolicy{.read_only = false, .unlock_key = kKey, .unlock_timeout_s = 10, .write_clients = {}});
+  ASSERT_EQ(send(unlock_pdu(kKey)), 0);  // unlocked: the range must refuse tuning writes too
   snap_.mode = runtime::Mode::kManual;
   publish();
   int checked = 0;
@@ -193,7 +207,7 @@ TEST_F(Handler, EveryWritablePointBeyondItsLimitsIs03AndLeavesNoTrace) {
 }
 
 TEST_F(Handler, WriteToAnUnmappedRegisterIs02) {
-  EXPECT_EQ(send({0x06, 0x00, 0x0C, 0x00, 0x01}), 0x02);  // holding 12: not mapped
+  EXPECT_EQ(send({0x06, 0x00, 0x10, 0x00, 0x01}), 0x02);  // holding 16: not mapped
 }
 
 TEST_F(Handler, ABlockWriteArrivesAsOneGroup) {
@@ -204,38 +218,93 @@ TEST_F(Handler, ABlockWriteArrivesAsOneGroup) {
   EXPECT_EQ(c[0].kind, runtime::CommandKind::kSetpoint);
   EXPECT_EQ(c[1].kind, runtime::CommandKind::kMode);
   EXPECT_EQ(c[1].mode, runtime::Mode::kRun);
-  EXPECT_EQ(handler_->status(0).change_counter, 1u);  // one accepted write request
+  EXPECT_EQ(handler_->status(Session{}, 0).change_counter, 1u);  // one accepted write request
 }
 
 TEST_F(Handler, TuningIsLockedUntilTheKeyThenLocksAgain) {
   const Bytes lc = {0x10, 0x00, 0x1C, 0x00, 0x02, 0x04, 0x40, 0x40, 0x00, 0x00};  // lc_mm = 3.0f
   EXPECT_EQ(send(lc), 0x04);
-  EXPECT_EQ(send({0x06, 0x00, 0x09, 0x00, 0x01}), 0x03);  // wrong key
-  EXPECT_EQ(send({0x06, 0x00, 0x09, 0x10, 0xE1}, 1, "127.0.0.1", 0), 0);  // 4321
-  EXPECT_FALSE(handler_->status(kSecond).locked);
+  EXPECT_EQ(send(unlock_pdu(kKey + 1)), 0x03);  // wrong key
+  EXPECT_EQ(send(unlock_pdu(kKey), 1, "127.0.0.1", 0), 0);
+  EXPECT_FALSE(handler_->status(sessions_.at("127.0.0.1"), kSecond).locked);
   EXPECT_EQ(send(lc, 1, "127.0.0.1", kSecond), 0);
   const auto c = drain();
   ASSERT_EQ(c.size(), 1u);
   EXPECT_EQ(c[0].kind, runtime::CommandKind::kTuning);
   EXPECT_DOUBLE_EQ(c[0].tuning.ffidz.lc_v(), 3.0 / 50.0);
   EXPECT_EQ(send(lc, 1, "127.0.0.1", 11 * kSecond), 0x04);  // the 10 s unlock has run out
-  for (const auto& e : sink_.entries) EXPECT_NE(e.point, "unlock");  // the key is never logged
+  // The wrong key is audited as a refused attempt; no key, right or wrong, is ever in the trail.
+  int unlock_entries = 0;
+  for (const auto& e : sink_.entries) {
+    if (e.point != "unlock") continue;
+    ++unlock_entries;
+    EXPECT_EQ(e.new_value, 0.0);
+    EXPECT_EQ(e.source.find("5e3a"), std::string::npos) << e.source;
+  }
+  EXPECT_EQ(unlock_entries, 1);
+}
+
+TEST_F(Handler, TheUnlockBelongsToTheConnectionThatSentTheKey) {
+  const Bytes lc = {0x10, 0x00, 0x1C, 0x00, 0x02, 0x04, 0x40, 0x40, 0x00, 0x00};  // lc_mm = 3.0f
+  Session hmi{"127.0.0.1", "127.0.0.1:50001", 0}, other{"127.0.0.1", "127.0.0.1:50002", 0};
+  auto on = [&](Session& s, const Bytes& pdu) {
+    const Bytes a = adu(pdu);
+    return handler_->handle(a.data(), static_cast<int>(a.size()), s, 0, image_);
+  };
+  ASSERT_EQ(on(hmi, unlock_pdu(kKey)), 0);
+  EXPECT_EQ(on(other, lc), 0x04);  // the same address, another connection: still locked
+  EXPECT_EQ(on(hmi, lc), 0);
+  EXPECT_TRUE(handler_->status(other, 0).locked);
+  EXPECT_FALSE(handler_->status(hmi, 0).locked);
+}
+
+TEST_F(Handler, BruteForceLocksTheAddressOutAndTheRightKeyIsThenRefusedUnseen) {
+  for (std::uint64_t i = 1; i <= 50; ++i) {
+    const auto e = send(unlock_pdu(kKey ^ i), 1, "10.9.8.7", static_cast<std::int64_t>(i) * 1000);
+    EXPECT_EQ(e, i <= 5 ? 0x03 : 0x04) << "attempt " << i;  // 5 wrong keys looked at, then refused unseen
+  }
+  EXPECT_EQ(send(unlock_pdu(kKey), 1, "10.9.8.7", kSecond), 0x04);  // the right key, during the back-off
+  EXPECT_TRUE(handler_->status(sessions_.at("10.9.8.7"), kSecond).locked);
+  EXPECT_EQ(handler_->status(sessions_.at("10.9.8.7"), kSecond).unlock_failures, 51u);
+  EXPECT_EQ(send({0x04, 0x00, 0x84, 0x00, 0x02}), 0);  // unlock_failures, input 132-133
+  EXPECT_EQ((image_->tab_input_registers[132] << 16) | image_->tab_input_registers[133], 51);
+  ASSERT_FALSE(log_.empty());
+  EXPECT_NE(log_.back().find("10.9.8.7:50000"), std::string::npos) << log_.back();
+  EXPECT_NE(log_.back().find("refused for 10 s"), std::string::npos) << log_.back();
+  EXPECT_EQ(log_.size(), 5u);  // each key looked at, not each attempt refused unseen
+  ASSERT_EQ(sink_.entries.size(), 5u);
+  EXPECT_EQ(sink_.entries[0].point, "unlock");
+  EXPECT_NE(sink_.entries[0].source.find("10.9.8.7:50000"), std::string::npos);
+  EXPECT_EQ(send(unlock_pdu(kKey), 1, "127.0.0.1", kSecond), 0);  // another address is not locked out
+  // After the back-off the right key works; a wrong one would lock out for twice as long.
+  EXPECT_EQ(send(unlock_pdu(kKey ^ 1), 1, "10.9.8.7", 11 * kSecond), 0x03);
+  EXPECT_NE(log_.back().find("refused for 20 s"), std::string::npos) << log_.back();
+  EXPECT_EQ(send(unlock_pdu(kKey), 1, "10.9.8.7", 30 * kSecond), 0x04);
+  EXPECT_EQ(send(unlock_pdu(kKey), 1, "10.9.8.7", 32 * kSecond), 0);
+}
+
+TEST(UnlockKey, SixteenHexDigitsThatAreNotTrivial) {
+  EXPECT_EQ(*parse_unlock_key("5e3a9c17d24b086f"), 0x5e3a9c17d24b086fu);
+  EXPECT_EQ(*parse_unlock_key("5E3A9C17D24B086F"), 0x5e3a9c17d24b086fu);
+  for (const char* bad : {"4321", "5e3a9c17d24b086", "5e3a9c17d24b086f0", "5e3a9c17d24b086g", "0000000000000000", "0123456789abcdef",
+                          "fedcba9876543210", "abababababababab", "1234123412341234", "1111111122222222"})
+    EXPECT_FALSE(parse_unlock_key(bad).has_value()) << bad;
 }
 
 TEST_F(Handler, TuningValuesThatDoNotValidateTogetherAreRefusedWhole) {
-  ASSERT_EQ(send({0x06, 0x00, 0x09, 0x10, 0xE1}), 0);
+  ASSERT_EQ(send(unlock_pdu(kKey)), 0);
   // b_l (26-27) = 2.0f > b_r = 1.232: the dead zone would be invalid.
   EXPECT_EQ(send({0x10, 0x00, 0x1A, 0x00, 0x02, 0x04, 0x40, 0x00, 0x00, 0x00}), 0x03);
   EXPECT_TRUE(drain().empty());
 }
 
 TEST_F(Handler, PolicyRefusalsAre04) {
-  make(WritePolicy{.read_only = true, .unlock_key = 0, .unlock_timeout_s = 10, .write_clients = {}});
+  make(WritePolicy{.read_only = true, .unlock_key = std::nullopt, .unlock_timeout_s = 10, .write_clients = {}});
   EXPECT_EQ(send({0x06, 0x00, 0x02, 0x00, 0x01}), 0x04);
-  make(WritePolicy{.read_only = false, .unlock_key = 0, .unlock_timeout_s = 10, .write_clients = {"10.0.0.5"}});
+  make(WritePolicy{.read_only = false, .unlock_key = std::nullopt, .unlock_timeout_s = 10, .write_clients = {"10.0.0.5"}});
   EXPECT_EQ(send({0x06, 0x00, 0x02, 0x00, 0x01}, 1, "127.0.0.1"), 0x04);
   EXPECT_EQ(send({0x06, 0x00, 0x02, 0x00, 0x01}, 1, "10.0.0.5"), 0);
-  EXPECT_EQ(send({0x06, 0x00, 0x09, 0x00, 0x00}, 1, "10.0.0.5"), 0x03);  // no key configured: never unlocks
+  EXPECT_EQ(send(unlock_pdu(kKey), 1, "10.0.0.5"), 0x03);  // no key configured: never unlocks
 }
 
 TEST_F(Handler, ModeDependentWritesAre04) {

@@ -23,9 +23,9 @@ import threading
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from epa_appliance import UNIT, UNLOCK_KEY, Appliance, f32_value, f32_words, u32_value  # noqa: E402
+from epa_appliance import UNIT, Appliance, unlock, f32_value, f32_words, u32_value  # noqa: E402
 
-M_R, SETPOINT, UNLOCK = 20, 0, 9             # holding registers (registers/epa.csv)
+M_R, SETPOINT = 20, 0                        # holding registers (registers/epa.csv)
 CHANGE_COUNTER, SAVED_COUNTER = 122, 128     # input registers, uint32 ABCD
 
 
@@ -45,7 +45,7 @@ def write_and_confirm(app, rng, confirmed, deadline):
     """Writes until the appliance dies or the deadline; appends (point, value) of every write that
     saved_counter reported on disk while the appliance was alive."""
     c = app.client
-    if c.write_register(UNLOCK, UNLOCK_KEY, slave=UNIT).isError():
+    if unlock(c).isError():
         raise RuntimeError("unlock refused")
     pending = []  # (change number, point, value) written, not yet reported saved
     while time.monotonic() < deadline:

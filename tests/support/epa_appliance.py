@@ -34,7 +34,19 @@ from pymodbus.pdu import ExceptionResponse
 
 HOST = "127.0.0.1"
 UNIT = 1
-UNLOCK_KEY = 4321
+UNLOCK_KEY = "5e3a9c17d24b086f"  # [modbus] unlock_key of the test appliances: 16 hex digits
+UNLOCK_ADDRESS = 9               # the `unlock` key64 of registers/epa.csv: holding 9-12
+
+
+def key_words(key=UNLOCK_KEY):
+    """The four registers of a key64, most significant first."""
+    v = int(key, 16)
+    return [(v >> s) & 0xFFFF for s in (48, 32, 16, 0)]
+
+
+def unlock(client, key=UNLOCK_KEY):
+    """Writes the key to `unlock` in one FC16; the pymodbus answer."""
+    return client.write_registers(UNLOCK_ADDRESS, key_words(key), slave=UNIT)
 
 
 # ---- float32 encoding with an explicit word order ----
@@ -103,7 +115,7 @@ class Appliance:
                     'address = "127.0.0.1"\n'
                     f"port = {self.port}\n"
                     f'register_map = "{register_map}"\n'
-                    f"unlock_key = {UNLOCK_KEY}\n"
+                    f'unlock_key = "{UNLOCK_KEY}"\n'
                     + modbus_extra + web +
                     "[log]\n"
                     "status_interval_s = 0\n"
