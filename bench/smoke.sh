@@ -41,6 +41,7 @@ smoke jitter_vs_cyclictest '^cyclictest wake-up +[0-9]' bench/jitter_vs_cyclicte
 smoke store_burst '^burst: 1000 Modbus writes' bench/store_burst.py 1 1
 smoke arx_vs_octave '^speed ratio octave / ours: [0-9.]+x' bench/arx_vs_octave.sh "$build" 2000 2
 smoke idle_memory '^VmRSS [0-9]+ kB' bench/idle_memory.sh 1
+smoke attack '^attack: every row held' bench/attack.sh 1
 smoke diagnose_bench '^epa diagnose, 9 runs x 20 s, all candidates: [0-9.]+ s wall' bench/diagnose_bench.sh "$build"
 
 # Not in the "N passed, N failed" form: the suite's count is ctest's, these are not tests.

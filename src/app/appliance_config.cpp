@@ -282,6 +282,8 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   web.text("address", c.web.address);
   web.integer("port", c.web.port, 0, 65535);
   web.text("token", c.web.token);
+  if (!c.web.token.empty() && c.web.token.size() < 16 && !error)
+    error = core::parse_error(file + ": web.token must be at least 16 characters (or \"\" for no commands): a short token is guessed");
   web.text("static_dir", c.web.static_dir);
   web.refuse_unknown_keys();
 

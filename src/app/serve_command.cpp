@@ -165,7 +165,9 @@ core::Result<std::unique_ptr<web::WebServer>> start_web(const ApplianceConfig& c
     const auto health = store.health();
     return web::StoreStats{true, health.ok, counters.accepted, counters.saved, health.last_error, set_name};
   };
-  auto server = web::WebServer::start(c.web, channels, &gate, &audit, modbus_stats, store_stats);
+  web::WebConfig config = c.web;
+  config.log = [](const std::string& line) { spdlog::warn("{}", line); };
+  auto server = web::WebServer::start(config, channels, &gate, &audit, modbus_stats, store_stats);
   if (!server) return server.error();
   spdlog::info("web: listening on {}:{} (static files {}, commands {})", c.web.address, (*server)->port(), c.web.static_dir,
                c.web.token.empty() ? "disabled: no token configured" : "enabled with the token");

@@ -7,7 +7,7 @@ namespace epa::modbus {
 
 core::Result<std::uint64_t> parse_unlock_key(std::string_view text) {
   auto refuse = [](const std::string& why) {
-    return core::invalid_argument("unlock_key " + why + ": give 16 random hex digits, e.g. from `od -An -tx8 -N8 /dev/urandom`");
+    return core::invalid_argument(why + ": give 16 random hex digits, e.g. from `od -An -tx8 -N8 /dev/urandom`");
   };
   if (text.size() != 16) return refuse("must be 16 hex digits, got " + std::to_string(text.size()) + " characters");
   std::uint64_t key = 0;

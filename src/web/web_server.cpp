@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <mutex>
 #include <thread>
+#include <unordered_map>
 
 #include "web/command_body.hpp"
 #include "web/prometheus.hpp"
@@ -39,6 +41,36 @@ void send_error(httplib::Response& res, int status, const std::string& message) 
   res.set_content(error_json(message), kJson);
 }
 
+// The request head a status page or an HMI sends is a few hundred bytes; these are generous.
+constexpr std::size_t kMaxHeaderFields = 64;
+constexpr std::size_t kMaxHeadBytes = 8192;
+// A client that sent a wrong token this many times is refused unseen (429) for a back-off that
+// starts at kFirstBackoff and doubles up to kMaxBackoff.
+constexpr int kFreeTokenTries = 5;
+constexpr auto kFirstBackoff = std::chrono::seconds(10);
+constexpr auto kMaxBackoff = std::chrono::seconds(300);
+constexpr std::size_t kMaxStaticFileBytes = 4 << 20;
+
+std::string content_type(const std::filesystem::path& file) {
+  const std::string ext = file.extension().string();
+  if (ext == ".html") return "text/html; charset=utf-8";
+  if (ext == ".js") return "text/javascript; charset=utf-8";
+  if (ext == ".css") return "text/css; charset=utf-8";
+  if (ext == ".svg") return "image/svg+xml";
+  if (ext == ".png") return "image/png";
+  if (ext == ".json") return "application/json";
+  if (ext == ".ico") return "image/x-icon";
+  return "application/octet-stream";
+}
+
+// Whether `file` (canonical) lies inside `root` (canonical).
+bool within(const std::filesystem::path& file, const std::filesystem::path& root) {
+  auto f = file.begin();
+  for (auto r = root.begin(); r != root.end(); ++r, ++f)
+    if (f == file.end() || *f != *r) return false;
+  return true;
+}
+
 }  // namespace
 
 struct WebServer::Impl {
@@ -60,6 +92,15 @@ struct WebServer::Impl {
   bool stopping = false;
   std::thread listener, sampler;
 
+  std::filesystem::path static_root;  // canonical static_dir
+  struct TokenFailures {
+    int wrong_in_row = 0;
+    std::chrono::steady_clock::time_point locked_until{};
+    std::chrono::seconds next_backoff = kFirstBackoff;
+  };
+  std::mutex token_mutex;
+  std::unordered_map<std::string, TokenFailures> token_failures;  // by client address, bounded
+
   Impl(const WebConfig& c, runtime::LoopChannels& ch, points::WriteGate* g, RecentAudit* a, ModbusStatsFn m, StoreStatsFn st)
       : config(c), channels(ch), gate(g), audit(a), modbus_stats(std::move(m)), store_stats(std::move(st)) {}
 
@@ -77,20 +118,57 @@ struct WebServer::Impl {
     }
   }
 
-  // The token rule: none configured -> commands are off (403); else the bearer token must match (401).
-  bool authorised(const httplib::Request& req, httplib::Response& res) const {
+  // The token rule: none configured -> commands are off (403); else the bearer token must match
+  // (401), and an address that sent kFreeTokenTries wrong tokens is refused unseen (429) for a
+  // back-off, so a token cannot be guessed at request speed.
+  bool authorised(const httplib::Request& req, httplib::Response& res) {
     if (config.token.empty()) {
       send_error(res, 403, "commands are disabled: configure [web] token to enable them");
       return false;
     }
-    const std::string header = req.get_header_value("Authorization");
-    const std::string prefix = "Bearer ";
-    if (header.compare(0, prefix.size(), prefix) != 0 || !constant_time_equal(header.substr(prefix.size()), config.token)) {
-      res.set_header("WWW-Authenticate", "Bearer");
-      send_error(res, 401, "missing or wrong token: send 'Authorization: Bearer <token>'");
+    const auto now = std::chrono::steady_clock::now();
+    std::unique_lock lock(token_mutex);
+    if (auto it = token_failures.find(req.remote_addr); it != token_failures.end() && now < it->second.locked_until) {
+      const auto wait = std::chrono::duration_cast<std::chrono::seconds>(it->second.locked_until - now).count() + 1;
+      res.set_header("Retry-After", std::to_string(wait));
+      send_error(res, 429, "too many wrong tokens from " + req.remote_addr + ": try again in " + std::to_string(wait) + " s");
       return false;
     }
-    return true;
+    const std::string header = req.get_header_value("Authorization");
+    const std::string prefix = "Bearer ";
+    if (header.compare(0, prefix.size(), prefix) == 0 && constant_time_equal(header.substr(prefix.size()), config.token)) {
+      token_failures.erase(req.remote_addr);
+      return true;
+    }
+    if (token_failures.size() >= 4096 && !token_failures.contains(req.remote_addr)) token_failures.clear();  // bounded
+    TokenFailures& f = token_failures[req.remote_addr];
+    if (++f.wrong_in_row >= kFreeTokenTries) {
+      f.locked_until = now + f.next_backoff;
+      if (config.log)
+        config.log("web: " + std::to_string(f.wrong_in_row) + " wrong tokens from " + req.remote_addr + ":" +
+                   std::to_string(req.remote_port) + ": its commands are refused for " + std::to_string(f.next_backoff.count()) + " s");
+      f.next_backoff = std::min(f.next_backoff * 2, std::chrono::seconds(kMaxBackoff));
+      f.wrong_in_row = kFreeTokenTries - 1;
+    }
+    lock.unlock();
+    res.set_header("WWW-Authenticate", "Bearer");
+    send_error(res, 401, "missing or wrong token: send 'Authorization: Bearer <token>'");
+    return false;
+  }
+
+  // The page's files: only regular files inside static_dir, after every symlink and ".." is
+  // resolved, so nothing outside it is ever served.
+  void serve_static(const httplib::Request& req, httplib::Response& res) {
+    std::string rel = req.path == "/" ? "index.html" : req.path.substr(1);
+    std::error_code ec;
+    const auto file = std::filesystem::weakly_canonical(static_root / rel, ec);
+    if (ec || !within(file, static_root) || !std::filesystem::is_regular_file(file, ec) ||
+        std::filesystem::file_size(file, ec) > kMaxStaticFileBytes)
+      return send_error(res, 404, "no such resource");
+    std::ifstream in(file, std::ios::binary);
+    std::stringstream body;
+    body << in.rdbuf();
+    res.set_content(body.str(), content_type(file));
   }
 
   // A command: the token, then the body read into point writes, then the write gate decides (and
@@ -108,9 +186,25 @@ struct WebServer::Impl {
 
   void routes() {
     auto& s = server;
-    s.set_pre_routing_handler([this](const httplib::Request&, httplib::Response& res) {
+    s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
       requests.fetch_add(1, std::memory_order_relaxed);
       res.set_header("Cache-Control", "no-store");
+      // Caps on the head, and a declared body over the cap refused before any of it is read.
+      std::size_t head_bytes = req.method.size() + req.target.size();
+      for (const auto& [k, v] : req.headers) head_bytes += k.size() + v.size() + 4;
+      if (req.headers.size() > kMaxHeaderFields || head_bytes > kMaxHeadBytes) {
+        res.set_header("Connection", "close");
+        send_error(res, 431, "request head too large (at most " + std::to_string(kMaxHeaderFields) + " fields, " +
+                                 std::to_string(kMaxHeadBytes) + " bytes)");
+        return httplib::Server::HandlerResponse::Handled;
+      }
+      const std::string length = req.get_header_value("Content-Length");
+      const bool digits = !length.empty() && length.find_first_not_of("0123456789") == std::string::npos;
+      if (digits && (length.size() > 18 || std::stoull(length) > config.max_body_bytes)) {
+        res.set_header("Connection", "close");
+        send_error(res, 413, "request body too large (at most " + std::to_string(config.max_body_bytes) + " bytes)");
+        return httplib::Server::HandlerResponse::Handled;
+      }
       return httplib::Server::HandlerResponse::Unhandled;
     });
     s.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
@@ -146,6 +240,7 @@ struct WebServer::Impl {
     s.Post("/api/mode", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kMode, q, r); });
     s.Post("/api/reset", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kReset, q, r); });
     s.Post("/api/points", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kPoints, q, r); });
+    s.Get(R"(/.*)", [this](const httplib::Request& q, httplib::Response& r) { serve_static(q, r); });  // last: the page
 
     // Every error leaves as JSON: httplib's own (404 no route, 413 payload too large, 400 bad request) included.
     s.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
@@ -179,6 +274,14 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
   auto impl = std::make_unique<Impl>(config, channels, gate, audit, std::move(modbus_stats), std::move(store_stats));
   if (!std::filesystem::is_directory(config.static_dir))
     return core::io_error("web: static_dir '" + config.static_dir + "' is not a folder (it holds index.html, app.js, style.css)");
+  impl->static_root = std::filesystem::canonical(config.static_dir);
+  for (const char* page_file : {"index.html", "app.js", "style.css"}) {
+    std::error_code ec;
+    const auto f = std::filesystem::weakly_canonical(impl->static_root / page_file, ec);
+    if (ec || !within(f, impl->static_root) || !std::filesystem::is_regular_file(f))
+      return core::io_error("web: static_dir '" + config.static_dir + "' does not hold the page's " + page_file +
+                            " (it must be the folder of web/: index.html, app.js, style.css)");
+  }
   {
     std::ifstream in(config.chart_js, std::ios::binary);
     std::stringstream ss;
@@ -192,8 +295,6 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
   s.set_write_timeout(5, 0);
   s.set_keep_alive_timeout(2);
   s.set_keep_alive_max_count(100);
-  if (!s.set_mount_point("/", config.static_dir))
-    return core::io_error("web: cannot serve static files from '" + config.static_dir + "'");
   impl->routes();
 
   if (config.port == 0) {

@@ -25,6 +25,7 @@ struct WebConfig {
   std::string chart_js = "/usr/share/javascript/chart.js/chart.min.js";  // Debian's libjs-chart.js
   int worker_threads = 64;           // connections served at once; an idle one holds a worker until it times out
   std::size_t max_body_bytes = 4096;
+  std::function<void(const std::string&)> log;  // token lock-outs; may be empty
 };
 
 class RecentAudit;

@@ -19,6 +19,7 @@
 #include <set>
 #include <sstream>
 #include <thread>
+#include <filesystem>
 
 #include "web/recent_audit.hpp"
 
@@ -388,6 +389,93 @@ TEST_F(WebServerTest, ServesThePageAndChartJs) {
   ASSERT_TRUE(chart);
   EXPECT_EQ(chart->status, 200);  // Debian's libjs-chart.js
   EXPECT_NE(chart->body.find("Chart.js"), std::string::npos);
+}
+
+// One raw HTTP exchange: what the server answers to `request` (first line), and how long it took.
+std::pair<std::string, std::chrono::milliseconds> raw_exchange(int port, const std::string& request) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  timeval tv{10, 0};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  const auto t0 = std::chrono::steady_clock::now();
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) return {"connect failed", {}};
+  for (std::size_t sent = 0; sent < request.size();) {
+    const auto n = ::send(fd, request.data() + sent, request.size() - sent, MSG_NOSIGNAL);
+    if (n <= 0) break;
+    sent += static_cast<std::size_t>(n);
+  }
+  char buf[256] = {};
+  const auto n = ::recv(fd, buf, sizeof buf - 1, 0);
+  const auto took = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - t0);
+  ::close(fd);
+  const std::string answer(buf, n > 0 ? static_cast<std::size_t>(n) : 0);
+  return {answer.substr(0, answer.find("\r\n")), took};
+}
+
+TEST_F(WebServerTest, OversizedHeadsAndDeclaredBodiesAreRefusedAtOnce) {
+  start("a-token-of-sixteen-chars");
+  std::string many = "GET /api/status HTTP/1.1\r\nHost: x\r\n";
+  for (int i = 0; i < 100; ++i) many += "X-Filler-" + std::to_string(i) + ": y\r\n";
+  EXPECT_EQ(raw_exchange(server_->port(), many + "\r\n").first, "HTTP/1.1 431 Request Header Fields Too Large");
+  std::string big = "GET /api/status HTTP/1.1\r\nHost: x\r\n";  // 40 fields of 300 bytes: 12 KB
+  for (int i = 0; i < 40; ++i) big += "X-Big-" + std::to_string(i) + ": " + std::string(300, 'a') + "\r\n";
+  EXPECT_EQ(raw_exchange(server_->port(), big + "\r\n").first, "HTTP/1.1 431 Request Header Fields Too Large");
+  const auto [answer, took] = raw_exchange(server_->port(), "POST /api/setpoint HTTP/1.1\r\nHost: x\r\nContent-Length: 1000000000000\r\n"
+                                                            "Content-Type: application/json\r\n\r\n{");
+  EXPECT_EQ(answer, "HTTP/1.1 413 Payload Too Large");
+  EXPECT_LT(took, std::chrono::milliseconds(1000));  // not after holding a worker for the read timeout
+  EXPECT_TRUE(queued().empty());
+}
+
+TEST_F(WebServerTest, WrongTokensFromAnAddressAreRefusedUnseenForABackOff) {
+  start("a-token-of-sixteen-chars");
+  for (int i = 1; i <= 5; ++i) {
+    auto r = post("/api/setpoint", R"({"setpoint_mm": 150})", "guess-" + std::to_string(i));
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->status, 401) << i;
+  }
+  auto locked = post("/api/setpoint", R"({"setpoint_mm": 150})", "a-token-of-sixteen-chars");  // right, but too late
+  ASSERT_TRUE(locked);
+  EXPECT_EQ(locked->status, 429);
+  EXPECT_FALSE(locked->get_header_value("Retry-After").empty());
+  EXPECT_TRUE(queued().empty());
+  EXPECT_EQ(get_json("/api/status")["mode"], "run");  // reading goes on
+}
+
+TEST(WebServerStatic, NothingOutsideStaticDirIsServedAndTheFolderMustHoldThePage) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("epa-web-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const char* f : {"index.html", "app.js", "style.css"}) fs::copy_file(fs::path(EPA_SOURCE_DIR) / "web" / f, dir / f);
+  fs::create_symlink("/etc/passwd", dir / "passwd");  // a link that leaves the folder
+  fs::create_directory_symlink("/etc", dir / "etc");
+  epa::runtime::LoopChannels channels{16};
+  epa::web::WebConfig config;
+  config.address = "127.0.0.1";
+  config.port = 0;
+  config.static_dir = dir.string();
+  auto server = epa::web::WebServer::start(config, channels, nullptr, nullptr);
+  ASSERT_TRUE(server.has_value()) << server.error().message;
+  httplib::Client c("127.0.0.1", (*server)->port());
+  for (const char* path : {"/passwd", "/etc/passwd", "/../../etc/passwd", "/%2e%2e/%2e%2e/etc/passwd"}) {
+    auto r = c.Get(path);
+    ASSERT_TRUE(r) << path;
+    EXPECT_EQ(r->status, 404) << path;
+    EXPECT_EQ(r->body.find("root:"), std::string::npos) << path;
+  }
+  auto page = c.Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  (*server)->stop();
+  config.static_dir = "/";  // a folder, but not the page's
+  auto root = epa::web::WebServer::start(config, channels, nullptr, nullptr);
+  ASSERT_FALSE(root.has_value());
+  EXPECT_NE(root.error().message.find("index.html"), std::string::npos) << root.error().message;
+  fs::remove_all(dir);
 }
 
 TEST_F(WebServerTest, FiftyIdleConnectionsDoNotStopANormalRequest) {
