@@ -13,6 +13,7 @@
 #include <unordered_map>
 
 #include "web/command_body.hpp"
+#include "web/elastic_task_queue.hpp"
 #include "web/prometheus.hpp"
 #include "web/recent_audit.hpp"
 #include "web/trend_buffer.hpp"
@@ -50,6 +51,7 @@ constexpr int kFreeTokenTries = 5;
 constexpr auto kFirstBackoff = std::chrono::seconds(10);
 constexpr auto kMaxBackoff = std::chrono::seconds(300);
 constexpr std::size_t kMaxStaticFileBytes = 4 << 20;
+constexpr std::size_t kIdleWorkers = 4;  // kept when nothing happens; more start per connection
 
 std::string content_type(const std::filesystem::path& file) {
   const std::string ext = file.extension().string();
@@ -289,7 +291,9 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
   }
   auto& s = impl->server;
   const int threads = config.worker_threads;
-  s.new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<std::size_t>(threads)); };
+  s.new_task_queue = [threads] {
+    return new ElasticTaskQueue(kIdleWorkers, static_cast<std::size_t>(threads), std::chrono::seconds(5));
+  };
   s.set_payload_max_length(config.max_body_bytes);
   s.set_read_timeout(5, 0);
   s.set_write_timeout(5, 0);

@@ -3,8 +3,9 @@
 // and Chart.js, and, when a token is configured, the commands (setpoint, mode, reset, and any
 // writable point through /api/points), each decided by the one write gate. It reads only
 // the published snapshot and keeps its own buffers (a sampler thread fills the 30 s trend), so it
-// cannot slow the scan cycle; a bounded worker pool, timeouts and a payload cap bound what a
-// crowd of clients can cost.
+// cannot slow the scan cycle; workers started per connection up to a cap (elastic_task_queue.hpp),
+// timeouts, caps on the request head and body, and a token back-off bound what a crowd of clients
+// can cost.
 #include <functional>
 #include <memory>
 #include <string>
@@ -23,7 +24,7 @@ struct WebConfig {
   std::string token;                 // "": commands refused (403); else "Authorization: Bearer <token>"
   std::string static_dir = "../web"; // index.html, app.js, style.css
   std::string chart_js = "/usr/share/javascript/chart.js/chart.min.js";  // Debian's libjs-chart.js
-  int worker_threads = 64;           // connections served at once; an idle one holds a worker until it times out
+  int worker_threads = 512;          // connections served at once (a worker each, started on demand)
   std::size_t max_body_bytes = 4096;
   std::function<void(const std::string&)> log;  // token lock-outs; may be empty
 };

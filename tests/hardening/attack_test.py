@@ -14,6 +14,12 @@ with a key and the shipped limits. Each row of issue 15's table that this releas
   bad config    idle_timeout_s = 1e300, unlock_timeout_s = 1e300, [recorder] buffer_s = 1e12, a
                 4-digit unlock key: `epa serve` refuses to start, naming file, line and key
   spreadsheet   the shipped register map saved with a byte-order mark and CRLF: it starts
+  slow HTTP     200 connections sending one header byte a second: /api/status answered within
+                1 s at least 95 % of the time
+  big heads     2,000 header lines, 1 MB of headers: refused (431); Content-Length 10^12:
+                413 at once
+  token guess   wrong tokens: after 5 the address gets 429 without a look at the token, the
+                log names it
 
     attack_test.py <epa binary> <source dir> [HOLD_SECONDS=8]
 
@@ -184,6 +190,81 @@ def poll_while_held(app, idle, slow, seconds):
     return served, total
 
 
+def http_raw(port, request, timeout=5.0):
+    """The status line of the answer to a raw request, and the seconds it took."""
+    t0 = time.monotonic()
+    with socket.create_connection((HOST, port), timeout=timeout) as s:
+        try:
+            s.sendall(request)
+        except OSError:
+            pass  # the server may close before it has read everything: what it answered counts
+        data = b""
+        try:
+            while b"\r\n" not in data:
+                chunk = s.recv(4096)
+                if not chunk:
+                    break
+                data += chunk
+        except OSError:
+            pass
+    return data.split(b"\r\n")[0].decode(errors="replace"), time.monotonic() - t0
+
+
+def slow_http(app, connections, seconds):
+    stop = threading.Event()
+    head = b"GET /api/status HTTP/1.1\r\nHost: x\r\nX-Slow: " + b"a" * 100 + b"\r\n\r\n"
+
+    def dribble():
+        while not stop.is_set():
+            try:
+                with socket.create_connection((HOST, app.web_port), timeout=2) as s:
+                    for i in range(len(head)):
+                        if stop.wait(1.0):
+                            return
+                        s.sendall(head[i:i + 1])
+            except OSError:
+                stop.wait(0.1)
+
+    threads = [threading.Thread(target=dribble, daemon=True) for _ in range(connections)]
+    for t in threads:
+        t.start()
+    time.sleep(2.0)
+    served = total = 0
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        total += 1
+        line, took = http_raw(app.web_port, b"GET /api/status HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n", timeout=2.0)
+        if line.startswith("HTTP/1.1 200") and took <= 1.0:
+            served += 1
+        time.sleep(0.1)
+    stop.set()
+    for t in threads:
+        t.join(timeout=3)
+    return served, total
+
+
+def http_rows(app, hold_s):
+    served, total = slow_http(app, 200, hold_s)
+    check(total > 0 and served >= 0.95 * total, f"200 slow HTTP connections: {served} of {total} /api/status answered within 1 s")
+    lines = b"GET /api/status HTTP/1.1\r\nHost: x\r\n" + b"".join(b"X-%d: y\r\n" % i for i in range(2000)) + b"\r\n"
+    line, _ = http_raw(app.web_port, lines)
+    check(line.startswith("HTTP/1.1 4"), f"2,000 header lines refused: {line}")
+    megabyte = b"GET /api/status HTTP/1.1\r\nHost: x\r\n" + b"".join(b"X-%d: %s\r\n" % (i, b"a" * 1000) for i in range(1000)) + b"\r\n"
+    line, _ = http_raw(app.web_port, megabyte)
+    check(line.startswith("HTTP/1.1 4"), f"1 MB of headers refused: {line}")
+    line, took = http_raw(app.web_port, b"POST /api/setpoint HTTP/1.1\r\nHost: x\r\nContent-Length: 1000000000000\r\n\r\n{")
+    check(line.startswith("HTTP/1.1 413") and took < 1.0, f"Content-Length 10^12: {line} after {took:.2f} s")
+    codes = []
+    for i in range(8):
+        body = b'{"setpoint_mm": 10}'
+        req = (b"POST /api/setpoint HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer guess-%d-xxxxxxxxxxxx\r\n"
+               b"Content-Type: application/json\r\nContent-Length: %d\r\nConnection: close\r\n\r\n%s" % (i, len(body), body))
+        codes.append(http_raw(app.web_port, req)[0][9:12])
+    check(codes[:5] == ["401"] * 5 and set(codes[5:]) == {"429"}, f"token guessing: 401 five times, then 429: {codes}")
+    time.sleep(0.2)
+    check("wrong tokens from 127.0.0.1" in app.log_text(), "the log names the guessing address")
+
+
 def refused_config(epa, src, tmp, edit, expect):
     """`epa serve` with the shipped configuration plus one edit: it must refuse to start."""
     base = open(os.path.join(src, "config", "epa.toml")).read()
@@ -205,7 +286,8 @@ def main():
     hold_s = float(sys.argv[3]) if len(sys.argv) == 4 else 8.0
     reg_map = os.path.join(src, "registers", "epa.csv")
 
-    app = Appliance(epa, reg_map, "", modbus_extra="max_clients = 16\n")
+    app = Appliance(epa, reg_map, "", modbus_extra="max_clients = 16\n", web_static_dir=os.path.join(src, "web"),
+                    web_extra='token = "a-token-for-the-attack-suite"\n')
     try:
         brute_force(app)
         unlock_scope(app)
@@ -213,6 +295,7 @@ def main():
         check(total > 0 and served >= 0.95 * total, f"16 idle + 16 slow connections: {served} of {total} polls served within 1 s")
         served, total = poll_while_held(app, idle=300, slow=0, seconds=min(hold_s, 5.0))
         check(total > 0 and served >= 0.95 * total, f"300 idle connections: {served} of {total} polls served within 1 s")
+        http_rows(app, hold_s)
         check(app.proc.poll() is None, "the appliance is still running")
     finally:
         app.stop()
@@ -221,7 +304,8 @@ def main():
                 (lambda t: t.replace("idle_timeout_s = 60.0", "idle_timeout_s = 1e300"), ["bad.toml:", "modbus.idle_timeout_s"]),
                 (lambda t: t.replace("unlock_timeout_s = 60.0", "unlock_timeout_s = 1e300"), ["modbus.unlock_timeout_s"]),
                 (lambda t: t.replace("buffer_s = 60.0", "buffer_s = 1e12"), ["recorder.buffer_s"]),
-                (lambda t: t.replace('unlock_key = ""', 'unlock_key = "4321"'), ["modbus.unlock_key", "16 hex digits"])):
+                (lambda t: t.replace('unlock_key = ""', 'unlock_key = "4321"'), ["modbus.unlock_key", "16 hex digits"]),
+                (lambda t: t.replace('token = ""', 'token = "1"'), ["web.token", "16 characters"])):
             refused_config(epa, src, tmp, edit, expect)
         app.remove()
 
