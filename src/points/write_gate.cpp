@@ -95,10 +95,16 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
     out.commands.push_back(runtime::tuning_command(*t));
     out.command_point.push_back(first_tuning_point);
   }
-  // 4. The scan cycle's own rules, in the state it last published.
-  for (std::size_t i = 0; i < out.commands.size(); ++i)
-    if (const auto r = runtime::check_command(out.commands[i], snap.mode, loop_rules_); r != runtime::CommandRefusal::kNone)
+  // 4. The scan cycle's own rules, in the state it last published, carried through the group in
+  // the order the loop applies it (mode MANUAL then a manual valve command is one valid group).
+  runtime::Mode mode = snap.mode;
+  for (std::size_t i = 0; i < out.commands.size(); ++i) {
+    const runtime::Command& c = out.commands[i];
+    if (const auto r = runtime::check_command(c, mode, loop_rules_); r != runtime::CommandRefusal::kNone)
       return refuse(gate_refusal(r), quoted(out.command_point[i]) + ": " + std::string(runtime::describe(r)));
+    if (c.kind == runtime::CommandKind::kMode) mode = c.mode;
+    if (c.kind == runtime::CommandKind::kReset && mode == runtime::Mode::kFault) mode = runtime::Mode::kStop;
+  }
   return {};
 }
 

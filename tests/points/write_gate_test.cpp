@@ -207,6 +207,7 @@ TEST(WriteGate, EveryWriteTheGateAcceptsIsAppliedByTheScanCycleInTheSameState) {
     // Groups as HMIs send them: mode and setpoint, a manual move, a whole dead zone.
     hold({{PointId::kMode, 1.0}, {PointId::kSetpoint, 250.0}}, mode);
     hold({{PointId::kMode, 2.0}, {PointId::kManualValve, 1.5}}, mode);
+    hold({{PointId::kReset, 1.0}, {PointId::kMode, 1.0}}, mode);  // a fault cleared and RUN asked in one write
     hold({{PointId::kMr, 2.0}, {PointId::kMl, 2.1}, {PointId::kBr, 1.3}, {PointId::kBl, -1.5}, {PointId::kLc, 4.0}}, mode);
   }
   // Neither side of the check is empty: the walk exercised both.
