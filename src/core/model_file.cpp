@@ -1,10 +1,12 @@
 #include "core/model_file.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <sstream>
 #include <toml++/toml.h>
 
 #include "core/atomic_file.hpp"
+#include "core/format.hpp"
 #include "core/text_file.hpp"
 #include "core/toml_number.hpp"
 
@@ -13,12 +15,18 @@ namespace epa::core {
 namespace {
 
 constexpr const char* kSchema = "epa-model/1";
+// Every number of a model file is bounded: nothing physical in it comes near, and 1e300 or NaN
+// would only overflow later (the model's own validation then checks each value's meaning).
+constexpr double kMaxMagnitude = 1e6;
 
 Result<double> number_at(const toml::table& t, const char* table_name, const char* key, const std::string& src) {
   const auto* node = t.get(key);
   const std::string where = src + ": " + (table_name[0] ? std::string("[") + table_name + "] " : std::string()) + key;
   if (!node) return parse_error(where + " is missing");
-  if (auto v = node->value<double>()) return *v;
+  if (auto v = node->value<double>()) {
+    if (std::isfinite(*v) && std::abs(*v) <= kMaxMagnitude) return *v;
+    return parse_error(where + " " + format_number(*v) + " is outside [-1e6, 1e6] (line " + std::to_string(node->source().begin.line) + ")");
+  }
   return parse_error(where + " must be a number");
 }
 
@@ -29,6 +37,9 @@ Result<Polynomial> array_at(const toml::table& t, const char* key, const std::st
   for (std::size_t i = 0; i < arr->size(); ++i) {
     auto v = arr->get(i)->value<double>();
     if (!v) return parse_error(src + ": [arx] " + key + "[" + std::to_string(i) + "] is not a number");
+    if (!std::isfinite(*v) || std::abs(*v) > kMaxMagnitude)
+      return parse_error(src + ": [arx] " + key + "[" + std::to_string(i) + "] " + format_number(*v) + " is outside [-1e6, 1e6] (line " +
+                         std::to_string(arr->get(i)->source().begin.line) + ")");
     c.push_back(*v);
   }
   return Polynomial(std::move(c));

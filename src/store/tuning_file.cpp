@@ -1,15 +1,20 @@
 #include "store/tuning_file.hpp"
 
+#include <cmath>
 #include <set>
 #include <sstream>
 #include <toml++/toml.h>
 
+#include "core/format.hpp"
 #include "core/model_file.hpp"
 #include "core/toml_number.hpp"
 
 namespace epa::store {
 
 namespace {
+
+// Every number of a tuning file is bounded (the set's own validation then checks each meaning).
+constexpr double kMaxMagnitude = 1e6;
 
 constexpr const char* kSchema = "epa-tuning/1";
 
@@ -29,7 +34,11 @@ core::Status only_keys(const toml::table& t, const std::set<std::string>& allowe
 core::Result<double> number(const toml::table& t, const char* key, const std::string& where) {
   const auto* node = t.get(key);
   if (!node) return core::parse_error(where + " " + key + " is missing");
-  if (auto v = node->value<double>()) return *v;
+  if (auto v = node->value<double>()) {
+    if (std::isfinite(*v) && std::abs(*v) <= kMaxMagnitude) return *v;
+    return core::parse_error(where + " " + key + " " + core::format_number(*v) + " is outside [-1e6, 1e6] (line " +
+                             std::to_string(node->source().begin.line) + ")");
+  }
   return core::parse_error(where + " " + key + " must be a number");
 }
 
@@ -40,6 +49,8 @@ core::Result<core::Polynomial> polynomial(const toml::table& t, const char* key,
   for (std::size_t i = 0; i < arr->size(); ++i) {
     auto v = arr->get(i)->value<double>();
     if (!v) return core::parse_error(where + " " + key + "[" + std::to_string(i) + "] is not a number");
+    if (!std::isfinite(*v) || std::abs(*v) > kMaxMagnitude)
+      return core::parse_error(where + " " + key + "[" + std::to_string(i) + "] " + core::format_number(*v) + " is outside [-1e6, 1e6]");
     c.push_back(*v);
   }
   return core::Polynomial(std::move(c));

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -82,6 +84,23 @@ TEST(ModelFile, ValidTextParsesToTheDocumentedFields) {
   EXPECT_EQ(file->model.Ts, 0.005);
   EXPECT_EQ(file->model.mm_per_volt, 50.0);
   EXPECT_EQ(file->source, "hand-written test model");
+}
+
+// Every number is bounded: 1e300, NaN and infinities are refused naming the key and its line.
+TEST(ModelFile, NumbersOutsideAnyPhysicalRangeAreRefusedNamingKeyAndLine) {
+  const std::string text(kValidText);
+  for (const auto& [from, to, expected] :
+       {std::tuple{"Ts = 0.005", "Ts = 1e300", "Ts 1e+300 is outside [-1e6, 1e6] (line "},
+        std::tuple{"Ts = 0.005", "Ts = nan", "Ts nan is outside"},
+        std::tuple{"-0.9094", "-inf", "A[1] -inf is outside"}}) {
+    std::string bad = text;
+    const auto at = bad.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    bad.replace(at, std::string(from).size(), to);
+    const auto r = parse_model_toml(bad, "m.toml");
+    ASSERT_FALSE(r.has_value()) << to;
+    EXPECT_NE(r.error().message.find(expected), std::string::npos) << r.error().message;
+  }
 }
 
 TEST(ModelFile, IntegerValuesAreAcceptedAsNumbers) {

@@ -73,6 +73,9 @@ TEST(TuningFile, BadFilesAreRefusedNamingWhatIsWrong) {
       {replaced(good, "[rst]\n", "[rst]\nX = [1.0]\n"), "[rst]: unknown key 'X'"},
       {replaced(good, "lc_mm = 5.0", "lc_mm = \"five\""), "lc_mm must be a number"},
       {replaced(good, "lc_mm = 5.0", "lc_mm = = 5"), "x.toml:"},
+      {replaced(good, "lc_mm = 5.0", "lc_mm = 1e300"), "lc_mm 1e+300 is outside [-1e6, 1e6]"},
+      {replaced(good, "lc_mm = 5.0", "lc_mm = nan"), "lc_mm nan is outside"},
+      {replaced(good, "b_l = -1.722", "b_l = -inf"), "b_l -inf is outside"},
       {good.substr(0, good.find("[model]")), "[model] is missing"},
   };
   for (const auto& c : cases) {
