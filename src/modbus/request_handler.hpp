@@ -9,7 +9,8 @@
 // 03 bad quantity, a value outside the limits (the catalog's, the configuration's and the map's),
 // a write that covers only part of a 32-bit value, a wrong unlock key, or tuning values that do
 // not validate together; 04 the write cannot be applied (server read-only, client not allowed to
-// write, tuning locked, wrong mode, fault latched); 06 the command queue is full (busy); 0B a
+// write, tuning locked, wrong mode, fault latched, an unlock from an address in its back-off);
+// 06 the command queue is full (busy); 0B a
 // request for another unit id.
 #include <cstdint>
 #include <functional>
