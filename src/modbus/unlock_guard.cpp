@@ -1,6 +1,5 @@
 #include "modbus/unlock_guard.hpp"
 
-#include <algorithm>
 #include <set>
 
 namespace epa::modbus {
@@ -42,31 +41,17 @@ UnlockGuard::Attempt UnlockGuard::attempt(const std::string& address, std::uint6
     ++failures_;
     return {Verdict::kNoKey};
   }
-  if (records_.size() >= kMaxAddresses && !records_.contains(address)) {
-    // Bounded: forget the address seen longest ago (a flood of spoofed sources cannot grow it).
-    auto oldest = std::min_element(records_.begin(), records_.end(),
-                                   [](const auto& a, const auto& b) { return a.second.last_seen_ns < b.second.last_seen_ns; });
-    records_.erase(oldest);
-  }
-  Record& r = records_[address];
-  r.last_seen_ns = now_ns;
-  if (now_ns < r.locked_until_ns) {
+  if (backoff_.locked_until(address, now_ns) != 0) {
     ++failures_;
-    return {Verdict::kLockedOut, false, 0, r.locked_until_ns};
+    return {Verdict::kLockedOut};
   }
   if (key == *key_) {
-    records_.erase(address);
+    backoff_.right(address);
     return {Verdict::kUnlocked};
   }
   ++failures_;
-  if (++r.wrong_in_row < kFreeAttempts) return {Verdict::kWrongKey};
-  // Locked out: from now on this address's attempts are refused unseen until the back-off ends;
-  // the next wrong key after it locks out again, twice as long.
-  Attempt a{Verdict::kWrongKey, true, r.next_backoff_ns, now_ns + r.next_backoff_ns};
-  r.locked_until_ns = a.locked_until_ns;
-  r.next_backoff_ns = std::min(r.next_backoff_ns * 2, kMaxBackoffNs);
-  r.wrong_in_row = kFreeAttempts - 1;
-  return a;
+  const auto lockout = backoff_.wrong(address, now_ns);
+  return {Verdict::kWrongKey, lockout.started, lockout.backoff_ns};
 }
 
 }  // namespace epa::modbus

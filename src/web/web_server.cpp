@@ -10,8 +10,9 @@
 #include <sstream>
 #include <mutex>
 #include <thread>
-#include <unordered_map>
 
+#include "core/address_backoff.hpp"
+#include "runtime/clock.hpp"
 #include "web/command_body.hpp"
 #include "web/elastic_task_queue.hpp"
 #include "web/prometheus.hpp"
@@ -45,11 +46,6 @@ void send_error(httplib::Response& res, int status, const std::string& message) 
 // The request head a status page or an HMI sends is a few hundred bytes; these are generous.
 constexpr std::size_t kMaxHeaderFields = 64;
 constexpr std::size_t kMaxHeadBytes = 8192;
-// A client that sent a wrong token this many times is refused unseen (429) for a back-off that
-// starts at kFirstBackoff and doubles up to kMaxBackoff.
-constexpr int kFreeTokenTries = 5;
-constexpr auto kFirstBackoff = std::chrono::seconds(10);
-constexpr auto kMaxBackoff = std::chrono::seconds(300);
 constexpr std::size_t kMaxStaticFileBytes = 4 << 20;
 constexpr std::size_t kIdleWorkers = 4;  // kept when nothing happens; more start per connection
 
@@ -95,13 +91,9 @@ struct WebServer::Impl {
   std::thread listener, sampler;
 
   std::filesystem::path static_root;  // canonical static_dir
-  struct TokenFailures {
-    int wrong_in_row = 0;
-    std::chrono::steady_clock::time_point locked_until{};
-    std::chrono::seconds next_backoff = kFirstBackoff;
-  };
   std::mutex token_mutex;
-  std::unordered_map<std::string, TokenFailures> token_failures;  // by client address, bounded
+  core::AddressBackoff token_guesses;  // by client address, under token_mutex
+  runtime::MonotonicClock clock;
 
   Impl(const WebConfig& c, runtime::LoopChannels& ch, points::WriteGate* g, RecentAudit* a, ModbusStatsFn m, StoreStatsFn st)
       : config(c), channels(ch), gate(g), audit(a), modbus_stats(std::move(m)), store_stats(std::move(st)) {}
@@ -121,38 +113,33 @@ struct WebServer::Impl {
   }
 
   // The token rule: none configured -> commands are off (403); else the bearer token must match
-  // (401), and an address that sent kFreeTokenTries wrong tokens is refused unseen (429) for a
-  // back-off, so a token cannot be guessed at request speed.
+  // (401), and an address that sent 5 wrong tokens is refused unseen (429) for a back-off
+  // (core::AddressBackoff), so a token cannot be guessed at request speed.
   bool authorised(const httplib::Request& req, httplib::Response& res) {
     if (config.token.empty()) {
       send_error(res, 403, "commands are disabled: configure [web] token to enable them");
       return false;
     }
-    const auto now = std::chrono::steady_clock::now();
+    const std::int64_t now_ns = clock.now_ns();
     std::unique_lock lock(token_mutex);
-    if (auto it = token_failures.find(req.remote_addr); it != token_failures.end() && now < it->second.locked_until) {
-      const auto wait = std::chrono::duration_cast<std::chrono::seconds>(it->second.locked_until - now).count() + 1;
-      res.set_header("Retry-After", std::to_string(wait));
-      send_error(res, 429, "too many wrong tokens from " + req.remote_addr + ": try again in " + std::to_string(wait) + " s");
+    if (const std::int64_t until_ns = token_guesses.locked_until(req.remote_addr, now_ns); until_ns != 0) {
+      const auto wait_s = std::to_string((until_ns - now_ns) / 1'000'000'000 + 1);
+      res.set_header("Retry-After", wait_s);
+      send_error(res, 429, "too many wrong tokens from " + req.remote_addr + ": try again in " + wait_s + " s");
       return false;
     }
     const std::string header = req.get_header_value("Authorization");
     const std::string prefix = "Bearer ";
     if (header.compare(0, prefix.size(), prefix) == 0 && constant_time_equal(header.substr(prefix.size()), config.token)) {
-      token_failures.erase(req.remote_addr);
+      token_guesses.right(req.remote_addr);
       return true;
     }
-    if (token_failures.size() >= 4096 && !token_failures.contains(req.remote_addr)) token_failures.clear();  // bounded
-    TokenFailures& f = token_failures[req.remote_addr];
-    if (++f.wrong_in_row >= kFreeTokenTries) {
-      f.locked_until = now + f.next_backoff;
-      if (config.log)
-        config.log("web: " + std::to_string(f.wrong_in_row) + " wrong tokens from " + req.remote_addr + ":" +
-                   std::to_string(req.remote_port) + ": its commands are refused for " + std::to_string(f.next_backoff.count()) + " s");
-      f.next_backoff = std::min(f.next_backoff * 2, std::chrono::seconds(kMaxBackoff));
-      f.wrong_in_row = kFreeTokenTries - 1;
-    }
+    const auto lockout = token_guesses.wrong(req.remote_addr, now_ns);
     lock.unlock();
+    if (lockout.started && config.log)
+      config.log("web: " + std::to_string(lockout.wrong_in_row) + " wrong tokens from " + req.remote_addr + ":" +
+                 std::to_string(req.remote_port) + ": its commands are refused for " +
+                 std::to_string(lockout.backoff_ns / 1'000'000'000) + " s");
     res.set_header("WWW-Authenticate", "Bearer");
     send_error(res, 401, "missing or wrong token: send 'Authorization: Bearer <token>'");
     return false;
