@@ -281,9 +281,11 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   web.boolean("enabled", c.web_enabled);
   web.text("address", c.web.address);
   web.integer("port", c.web.port, 0, 65535);
-  web.text("token", c.web.token);
-  if (!c.web.token.empty() && c.web.token.size() < 16 && !error)
-    error = core::parse_error(file + ": web.token must be at least 16 characters (or \"\" for no commands): a short token is guessed");
+  web.choice<std::string>("token", c.web.token, [](std::string_view v) -> core::Result<std::string> {
+    if (!v.empty() && v.size() < 16)
+      return core::invalid_argument("must be at least 16 characters (or \"\" for no commands): a short token is guessed");
+    return std::string(v);
+  });
   web.text("static_dir", c.web.static_dir);
   web.refuse_unknown_keys();
 

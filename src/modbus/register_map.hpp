@@ -73,17 +73,17 @@ class RegisterMap {
   std::array<std::vector<std::int32_t>, 4> index_;  // per table: address -> entry index, -1 unmapped
 };
 
-// Engineering value <-> register words (width() of them) or a bit. Integer types round and clamp
-// to their range; a NaN ("never reached") becomes the type's sentinel: int16 -32768, uint16 65535,
-// int32 INT32_MIN, uint32 UINT32_MAX (float32 carries the NaN itself).
 // The map's ranges narrow the one set of write limits (every interface's), and its defaults must
 // lie within them: a map that leaves a point no value, or whose default the configuration's limits
 // exclude, is refused with the file, line and reason.
 core::Status narrow_limits(const RegisterMap& map, points::WriteLimits& limits);
 
+// Engineering value <-> register words (width() of them) or a bit. Integer types round and clamp
+// to their range; a NaN ("never reached") becomes the type's sentinel: int16 -32768, uint16 65535,
+// int32 INT32_MIN, uint32 UINT32_MAX (float32 carries the NaN itself).
 void encode_value(const RegisterEntry& e, double value, std::uint16_t* words) noexcept;
+double decode_value(const RegisterEntry& e, const std::uint16_t* words) noexcept;
 // The 64-bit key of a key64's four words.
 std::uint64_t key_value(const std::uint16_t* words) noexcept;
-double decode_value(const RegisterEntry& e, const std::uint16_t* words) noexcept;
 
 }  // namespace epa::modbus

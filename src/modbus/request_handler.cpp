@@ -178,7 +178,7 @@ std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, Sess
   std::vector<points::PointWrite> group;
   bool unlock = false;
   for (const auto& w : writes) {
-    if (w.entry->point->access != points::Access::kKey) {
+    if (w.entry->point->gated()) {
       group.push_back({w.entry->point->id, w.value});
       continue;
     }

@@ -51,6 +51,7 @@ struct PointDef {
   int index = 0;            // for the coefficients: F3 reads F[3]
 
   bool writable() const { return access != Access::kRead; }
+  bool gated() const { return access == Access::kWrite || access == Access::kTuning; }  // written through the gate
   bool tuning() const { return access == Access::kTuning; }
   double value(const PointContext& c) const { return read(c, index); }
 };

@@ -49,7 +49,7 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
   for (const PointWrite& w : writes) {
     if (index(w.id) >= kPointCount) return refuse(Refusal::kNotWritable, "unknown point");
     const PointDef& p = point(w.id);
-    if (!p.writable() || p.access == Access::kKey) return refuse(Refusal::kNotWritable, quoted(w.id) + " is read-only");
+    if (!p.gated()) return refuse(Refusal::kNotWritable, quoted(w.id) + " is read-only");
     if (auto e = limits_.check(w.id, w.value); !e.empty()) return refuse(Refusal::kInvalidValue, e);
     if (p.integer && w.value != std::floor(w.value))
       return refuse(Refusal::kInvalidValue, quoted(w.id) + " takes whole numbers, not " + core::format_number(w.value));

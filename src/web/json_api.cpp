@@ -131,7 +131,7 @@ std::string points_json(const points::WriteLimits& limits) {
     static constexpr const char* kAccess[] = {"r", "rw", "rw after unlock", "key (Modbus only)"};
     json e = {{"name", std::string(p.name)}, {"unit", std::string(p.unit)}, {"access", kAccess[static_cast<int>(p.access)]},
               {"description", std::string(p.description)}};
-    if (p.writable() && p.access != points::Access::kKey) {
+    if (p.gated()) {
       const auto& r = limits.range(p.id);
       e["min"] = r.min.value;
       e["max"] = r.max.value;

@@ -44,7 +44,7 @@ const Requester kOperator{"test", true, "", /*tuning_unlocked=*/true};
 std::vector<const PointDef*> gated_points() {
   std::vector<const PointDef*> out;
   for (const auto& p : point_catalog())
-    if (p.writable() && p.access != Access::kKey) out.push_back(&p);
+    if (p.gated()) out.push_back(&p);
   return out;
 }
 
