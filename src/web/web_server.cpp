@@ -14,6 +14,7 @@
 #include "core/address_backoff.hpp"
 #include "runtime/clock.hpp"
 #include "web/command_body.hpp"
+#include "web/deadline_http_server.hpp"
 #include "web/elastic_task_queue.hpp"
 #include "web/prometheus.hpp"
 #include "web/recent_audit.hpp"
@@ -46,6 +47,7 @@ void send_error(httplib::Response& res, int status, const std::string& message) 
 // The request head a status page or an HMI sends is a few hundred bytes; these are generous.
 constexpr std::size_t kMaxHeaderFields = 64;
 constexpr std::size_t kMaxHeadBytes = 8192;
+constexpr std::size_t kMaxRequestBytes = 64 * 1024;  // beyond it a request is cut unread (431), not parsed
 constexpr std::size_t kMaxStaticFileBytes = 4 << 20;
 constexpr std::size_t kIdleWorkers = 4;  // kept when nothing happens; more start per connection
 
@@ -78,7 +80,7 @@ struct WebServer::Impl {
   RecentAudit* audit;
   ModbusStatsFn modbus_stats;
   StoreStatsFn store_stats;
-  httplib::Server server;
+  DeadlineHttpServer server;
   TrendBuffer trend;
   std::string chart_js;
   int port = 0;
@@ -96,7 +98,20 @@ struct WebServer::Impl {
   runtime::MonotonicClock clock;
 
   Impl(const WebConfig& c, runtime::LoopChannels& ch, points::WriteGate* g, RecentAudit* a, ModbusStatsFn m, StoreStatsFn st)
-      : config(c), channels(ch), gate(g), audit(a), modbus_stats(std::move(m)), store_stats(std::move(st)) {}
+      : config(c),
+        channels(ch),
+        gate(g),
+        audit(a),
+        modbus_stats(std::move(m)),
+        store_stats(std::move(st)),
+        server(request_limits(c)) {}
+
+  static RequestLimits request_limits(const WebConfig& c) {
+    RequestLimits limits;
+    limits.request_deadline = limits.read_timeout = std::chrono::milliseconds(c.request_deadline_ms);
+    limits.max_request_bytes = kMaxRequestBytes;
+    return limits;
+  }
 
   ModbusStats modbus() const { return modbus_stats ? modbus_stats() : ModbusStats{}; }
   StoreStats store() const { return store_stats ? store_stats() : StoreStats{}; }
@@ -281,11 +296,7 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
   s.new_task_queue = [threads] {
     return new ElasticTaskQueue(kIdleWorkers, static_cast<std::size_t>(threads), std::chrono::seconds(5));
   };
-  s.set_payload_max_length(config.max_body_bytes);
-  s.set_read_timeout(5, 0);
-  s.set_write_timeout(5, 0);
-  s.set_keep_alive_timeout(2);
-  s.set_keep_alive_max_count(100);
+  s.set_payload_max_length(config.max_body_bytes);  // timeouts and keep-alive: RequestLimits
   impl->routes();
 
   if (config.port == 0) {

@@ -4,8 +4,8 @@
 // writable point through /api/points), each decided by the one write gate. It reads only
 // the published snapshot and keeps its own buffers (a sampler thread fills the 30 s trend), so it
 // cannot slow the scan cycle; workers started per connection up to a cap (elastic_task_queue.hpp),
-// timeouts, caps on the request head and body, and a token back-off bound what a crowd of clients
-// can cost.
+// a deadline per request (deadline_http_server.hpp), caps on the request head and body, and a token
+// back-off bound what a crowd of clients can cost.
 #include <functional>
 #include <memory>
 #include <string>
@@ -26,6 +26,7 @@ struct WebConfig {
   std::string chart_js = "/usr/share/javascript/chart.js/chart.min.js";  // Debian's libjs-chart.js
   int worker_threads = 512;          // connections served at once (a worker each, started on demand)
   std::size_t max_body_bytes = 4096;
+  int request_deadline_ms = 2000;    // a request's head and body arrive within this of its first byte, or 408
   std::function<void(const std::string&)> log;  // token lock-outs; may be empty
 };
 

@@ -16,6 +16,8 @@ with a key and the shipped limits. Each row of issue 15's table that this releas
   spreadsheet   the shipped register map saved with a byte-order mark and CRLF: it starts
   slow HTTP     200 connections sending one header byte a second: /api/status answered within
                 1 s at least 95 % of the time
+  head deadline a request head sent a byte every 0.3 s: answered 408 and closed about 2 s after
+                its first byte (each byte resets httplib's own read timeout; this is ours)
   big heads     2,000 header lines, 1 MB of headers: refused (431); Content-Length 10^12:
                 413 at once
   token guess   wrong tokens: after 5 the address gets 429 without a look at the token, the
@@ -29,6 +31,7 @@ Loopback only, every loop bounded; the appliances are stopped by their PID. Exit
 holds, 1 otherwise (each failure says what was expected and what came back).
 """
 import os
+import select
 import socket
 import struct
 import subprocess
@@ -243,9 +246,38 @@ def slow_http(app, connections, seconds):
     return served, total
 
 
+def dribbled_head(port):
+    """Sends a request head a byte every 0.3 s until the server answers or closes: its status line
+    and the seconds from the first byte to the end of the connection."""
+    head = b"GET /api/status HTTP/1.1\r\nHost: x\r\nX-Slow: " + b"a" * 200 + b"\r\n\r\n"
+    with socket.create_connection((HOST, port), timeout=10) as s:
+        t0 = time.monotonic()
+        data = b""
+        for i in range(len(head)):  # 75 s at most: the deadline must end it long before
+            try:
+                s.sendall(head[i:i + 1])
+            except OSError:
+                break
+            r, _, _ = select.select([s], [], [], 0.3)
+            if r:
+                break
+        try:
+            while True:
+                chunk = s.recv(4096)
+                if not chunk:
+                    break
+                data += chunk
+        except OSError:
+            pass
+        return data.split(b"\r\n")[0].decode(errors="replace"), time.monotonic() - t0
+
+
 def http_rows(app, hold_s):
     served, total = slow_http(app, 200, hold_s)
     check(total > 0 and served >= 0.95 * total, f"200 slow HTTP connections: {served} of {total} /api/status answered within 1 s")
+    line, took = dribbled_head(app.web_port)
+    check(line.startswith("HTTP/1.1 408") and 1.5 <= took <= 3.5,
+          f"a head dribbled a byte every 0.3 s: 408 and closed 2 s after its first byte: {line!r} after {took:.1f} s")
     lines = b"GET /api/status HTTP/1.1\r\nHost: x\r\n" + b"".join(b"X-%d: y\r\n" % i for i in range(2000)) + b"\r\n"
     line, _ = http_raw(app.web_port, lines)
     check(line.startswith("HTTP/1.1 4"), f"2,000 header lines refused: {line}")

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <httplib.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -68,6 +69,7 @@ class WebServerTest : public ::testing::Test {
     config.port = 0;
     config.token = token;
     config.static_dir = std::string(EPA_SOURCE_DIR) + "/web";
+    config.request_deadline_ms = request_deadline_ms_;
     auto limits = epa::points::WriteLimits::from_config(limits_, "test.toml");
     ASSERT_TRUE(limits.has_value()) << limits.error().message;
     gate_ = std::make_unique<epa::points::WriteGate>(std::move(*limits), limits_,
@@ -102,6 +104,7 @@ class WebServerTest : public ::testing::Test {
     return out;
   }
 
+  int request_deadline_ms_ = 2000;
   epa::runtime::LoopChannels channels_{16};
   epa::runtime::RuntimeConfig limits_;  // setpoint range [0, 500] mm
   epa::runtime::Snapshot snap_;
@@ -502,6 +505,85 @@ TEST_F(WebServerTest, FiftyIdleConnectionsDoNotStopANormalRequest) {
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 200);
   EXPECT_LT(took, 200ms);
+}
+
+// A connected loopback socket to the server, with a 10 s receive timeout; -1 on failure.
+int connect_to(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  timeval tv{10, 0};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// Everything the server sends until it closes the connection (or 10 s pass).
+std::string read_to_close(int fd) {
+  std::string all;
+  char buf[4096];
+  for (ssize_t n; (n = ::recv(fd, buf, sizeof buf, 0)) > 0;) all.append(buf, static_cast<std::size_t>(n));
+  return all;
+}
+
+std::size_t count_of(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+TEST_F(WebServerTest, PipelinedRequestsOnOneConnectionAreEachAnswered) {
+  start();
+  const int fd = connect_to(server_->port());
+  ASSERT_GE(fd, 0);
+  const std::string get = "GET /api/status HTTP/1.1\r\nHost: x\r\n\r\n";
+  const std::string last = "GET /api/points HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n";
+  const std::string three = get + get + last;  // in one segment: the second and third wait in the buffer
+  ASSERT_EQ(::send(fd, three.data(), three.size(), MSG_NOSIGNAL), static_cast<ssize_t>(three.size()));
+  const std::string answers = read_to_close(fd);
+  ::close(fd);
+  EXPECT_EQ(count_of(answers, "HTTP/1.1 200 OK"), 3u) << answers.substr(0, 300);
+  EXPECT_EQ(count_of(answers, "\"mode\":\"run\""), 2u);
+}
+
+TEST_F(WebServerTest, ARequestNotCompleteWithinItsDeadlineIs408AndClosed) {
+  request_deadline_ms_ = 400;
+  start();
+  const int fd = connect_to(server_->port());
+  ASSERT_GE(fd, 0);
+  const std::string head = "GET /api/status HTTP/1.1\r\nHost: x\r\nX-Slow: aaaaaaaaaaaaaaaaaaaa\r\n\r\n";
+  const auto t0 = std::chrono::steady_clock::now();
+  std::size_t sent = 0;
+  for (; sent < head.size(); ++sent) {  // a byte every 50 ms: each one in time for a per-read timeout
+    if (::send(fd, head.data() + sent, 1, MSG_NOSIGNAL) != 1) break;
+    pollfd p{fd, POLLIN, 0};
+    if (::poll(&p, 1, 50) > 0) break;  // answered (or closed) before the head was complete
+  }
+  const std::string answer = read_to_close(fd);
+  const auto took = std::chrono::steady_clock::now() - t0;
+  ::close(fd);
+  EXPECT_LT(sent, head.size());
+  EXPECT_EQ(answer.substr(0, answer.find("\r\n")), "HTTP/1.1 408 Request Timeout");
+  EXPECT_NE(answer.find("deadline"), std::string::npos) << answer;
+  EXPECT_GE(took, 350ms);
+  EXPECT_LT(took, 1500ms);
+  EXPECT_EQ(get_json("/api/status")["mode"], "run");  // the others are served as before
+}
+
+TEST_F(WebServerTest, ARequestFarBeyondTheHeadCapIsCutUnreadWith431) {
+  start();
+  const int fd = connect_to(server_->port());
+  ASSERT_GE(fd, 0);
+  std::string huge = "GET /api/status HTTP/1.1\r\nHost: x\r\nX-Huge: " + std::string(200 * 1024, 'a') + "\r\n\r\n";
+  (void)::send(fd, huge.data(), huge.size(), MSG_NOSIGNAL);  // the server may close before it has all
+  const std::string answer = read_to_close(fd);
+  ::close(fd);
+  EXPECT_EQ(answer.substr(0, answer.find("\r\n")), "HTTP/1.1 431 Request Header Fields Too Large");
 }
 
 }  // namespace
