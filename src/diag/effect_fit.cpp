@@ -69,6 +69,11 @@ double local_fit(Objective& obj, const std::vector<Slot>& slots, const FitOption
       }
       if (any) starts.push_back(x);
     }
+  // And everything at its neutral value: a re-fit gone astray (a gain pushed to where it absorbs
+  // an unmodelled effect) must not be every start's starting point.
+  std::vector<double> all_neutral(n);
+  for (std::size_t i = 0; i < n; ++i) all_neutral[i] = slots[i].to_unit(slots[i].spec.neutral);
+  if (all_neutral != neutral) starts.push_back(all_neutral);
   double best = std::numeric_limits<double>::infinity();
   std::vector<double> best_x = neutral;
   for (auto x : starts) {

@@ -12,10 +12,19 @@
 //     chance_threshold.hpp), re-fitting on top of what is accepted; at most max_effects.
 //     input_delay and valve_lag explain much the same; when the runner-up comes within
 //     confusable_ratio of the winner's reduction, the pair is reported as confusable.
-//  5. gain_change and deadzone_shift are named when their parameters, fitted with the accepted
-//     effects, lie beyond tolerances calibrated on effect-free data from slightly perturbed models.
-//  6. Unexplained: a held-out gap left above unexplained_factor times the noise floor (the gap
-//     that sensor noise alone gives a perfect model, estimated from the runs at rest).
+//  5. Pairs: the best pair_pool first-round candidates fitted two at a time, jointly; a pair
+//     replaces the forward set when it leaves a smaller gap and each of its effects beats its own
+//     chance threshold on top of the other (two effects that each explain little alone).
+//  6. The accepted set re-fitted jointly from the nominal model, then a backward check: an effect
+//     stays only while removing it (the rest re-fitted) costs more than its chance threshold.
+//  7. gain_change and deadzone_shift are named when their parameters, fitted with the accepted
+//     effects, lie beyond tolerances calibrated on effect-free data from slightly perturbed models
+//     and holding them nominal costs more than their chance threshold of the baseline gap (a
+//     parameter that only absorbs the residue of an effect's imperfect form is not a finding).
+//  8. Unexplained: a held-out gap left above unexplained_factor times the noise floor (the gap
+//     that sensor noise alone gives a perfect model, estimated from the runs at rest) and, when
+//     effects are named, above unexplained_share of the baseline gap: a rig's effect never has
+//     the library's exact form, and the residue of the named effects' forms is theirs.
 // Without held-out runs, folds leave one training run out each (cross-validation by run).
 #include <functional>
 #include <string>
@@ -36,6 +45,8 @@ struct DiagnosisOptions {
   double threshold_scale = 1.0;    // multiplies every chance threshold
   double confusable_ratio = 0.85;
   double unexplained_factor = 1.6;
+  double unexplained_share = 1.0 / 3.0;  // with effects named: a gap left above this share of the baseline
+  std::size_t pair_pool = 4;             // the best first-round candidates tried in pairs
   double refit_threshold_pct = 5.0;  // the re-fit must beat this reduction for gain/break points to be named
   double gain_tolerance = 0.06;      // |gain_ratio - 1| beyond this names gain_change
   double shift_tolerance_V = 0.06;   // a break point moved beyond this names deadzone_shift

@@ -26,8 +26,15 @@ constexpr ParamSpec kFriction[] = {
     {"breakaway_V", 0.0, 2.0, 0.0, false, "drive u_d needed to start from rest (stiction)"},
     {"coulomb_V", 0.0, 2.0, 0.0, false, "drive u_d lost while moving; below it the piston sticks"}};
 constexpr ParamSpec kSaturation[] = {{"ceiling_mm_s", 20.0, 5000.0, 5000.0, false, "largest piston speed (choked flow)"}};
+// A family, not one form: a gain that changes along the stroke the same way in both directions
+// (slope), one that falls as the driving chamber lengthens (air compressibility: extending, the
+// cap-side chamber grows with the position; retracting, the rod side grows as it falls), and one
+// that differs between mid-stroke and the ends (curvature, zero mean over the stroke).
 constexpr ParamSpec kPosition[] = {
-    {"slope_per_100mm", -0.8, 0.8, 0.0, false, "relative gain change per 100 mm from mid-stroke (250 mm)"}};
+    {"slope_per_100mm", -0.8, 0.8, 0.0, false, "relative gain change per 100 mm from mid-stroke (250 mm), both directions"},
+    {"chamber_slope_per_100mm", -0.8, 0.8, 0.0, false,
+     "relative gain fall per 100 mm the driving chamber is longer than at mid-stroke", true},
+    {"curvature", -0.8, 0.8, 0.0, false, "relative gain at the ends over mid-stroke, (x/250 mm - 1)^2 - 1/3 shaped", true}};
 constexpr ParamSpec kQuantization[] = {{"step_mm", 0.0, 10.0, 0.0, false, "position sensor resolution"}};
 
 constexpr double kMidStrokeMm = 250.0;
@@ -134,7 +141,11 @@ DriveEffects::DriveEffects(const EffectSet& e, const core::DeadZone& nominal, do
     breakaway_ = std::max(e.param(EffectKind::kStaticFriction, 0), coulomb_);  // stiction is never below Coulomb
   }
   if (e.on(EffectKind::kGainChange)) gain_ = e.param(EffectKind::kGainChange, 0);
-  if (e.on(EffectKind::kPositionDependentGain)) slope_per_mm_ = e.param(EffectKind::kPositionDependentGain, 0) / 100.0;
+  if (e.on(EffectKind::kPositionDependentGain)) {
+    slope_per_mm_ = e.param(EffectKind::kPositionDependentGain, 0) / 100.0;
+    chamber_per_mm_ = e.param(EffectKind::kPositionDependentGain, 1) / 100.0;
+    curvature_ = e.param(EffectKind::kPositionDependentGain, 2);
+  }
   if (e.on(EffectKind::kFlowSaturation) && speed_mm_s_per_V > 0.0)
     max_drive_ = e.param(EffectKind::kFlowSaturation, 0) / speed_mm_s_per_V;
 }
@@ -158,7 +169,13 @@ double DriveEffects::drive_before_position(double spool_v) noexcept {
 
 double DriveEffects::finish(double drive, double position_mm) const noexcept {
   double d = drive;
-  if (slope_per_mm_ != 0.0) d *= std::max(kMinPositionFactor, 1.0 + slope_per_mm_ * (position_mm - kMidStrokeMm));
+  if (slope_per_mm_ != 0.0 || chamber_per_mm_ != 0.0 || curvature_ != 0.0) {
+    const double from_mid_mm = position_mm - kMidStrokeMm, xi = from_mid_mm / kMidStrokeMm;
+    // Extending (d > 0) the driving chamber is longer the further out; retracting, the nearer in.
+    const double chamber_longer_mm = d >= 0.0 ? from_mid_mm : -from_mid_mm;
+    d *= std::max(kMinPositionFactor, 1.0 + slope_per_mm_ * from_mid_mm - chamber_per_mm_ * chamber_longer_mm +
+                                          curvature_ * (xi * xi - 1.0 / 3.0));
+  }
   if (max_drive_ > 0.0) d = std::clamp(d, -max_drive_, max_drive_);
   return d;
 }
@@ -196,6 +213,7 @@ core::Result<EffectSet> parse_effect_specs(const std::vector<std::string>& specs
       if (comma == std::string::npos) break;
       start = comma + 1;
     }
+    while (values.size() < params.size() && params[values.size()].optional) values.push_back(params[values.size()].neutral);
     if (values.size() != params.size()) {
       std::string names;
       for (const auto& p : params) names += (names.empty() ? "" : ",") + std::string(p.name);

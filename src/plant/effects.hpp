@@ -29,7 +29,7 @@ enum class EffectKind {
   kValveLag,               // tau_s: first-order spool dynamics
   kStaticFriction,         // breakaway_V, coulomb_V: stiction and Coulomb friction (stick-slip)
   kFlowSaturation,         // ceiling_mm_s: choked flow, a velocity ceiling
-  kPositionDependentGain,  // slope_per_100mm: gain changes along the stroke (air compressibility)
+  kPositionDependentGain,  // slope_per_100mm, chamber_slope_per_100mm, curvature: gain along the stroke
   kSensorQuantization,     // step_mm: a coarse position sensor
 };
 inline constexpr std::size_t kEffectCount = 8;
@@ -51,6 +51,7 @@ struct ParamSpec {
   double neutral;
   bool integer = false;    // fitted on a grid of integers (delay)
   std::string_view meaning;
+  bool optional = false;   // may be left out of a spec: neutral then
 };
 std::span<const ParamSpec> param_specs(EffectKind kind);
 
@@ -79,7 +80,8 @@ class EffectSet {
 };
 
 // Effects from text, as the simulators' options give them: "valve_lag=0.02",
-// "static_friction=0.6,0.3" (the parameters in param_specs order, all of them). Validated; the
+// "static_friction=0.6,0.3" (the parameters in param_specs order; optional ones left out at the
+// end are neutral, so "position_dependent_gain=0.2" is the slope alone). Validated; the
 // error names the spec and what is wrong.
 core::Result<EffectSet> parse_effect_specs(const std::vector<std::string>& specs);
 
@@ -129,7 +131,8 @@ class DriveEffects {
   core::DeadZone dead_zone_;
   bool friction_ = false;
   double breakaway_ = 0, coulomb_ = 0;
-  double gain_ = 1.0, slope_per_mm_ = 0.0, max_drive_ = 0.0;  // max_drive_ 0: no ceiling
+  double gain_ = 1.0, max_drive_ = 0.0;  // max_drive_ 0: no ceiling
+  double slope_per_mm_ = 0.0, chamber_per_mm_ = 0.0, curvature_ = 0.0;  // position_dependent_gain
   State state_;
 };
 
