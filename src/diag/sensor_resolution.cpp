@@ -16,6 +16,20 @@ std::optional<double> reading_resolution_mm(const std::vector<const core::Run*>&
       if (d > 1e-9 && (step == 0.0 || d < step)) step = d;
     }
   if (step <= 0.0) return std::nullopt;
+  // The smallest change carries the rounding of the file's decimals (a 10-bit sensor's 0.48876 mm
+  // written as 0.4888 or 0.4887); far from the origin that error adds up to more than the
+  // tolerance, so the step is refined by least squares over the levels the readings sit on.
+  for (int pass = 0; pass < 2; ++pass) {
+    double num = 0.0, den = 0.0;
+    for (const auto* r : runs) {
+      if (r->y_mm.empty()) continue;
+      for (double y : r->y_mm) {
+        const double n = std::round((y - r->y_mm.front()) / step);
+        num += n * (y - r->y_mm.front()), den += n * n;
+      }
+    }
+    if (den > 0.0) step = num / den;
+  }
   std::size_t on_grid = 0, total = 0;
   std::set<long long> levels;
   for (const auto* r : runs) {

@@ -28,4 +28,18 @@ TEST(SensorResolution, AQuantisedSensorsStepIsFoundAndAContinuousOneHasNone) {
   EXPECT_FALSE(epa::diag::reading_resolution_mm({&coarse, &fine}).has_value());  // every run must lie on it
 }
 
+TEST(SensorResolution, AStepWrittenWithFewDecimalsIsFoundOverTheWholeStroke) {
+  // A 10-bit sensor over 500 mm (0.48876 mm) in a file of 4 decimals, readings across 400 mm:
+  // the smallest change is 0.4887 or 0.4888, whose error adds up to a fifth of a step out there.
+  const double step = 500.0 / 1023;
+  epa::core::Run r;
+  for (int k = 0; k < 2000; ++k) {
+    const double y = std::round(std::round((50.0 + 0.2 * k) / step) * step * 1e4) / 1e4;
+    r.t_s.push_back(0.005 * k), r.y_mm.push_back(y), r.u_V.push_back(0.0);
+  }
+  const auto found = epa::diag::reading_resolution_mm({&r});
+  ASSERT_TRUE(found.has_value());
+  EXPECT_NEAR(*found, step, 1e-5);
+}
+
 }  // namespace

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# The blind test of `epa diagnose` (tests/diag/blind/): rigs whose effects are written from
+# physics in forms the diagnosis does not fit, 6 training + 3 held-out runs each, scored as the
+# withheld benchmark scores (issue 18). Prints every case, the confusion matrix and the score line.
+#
+#   bench/diagnose_blind.sh [SEEDS=2] [BUILD_DIR=build/release]     (38 cases per seed)
+#   bench/diagnose_blind.sh fast                                    (11 cases: one per phenomenon)
+#
+# Exit 0 when it ran; the thresholds of issue 18 are reported on the "blind check" line.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+arg=${1:-2}
+build=${2:-build/release}
+cmake --build "$build" --target epa >/dev/null
+if [ "$arg" = fast ]; then
+  set -- --fast
+else
+  [[ $arg =~ ^[0-9]+$ ]] || { echo "usage: $0 [SEEDS|fast] [BUILD_DIR]" >&2; exit 1; }
+  set -- --seeds "$arg"
+fi
+/usr/bin/python3 tests/diag/blind/blind_diagnosis.py "$build/src/app/epa" "$@" --check || true
