@@ -14,6 +14,14 @@ std::size_t first_window_start(const core::HammersteinModel& model) {
 
 namespace {
 
+// Where the piston was at sample k by the measurements (plant::kWherePositions; before the run's
+// start, its first reading).
+double measured_where_mm(const core::Run& run, std::size_t k) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < plant::kWherePositions; ++i) sum += run.y_mm[k >= i ? k - i : 0];
+  return sum / static_cast<double>(plant::kWherePositions);
+}
+
 // Calls on_prediction(k, predicted_mm, error_mm) for every prediction.
 template <typename OnPrediction>
 void replay(const ReplayModel& m, const core::Run& run, std::size_t horizon, OnPrediction&& on_prediction) {
@@ -39,11 +47,14 @@ void replay(const ReplayModel& m, const core::Run& run, std::size_t horizon, OnP
 
   std::array<double, core::kMaxModelOrder + 1> y{}, ud{};  // y(k), y(k-1), ...; u_d(k), u_d(k-1), ...
   for (std::size_t k0 = start; k0 + 1 < n; k0 += horizon) {
-    for (std::size_t i = 0; i < na && i <= k0; ++i) y[i] = run.y_mm[k0 - i] / mpv;
-    for (std::size_t i = 1; i < nb && i <= k0; ++i) ud[i] = drive.finish(pre[k0 - i], run.y_mm[k0 - i]);
+    // y holds the measured past (kWherePositions of it, for where the piston is), then the model's.
+    for (std::size_t i = 0; i < std::max(na, plant::kWherePositions); ++i) y[i] = run.y_mm[k0 >= i ? k0 - i : 0] / mpv;
+    for (std::size_t i = 1; i < nb && i <= k0; ++i) ud[i] = drive.finish(pre[k0 - i], measured_where_mm(run, k0 - i));
     const std::size_t end = std::min(n - 1, k0 + horizon);
     for (std::size_t k = k0; k < end; ++k) {
-      ud[0] = drive.finish(pre[k], y[0] * mpv);
+      double where_mm = 0.0;
+      for (std::size_t i = 0; i < plant::kWherePositions; ++i) where_mm += y[i];
+      ud[0] = drive.finish(pre[k], where_mm / static_cast<double>(plant::kWherePositions) * mpv);
       double next = 0.0;
       for (std::size_t i = 1; i <= na; ++i) next -= a[i] * y[i - 1];
       for (std::size_t i = 1; i <= nb; ++i) next += b[i] * ud[i - 1];

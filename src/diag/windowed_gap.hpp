@@ -7,7 +7,8 @@
 //
 // Effects that depend on the command history alone (delay, lag, dead zone, friction, gain,
 // ceiling) are computed over the whole run, so they carry their state across restarts as the real
-// valve would; position_dependent_gain reads the model's own position inside a window;
+// valve would; position_dependent_gain reads where the piston is (plant::kWherePositions: the
+// measured positions, then the model's own inside a window);
 // sensor_quantization rounds the prediction as the sensor would round the truth.
 #include <cstddef>
 #include <span>

@@ -31,7 +31,7 @@ core::Result<AugmentedPlant> AugmentedPlant::make(const core::HammersteinModel& 
 
 void AugmentedPlant::step(double valve_v) noexcept {
   const double spool_v = valve_.apply(std::isfinite(valve_v) ? valve_v : 0.0);
-  arx_.step(drive_.apply(spool_v, arx_.position_mm()));
+  arx_.step(drive_.apply(spool_v, arx_.mean_position_mm(kWherePositions)));
   sample_sensor();
 }
 

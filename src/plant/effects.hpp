@@ -136,6 +136,11 @@ class DriveEffects {
   State state_;
 };
 
+// Where the piston is, for position_dependent_gain: the mean of the last kWherePositions
+// positions. Not the last one alone: the printed B swings the position by tens of mm at the
+// Nyquist frequency with every change of the drive, and a gain fed from that swing feeds on itself.
+inline constexpr std::size_t kWherePositions = 6;
+
 // sensor_quantization: the reading rounded to the sensor's step (identity for step 0).
 double quantize_mm(double position_mm, double step_mm) noexcept;
 

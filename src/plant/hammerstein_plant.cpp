@@ -53,4 +53,11 @@ void HammersteinPlant::sample_sensor() noexcept {
   state_.measured_v = state_.y_past[0] + (noise_std_v_ > 0.0 ? noise_std_v_ * state_.rng.normal() : 0.0);
 }
 
+double HammersteinPlant::mean_position_mm(std::size_t samples) const {
+  const std::size_t n = std::clamp<std::size_t>(samples, 1, state_.y_past.size());
+  double sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i) sum += state_.y_past[i];
+  return sum / static_cast<double>(n) * mm_per_volt_;
+}
+
 }  // namespace epa::plant

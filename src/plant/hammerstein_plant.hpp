@@ -35,6 +35,8 @@ class HammersteinPlant {
   double measured_mm() const { return state_.measured_v * mm_per_volt_; }
   double position_v() const { return state_.y_past[0]; }         // true position at k, V
   double position_mm() const { return state_.y_past[0] * mm_per_volt_; }
+  // The mean of the last `samples` positions (at most kMaxModelOrder), mm.
+  double mean_position_mm(std::size_t samples) const;
 
   // Applies valve command u(k) (V; non-finite is taken as 0 V, the centred valve) and advances.
   void step(double valve_v) noexcept;
