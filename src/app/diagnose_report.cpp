@@ -5,6 +5,7 @@
 
 #include <cstdio>
 
+#include "app/effect_shapes.hpp"
 #include "app/svg_chart.hpp"
 
 namespace epa::app {
@@ -55,6 +56,10 @@ std::string render_diagnosis_html(const diag::GapReport& r) {
     u.series.push_back({"u", "#2ca02c", r.trace_t_s, r.trace_u_V, false});
     u.bands.push_back({d.nominal.model.dead_zone.b_l, d.nominal.model.dead_zone.b_r, "dead band"});
     h += inline_svg(render_svg("Recorded vs nominal vs augmented model", {p, u}, 1, 1100, 320));
+  }
+  if (const auto shapes = effect_shape_panels(d); !shapes.empty()) {
+    h += "<h2>What was fitted: the named effects' shapes</h2>\n";
+    h += inline_svg(render_svg("Fitted shapes, in physical units", shapes, 2, 540, 280));
   }
   // Share of the gap against share of the time as two bars per regime: a regime whose red bar
   // outgrows its grey one is where the model is wrong.

@@ -1,0 +1,105 @@
+#include "app/effect_shapes.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "plant/effects.hpp"
+
+namespace epa::app {
+
+namespace {
+
+using plant::EffectKind;
+
+// The final model's effect `kind` alone, on the nominal dead zone.
+plant::EffectSet only(const diag::Diagnosis& d, EffectKind kind) {
+  plant::EffectSet e;
+  e.set(kind, d.final_model.effects.params(kind));
+  return e;
+}
+
+double speed_per_V(const core::HammersteinModel& m) {
+  return plant::steady_speed_mm_s_per_V(m.A.coefficients(), m.B.coefficients(), m.Ts, m.mm_per_volt);
+}
+
+Panel position_gain(const diag::Diagnosis& d) {
+  const auto& m = d.nominal.model;
+  plant::DriveEffects drive(only(d, EffectKind::kPositionDependentGain), core::DeadZone{}, speed_per_V(m));
+  Panel p{"position_dependent_gain: gain along the stroke", "position (mm)", "gain / nominal", {}, {}, {}, {}, {}, {}};
+  Series out{"extending", "#1f77b4", {}, {}, false}, in{"retracting", "#d62728", {}, {}, true};
+  for (double x = 0.0; x <= d.final_model.stroke_mm + 1e-9; x += d.final_model.stroke_mm / 100.0) {
+    out.x.push_back(x), out.y.push_back(drive.finish(1.0, x));
+    in.x.push_back(x), in.y.push_back(-drive.finish(-1.0, x));
+  }
+  p.series = {out, in};
+  p.y_min = 0.0;
+  return p;
+}
+
+// Drive in -> drive out of the friction form, from rest (breakaway) and while moving (Coulomb).
+Panel friction(const diag::Diagnosis& d) {
+  Panel p{"static_friction: drive left by friction", "drive u_d (V)", "drive after friction (V)", {}, {}, {}, {}, {}, {}};
+  Series from_rest{"from rest", "#d62728", {}, {}, false}, moving{"while moving", "#1f77b4", {}, {}, true};
+  const auto effects = only(d, EffectKind::kStaticFriction);
+  const core::DeadZone identity{};
+  for (double u = -3.0; u <= 3.0 + 1e-9; u += 0.02) {
+    plant::DriveEffects rest(effects, identity, 0.0), move(effects, identity, 0.0);
+    move.set_state({.stuck = false});
+    from_rest.x.push_back(u), from_rest.y.push_back(rest.drive_before_position(u));
+    moving.x.push_back(u), moving.y.push_back(move.drive_before_position(u));
+  }
+  p.series = {from_rest, moving};
+  return p;
+}
+
+// The valve command's unit step as the spool sees it (delay and lag).
+Panel spool_step(const diag::Diagnosis& d) {
+  const double Ts = d.nominal.model.Ts;
+  plant::EffectSet e;
+  for (auto k : {EffectKind::kInputDelay, EffectKind::kValveLag})
+    if (d.final_model.effects.on(k)) e.set(k, d.final_model.effects.params(k));
+  plant::ValveEffects valve(e, Ts);
+  Panel p{"input_delay / valve_lag: the spool's answer to a 1 V step", "time (ms)", "spool (V)", {}, {}, {}, {}, {}, {}};
+  Series command{"command", "#9e9e9e", {}, {}, true}, spool{"spool", "#1f77b4", {}, {}, false};
+  for (int k = 0; k < 60; ++k) {
+    const double t_ms = 1000.0 * Ts * k;
+    command.x.push_back(t_ms), command.y.push_back(1.0);
+    spool.x.push_back(t_ms), spool.y.push_back(valve.apply(1.0));
+  }
+  p.series = {command, spool};
+  return p;
+}
+
+// Piston speed against the valve command, nominal and fitted: gain, break points and ceiling.
+Panel speed_map(const diag::Diagnosis& d) {
+  const auto& m = d.nominal.model;
+  const double speed = speed_per_V(m);
+  plant::EffectSet fitted;
+  for (auto k : {EffectKind::kGainChange, EffectKind::kDeadzoneShift, EffectKind::kFlowSaturation})
+    if (d.final_model.effects.on(k)) fitted.set(k, d.final_model.effects.params(k));
+  plant::DriveEffects nominal(plant::EffectSet{}, m.dead_zone, speed), with(fitted, m.dead_zone, speed);
+  Panel p{"gain_change / deadzone_shift / flow_saturation: steady speed", "valve command (V)", "piston speed (mm/s)", {}, {}, {}, {}, {}, {}};
+  Series a{"nominal", "#9e9e9e", {}, {}, true}, b{"fitted", "#1f77b4", {}, {}, false};
+  for (double u = -5.0; u <= 5.0 + 1e-9; u += 0.05) {
+    a.x.push_back(u), a.y.push_back(speed * nominal.finish(nominal.drive_before_position(u), 250.0));
+    b.x.push_back(u), b.y.push_back(speed * with.finish(with.drive_before_position(u), 250.0));
+  }
+  p.series = {a, b};
+  return p;
+}
+
+bool named(const diag::Diagnosis& d, EffectKind k) { return std::find(d.effects.begin(), d.effects.end(), k) != d.effects.end(); }
+
+}  // namespace
+
+std::vector<Panel> effect_shape_panels(const diag::Diagnosis& d) {
+  std::vector<Panel> panels;
+  if (named(d, EffectKind::kPositionDependentGain)) panels.push_back(position_gain(d));
+  if (named(d, EffectKind::kStaticFriction)) panels.push_back(friction(d));
+  if (named(d, EffectKind::kInputDelay) || named(d, EffectKind::kValveLag)) panels.push_back(spool_step(d));
+  if (named(d, EffectKind::kGainChange) || named(d, EffectKind::kDeadzoneShift) || named(d, EffectKind::kFlowSaturation))
+    panels.push_back(speed_map(d));
+  return panels;
+}
+
+}  // namespace epa::app
