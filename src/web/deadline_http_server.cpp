@@ -72,7 +72,11 @@ class DeadlineSocketStream final : public httplib::Stream {
 
   ssize_t read(char* ptr, std::size_t size) override {
     if (cut_ != Cut::kNone) return -1;
-    if (answering_) answering_ = false, request_bytes_ = 0, started_ = false;  // a new request on this connection
+    if (answering_) {  // a new request on this connection: its clock starts with its first byte
+      answering_ = false, request_bytes_ = 0;
+      started_ = pos_ < end_;  // pipelined: that byte is already here
+      if (started_) deadline_ = Clock::now() + limits_.request_deadline;
+    }
     if (pos_ == end_) {
       const ssize_t got = fill();
       if (got <= 0) return got;
