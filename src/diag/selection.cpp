@@ -200,8 +200,8 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
       for (std::size_t j = i + 1; j < firsts.size(); ++j)
         pairs.emplace_back(firsts[i].kind, firsts[j].kind);  // partners too: a line delay with a lag is both
     std::vector<std::future<Trial>> futures;
-    for (const auto& [a, b] : pairs)
-      futures.push_back(std::async(std::launch::async, [&, a, b] {
+    for (const auto& pair : pairs)
+      futures.push_back(std::async(std::launch::async, [&, a = pair.first, b = pair.second] {
         return trial(nominal_models, with_nominal({a, b}), folds, train, all_is_fold0, fo);
       }));
     auto alone_gap = [&](EffectKind k) {
