@@ -201,16 +201,22 @@ def http_raw(port, request, timeout=5.0):
             s.sendall(request)
         except OSError:
             pass  # the server may close before it has read everything: what it answered counts
-        data = b""
-        try:
-            while b"\r\n" not in data:
-                chunk = s.recv(4096)
-                if not chunk:
-                    break
-                data += chunk
-        except OSError:
-            pass
-    return data.split(b"\r\n")[0].decode(errors="replace"), time.monotonic() - t0
+        line = status_line(s)
+    return line, time.monotonic() - t0
+
+
+def status_line(s, until_closed=False):
+    """The first line of what the server sends on `s` (reading on to its close if asked)."""
+    data = b""
+    try:
+        while until_closed or b"\r\n" not in data:
+            chunk = s.recv(4096)
+            if not chunk:
+                break
+            data += chunk
+    except OSError:
+        pass
+    return data.split(b"\r\n")[0].decode(errors="replace")
 
 
 def slow_http(app, connections, seconds):
@@ -252,7 +258,6 @@ def dribbled_head(port):
     head = b"GET /api/status HTTP/1.1\r\nHost: x\r\nX-Slow: " + b"a" * 200 + b"\r\n\r\n"
     with socket.create_connection((HOST, port), timeout=10) as s:
         t0 = time.monotonic()
-        data = b""
         for i in range(len(head)):  # 75 s at most: the deadline must end it long before
             try:
                 s.sendall(head[i:i + 1])
@@ -261,15 +266,8 @@ def dribbled_head(port):
             r, _, _ = select.select([s], [], [], 0.3)
             if r:
                 break
-        try:
-            while True:
-                chunk = s.recv(4096)
-                if not chunk:
-                    break
-                data += chunk
-        except OSError:
-            pass
-        return data.split(b"\r\n")[0].decode(errors="replace"), time.monotonic() - t0
+        line = status_line(s, until_closed=True)
+        return line, time.monotonic() - t0
 
 
 def http_rows(app, hold_s):

@@ -394,8 +394,8 @@ TEST_F(WebServerTest, ServesThePageAndChartJs) {
   EXPECT_NE(chart->body.find("Chart.js"), std::string::npos);
 }
 
-// One raw HTTP exchange: what the server answers to `request` (first line), and how long it took.
-std::pair<std::string, std::chrono::milliseconds> raw_exchange(int port, const std::string& request) {
+// A connected loopback socket to the server, with a 10 s receive timeout; -1 on failure.
+int connect_to(int port) {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
@@ -403,8 +403,18 @@ std::pair<std::string, std::chrono::milliseconds> raw_exchange(int port, const s
   addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   timeval tv{10, 0};
   setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// One raw HTTP exchange: what the server answers to `request` (first line), and how long it took.
+std::pair<std::string, std::chrono::milliseconds> raw_exchange(int port, const std::string& request) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) return {"connect failed", {}};
+  const int fd = connect_to(port);
+  if (fd < 0) return {"connect failed", {}};
   for (std::size_t sent = 0; sent < request.size();) {
     const auto n = ::send(fd, request.data() + sent, request.size() - sent, MSG_NOSIGNAL);
     if (n <= 0) break;
@@ -505,22 +515,6 @@ TEST_F(WebServerTest, FiftyIdleConnectionsDoNotStopANormalRequest) {
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 200);
   EXPECT_LT(took, 200ms);
-}
-
-// A connected loopback socket to the server, with a 10 s receive timeout; -1 on failure.
-int connect_to(int port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<std::uint16_t>(port));
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  timeval tv{10, 0};
-  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
-    ::close(fd);
-    return -1;
-  }
-  return fd;
 }
 
 // Everything the server sends until it closes the connection (or 10 s pass).
