@@ -115,33 +115,29 @@ class DeadlineSocketStream final : public httplib::Stream {
     if (poll_for(fd_, POLLOUT, limits_.write_timeout)) (void)::send(fd_, all.data(), all.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
   }
 
-  void get_remote_ip_and_port(std::string& ip, int& port) const override {
-    sockaddr_storage a{};
-    socklen_t len = sizeof a;
-    ip.clear(), port = 0;
-    if (::getpeername(fd_, reinterpret_cast<sockaddr*>(&a), &len) == 0) ip = address_text(a, port);
-  }
-  void get_local_ip_and_port(std::string& ip, int& port) const override {
-    sockaddr_storage a{};
-    socklen_t len = sizeof a;
-    ip.clear(), port = 0;
-    if (::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len) == 0) ip = address_text(a, port);
-  }
+  void get_remote_ip_and_port(std::string& ip, int& port) const override { endpoint(::getpeername, ip, port); }
+  void get_local_ip_and_port(std::string& ip, int& port) const override { endpoint(::getsockname, ip, port); }
   socket_t socket() const override { return fd_; }
 
  private:
+  // The address and port getpeername or getsockname gives for the socket.
+  void endpoint(int (*get)(int, sockaddr*, socklen_t*), std::string& ip, int& port) const {
+    sockaddr_storage a{};
+    socklen_t len = sizeof a;
+    ip.clear(), port = 0;
+    if (get(fd_, reinterpret_cast<sockaddr*>(&a), &len) == 0) ip = address_text(a, port);
+  }
+
   // Reads what the socket has into the empty buffer: >0 bytes, 0 at the peer's end, -1 on a
   // timeout, a cut or an error.
   ssize_t fill() {
-    auto wait = limits_.read_timeout;
-    if (started_) {
+    if (started_) {  // every wait inside a request ends at its deadline
       const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline_ - Clock::now());
-      if (left < wait) wait = left;
-      if (wait.count() <= 0 || !poll_for(fd_, POLLIN, wait)) {
-        cut_ = left <= wait ? Cut::kDeadline : Cut::kNone;
+      if (left.count() <= 0 || !poll_for(fd_, POLLIN, left)) {
+        cut_ = Cut::kDeadline;
         return -1;
       }
-    } else if (!poll_for(fd_, POLLIN, wait)) {
+    } else if (!poll_for(fd_, POLLIN, limits_.read_timeout)) {
       return -1;
     }
     for (;;) {

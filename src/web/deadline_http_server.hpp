@@ -14,7 +14,7 @@ namespace epa::web {
 
 struct RequestLimits {
   std::chrono::milliseconds request_deadline{2000};    // first byte of a request -> its last byte
-  std::chrono::milliseconds read_timeout{2000};        // between two reads of one request
+  std::chrono::milliseconds read_timeout{2000};        // for a read outside a request (is_readable)
   std::chrono::milliseconds write_timeout{5000};       // per write of the answer
   std::chrono::milliseconds keep_alive_timeout{2000};  // a kept-alive connection waits this long for the next request
   std::size_t keep_alive_max_requests = 100;

@@ -108,7 +108,7 @@ struct WebServer::Impl {
 
   static RequestLimits request_limits(const WebConfig& c) {
     RequestLimits limits;
-    limits.request_deadline = limits.read_timeout = std::chrono::milliseconds(c.request_deadline_ms);
+    limits.request_deadline = std::chrono::milliseconds(c.request_deadline_ms);
     limits.max_request_bytes = kMaxRequestBytes;
     return limits;
   }
