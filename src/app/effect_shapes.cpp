@@ -1,6 +1,7 @@
 #include "app/effect_shapes.hpp"
 
 #include <algorithm>
+#include <initializer_list>
 #include <string>
 
 #include "plant/effects.hpp"
@@ -11,20 +12,16 @@ namespace {
 
 using plant::EffectKind;
 
-// The final model's effect `kind` alone, on the nominal dead zone.
-plant::EffectSet only(const diag::Diagnosis& d, EffectKind kind) {
+// The final model's effects of these kinds (those it has), without the others.
+plant::EffectSet fitted(const diag::Diagnosis& d, std::initializer_list<EffectKind> kinds) {
   plant::EffectSet e;
-  e.set(kind, d.final_model.effects.params(kind));
+  for (auto k : kinds)
+    if (d.final_model.effects.on(k)) e.set(k, d.final_model.effects.params(k));
   return e;
 }
 
-double speed_per_V(const core::HammersteinModel& m) {
-  return plant::steady_speed_mm_s_per_V(m.A.coefficients(), m.B.coefficients(), m.Ts, m.mm_per_volt);
-}
-
 Panel position_gain(const diag::Diagnosis& d) {
-  const auto& m = d.nominal.model;
-  plant::DriveEffects drive(only(d, EffectKind::kPositionDependentGain), core::DeadZone{}, speed_per_V(m));
+  plant::DriveEffects drive(fitted(d, {EffectKind::kPositionDependentGain}), core::DeadZone{}, 0.0);
   Panel p{"position_dependent_gain: gain along the stroke", "position (mm)", "gain / nominal", {}, {}, {}, {}, {}, {}};
   Series out{"extending", "#1f77b4", {}, {}, false}, in{"retracting", "#d62728", {}, {}, true};
   for (double x = 0.0; x <= d.final_model.stroke_mm + 1e-9; x += d.final_model.stroke_mm / 100.0) {
@@ -40,7 +37,7 @@ Panel position_gain(const diag::Diagnosis& d) {
 Panel friction(const diag::Diagnosis& d) {
   Panel p{"static_friction: drive left by friction", "drive u_d (V)", "drive after friction (V)", {}, {}, {}, {}, {}, {}};
   Series from_rest{"from rest", "#d62728", {}, {}, false}, moving{"while moving", "#1f77b4", {}, {}, true};
-  const auto effects = only(d, EffectKind::kStaticFriction);
+  const auto effects = fitted(d, {EffectKind::kStaticFriction});
   const core::DeadZone identity{};
   for (double u = -3.0; u <= 3.0 + 1e-9; u += 0.02) {
     plant::DriveEffects rest(effects, identity, 0.0), move(effects, identity, 0.0);
@@ -55,10 +52,7 @@ Panel friction(const diag::Diagnosis& d) {
 // The valve command's unit step as the spool sees it (delay and lag).
 Panel spool_step(const diag::Diagnosis& d) {
   const double Ts = d.nominal.model.Ts;
-  plant::EffectSet e;
-  for (auto k : {EffectKind::kInputDelay, EffectKind::kValveLag})
-    if (d.final_model.effects.on(k)) e.set(k, d.final_model.effects.params(k));
-  plant::ValveEffects valve(e, Ts);
+  plant::ValveEffects valve(fitted(d, {EffectKind::kInputDelay, EffectKind::kValveLag}), Ts);
   Panel p{"input_delay / valve_lag: the spool's answer to a 1 V step", "time (ms)", "spool (V)", {}, {}, {}, {}, {}, {}};
   Series command{"command", "#9e9e9e", {}, {}, true}, spool{"spool", "#1f77b4", {}, {}, false};
   for (int k = 0; k < 60; ++k) {
@@ -73,11 +67,9 @@ Panel spool_step(const diag::Diagnosis& d) {
 // Piston speed against the valve command, nominal and fitted: gain, break points and ceiling.
 Panel speed_map(const diag::Diagnosis& d) {
   const auto& m = d.nominal.model;
-  const double speed = speed_per_V(m);
-  plant::EffectSet fitted;
-  for (auto k : {EffectKind::kGainChange, EffectKind::kDeadzoneShift, EffectKind::kFlowSaturation})
-    if (d.final_model.effects.on(k)) fitted.set(k, d.final_model.effects.params(k));
-  plant::DriveEffects nominal(plant::EffectSet{}, m.dead_zone, speed), with(fitted, m.dead_zone, speed);
+  const double speed = plant::steady_speed_mm_s_per_V(m.A.coefficients(), m.B.coefficients(), m.Ts, m.mm_per_volt);
+  plant::DriveEffects nominal(plant::EffectSet{}, m.dead_zone, speed),
+      with(fitted(d, {EffectKind::kGainChange, EffectKind::kDeadzoneShift, EffectKind::kFlowSaturation}), m.dead_zone, speed);
   Panel p{"gain_change / deadzone_shift / flow_saturation: steady speed", "valve command (V)", "piston speed (mm/s)", {}, {}, {}, {}, {}, {}};
   Series a{"nominal", "#9e9e9e", {}, {}, true}, b{"fitted", "#1f77b4", {}, {}, false};
   for (double u = -5.0; u <= 5.0 + 1e-9; u += 0.05) {

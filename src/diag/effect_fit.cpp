@@ -143,21 +143,21 @@ EffectFit fit_effects(const ReplayModel& base, std::span<const EffectKind> kinds
       (specs[i].integer || kind == EffectKind::kSensorQuantization ? grid : continuous).push_back(s);
     }
   }
-  auto grid_then_local = [&](Objective& o_obj) {
+  auto grid_then_local = [&](Objective& fit) {
     double gap = std::numeric_limits<double>::infinity();
     for (const auto& s : grid) {
       if (s.spec.integer) {
         std::vector<double> values;
         for (double v = s.spec.lo; v <= s.spec.hi; v += 1.0) values.push_back(v);
-        gap = grid_fit(o_obj, s, values);
+        gap = grid_fit(fit, s, values);
       } else {
-        gap = grid_fit(o_obj, s, quantization_grid(0.02, s.spec.hi, 60, true));
-        const double coarse = o_obj.model.effects.params(s.kind)[s.i];
-        if (coarse > 0.0) gap = grid_fit(o_obj, s, quantization_grid(coarse / 1.12, std::min(s.spec.hi, coarse * 1.12), 15, false));
+        gap = grid_fit(fit, s, quantization_grid(0.02, s.spec.hi, 60, true));
+        const double coarse = fit.model.effects.params(s.kind)[s.i];
+        if (coarse > 0.0) gap = grid_fit(fit, s, quantization_grid(coarse / 1.12, std::min(s.spec.hi, coarse * 1.12), 15, false));
       }
     }
-    if (!continuous.empty()) gap = local_fit(o_obj, continuous, o);
-    return std::isfinite(gap) ? gap : o_obj.gap();
+    if (!continuous.empty()) gap = local_fit(fit, continuous, o);
+    return std::isfinite(gap) ? gap : fit.gap();
   };
   double gap = grid_then_local(obj);
   // A grid value is chosen with the other parameters where they stand; when those were fitted
@@ -165,7 +165,7 @@ EffectFit fit_effects(const ReplayModel& base, std::span<const EffectKind> kinds
   // their neutral values, and the better fit stays.
   bool fitted_elsewhere = false;
   for (const auto& s : continuous)
-    fitted_elsewhere = fitted_elsewhere || (!s.fresh && base.effects.on(s.kind) && base.effects.params(s.kind)[s.i] != s.spec.neutral);
+    fitted_elsewhere = fitted_elsewhere || (!s.fresh && base.effects.params(s.kind)[s.i] != s.spec.neutral);
   if (!grid.empty() && fitted_elsewhere) {
     Objective from_neutral{obj.model, runs, o.horizon};
     for (const auto& s : continuous) put(from_neutral.model, s, s.spec.neutral);

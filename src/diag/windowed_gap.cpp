@@ -45,16 +45,21 @@ void replay(const ReplayModel& m, const core::Run& run, std::size_t horizon, OnP
   pre.resize(n);
   for (std::size_t k = 0; k < n; ++k) pre[k] = drive.drive_before_position(valve.apply(run.u_V[k]));
 
+  const bool reads_position = drive.reads_position();  // else the replay need not know where the piston is
   std::array<double, core::kMaxModelOrder + 1> y{}, ud{};  // y(k), y(k-1), ...; u_d(k), u_d(k-1), ...
   for (std::size_t k0 = start; k0 + 1 < n; k0 += horizon) {
     // y holds the measured past (kWherePositions of it, for where the piston is), then the model's.
     for (std::size_t i = 0; i < std::max(na, plant::kWherePositions); ++i) y[i] = run.y_mm[k0 >= i ? k0 - i : 0] / mpv;
-    for (std::size_t i = 1; i < nb && i <= k0; ++i) ud[i] = drive.finish(pre[k0 - i], measured_where_mm(run, k0 - i));
+    for (std::size_t i = 1; i < nb && i <= k0; ++i)
+      ud[i] = drive.finish(pre[k0 - i], reads_position ? measured_where_mm(run, k0 - i) : 0.0);
     const std::size_t end = std::min(n - 1, k0 + horizon);
     for (std::size_t k = k0; k < end; ++k) {
       double where_mm = 0.0;
-      for (std::size_t i = 0; i < plant::kWherePositions; ++i) where_mm += y[i];
-      ud[0] = drive.finish(pre[k], where_mm / static_cast<double>(plant::kWherePositions) * mpv);
+      if (reads_position) {
+        for (std::size_t i = 0; i < plant::kWherePositions; ++i) where_mm += y[i];
+        where_mm *= mpv / static_cast<double>(plant::kWherePositions);
+      }
+      ud[0] = drive.finish(pre[k], where_mm);
       double next = 0.0;
       for (std::size_t i = 1; i <= na; ++i) next -= a[i] * y[i - 1];
       for (std::size_t i = 1; i <= nb; ++i) next += b[i] * ud[i - 1];

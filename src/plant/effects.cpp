@@ -169,7 +169,7 @@ double DriveEffects::drive_before_position(double spool_v) noexcept {
 
 double DriveEffects::finish(double drive, double position_mm) const noexcept {
   double d = drive;
-  if (slope_per_mm_ != 0.0 || chamber_per_mm_ != 0.0 || curvature_ != 0.0) {
+  if (reads_position()) {
     const double from_mid_mm = position_mm - kMidStrokeMm, xi = from_mid_mm / kMidStrokeMm;
     // Extending (d > 0) the driving chamber is longer the further out; retracting, the nearer in.
     const double chamber_longer_mm = d >= 0.0 ? from_mid_mm : -from_mid_mm;

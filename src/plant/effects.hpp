@@ -123,6 +123,8 @@ class DriveEffects {
   double drive_before_position(double spool_v) noexcept;
   // The position-dependent factor and the ceiling (memoryless part).
   double finish(double drive, double position_mm) const noexcept;
+  // Whether finish() reads the position (position_dependent_gain is on and not neutral).
+  bool reads_position() const { return slope_per_mm_ != 0.0 || chamber_per_mm_ != 0.0 || curvature_ != 0.0; }
   double apply(double spool_v, double position_mm) noexcept { return finish(drive_before_position(spool_v), position_mm); }
   const State& state() const { return state_; }
   void set_state(const State& s) { state_ = s; }

@@ -25,7 +25,6 @@ How each truth form differs from the fitted one:
   outside the vocabulary: a periodic load force; a sensor offset that drifts; outlier spikes.
 """
 import math
-import random
 
 TS = 0.005
 MM_PER_V = 50.0
@@ -138,13 +137,6 @@ class Rig:
         self.t = 0.0
         self.spool = effects.get("spool", NoSpool())
         self.enc = x0_mm
-        self.drift = 0.0
-
-    def velocity_mm_s(self):
-        """The piston's velocity as friction sees it: the drive's steady speed through the slow
-        pole of A' (the printed B makes each sample's displacement swing with every change of the
-        drive, which no piston does)."""
-        return self.v_mech
 
     def piston_mm(self):
         """Where the piston is, for effects that depend on it: the printed B swings the model's
@@ -178,6 +170,8 @@ class Rig:
     def friction(self, ud):
         """The friction force in drive volts; None while the piston is stuck."""
         e = self.e
+        # The velocity friction sees: the drive's steady speed through the slow pole of A' (the
+        # printed B swings each sample's displacement with every change of the drive; no piston does).
         v = self.v_mech
         if "karnopp" in e:
             fs, fc, vs, visc = e["karnopp"]
