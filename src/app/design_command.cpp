@@ -102,28 +102,17 @@ int run_design(const DesignOptions& o, std::ostream& out, std::ostream& err) {
   std::string controller_source;
   double cond = 0.0;
   bool solved = false;
-  if (!o.T.empty() || spec_given) {
-    if (spec_given) {
-      auto t = control::characteristic_from_spec({o.overshoot_pct, o.settling_s, m.Ts, o.observer_pole},
-                                                 m.A.degree() + m.B.degree() - 1);
-      if (!t) return err << "epa design: " << t.error().message << "\n", 1;
-      T = *t;
-      controller_source = "designed from the spec";
-    } else {
+  if (spec_given || !o.T.empty()) {
+    auto d = [&]() -> core::Result<control::RstDesign> {
+      if (spec_given) return control::design_from_spec(m, {o.overshoot_pct, o.settling_s, m.Ts, o.observer_pole});
       auto t = parse_T(o.T);
-      if (!t) return err << "epa design: " << t.error().message << "\n", 1;
-      T = *t;
-      controller_source = "solved from the given T";
-    }
-    auto sol = control::solve_diophantine(m.A, m.B, T);
-    if (!sol) return err << "epa design: " << sol.error().message << "\n", 1;
-    // The law needs a monic F; scaling F, G (and T) together leaves the controller unchanged.
-    const double f0 = sol->F[0];
-    F = sol->F * (1.0 / f0);
-    G = sol->G * (1.0 / f0);
-    T = T * (1.0 / f0);
-    H = G;
-    cond = sol->condition_number;
+      if (!t) return t.error();
+      return control::design_for_T(m, *t);
+    }();
+    controller_source = spec_given ? "designed from the spec" : "solved from the given T";
+    if (!d) return err << "epa design: " << d.error().message << "\n", 1;
+    F = d->F, G = d->G, H = d->H, T = d->T;
+    cond = d->condition_number;
     solved = true;
   } else {
     auto p = load_controller_polynomials(o.design_path);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "control/diophantine.hpp"
+
 namespace epa::control {
 
 using core::Polynomial;
@@ -27,6 +29,26 @@ core::Result<Polynomial> characteristic_from_spec(const DesignSpec& s, int degre
   Polynomial T = {1.0, -2.0 * r * std::cos(wd * s.Ts), r * r};
   for (int i = 2; i < degree; ++i) T = T * Polynomial{1.0, -s.observer_pole};
   return T;
+}
+
+core::Result<RstDesign> design_from_spec(const core::HammersteinModel& model, const DesignSpec& spec) {
+  auto T = characteristic_from_spec(spec, model.A.degree() + model.B.degree() - 1);
+  if (!T) return T.error();
+  return design_for_T(model, *T);
+}
+
+core::Result<RstDesign> design_for_T(const core::HammersteinModel& model, const Polynomial& T) {
+  auto sol = solve_diophantine(model.A, model.B, T);
+  if (!sol) return sol.error();
+  const double f0 = sol->F[0];
+  if (!(std::abs(f0) > 0.0 && std::isfinite(f0))) return core::numerical_error("design: F(0) is 0, F cannot be made monic");
+  RstDesign d;
+  d.F = sol->F * (1.0 / f0);
+  d.G = sol->G * (1.0 / f0);
+  d.T = T * (1.0 / f0);
+  d.H = d.G;
+  d.condition_number = sol->condition_number;
+  return d;
 }
 
 std::vector<ClosedLoopBranch> analyse_branches(const core::HammersteinModel& model, const Polynomial& F,

@@ -25,6 +25,16 @@ struct DesignSpec {
 // the other poles at p. Errors name the field that is out of range.
 core::Result<core::Polynomial> characteristic_from_spec(const DesignSpec& spec, int degree);
 
+// An RST design for `model`: T given or from `spec` (degree deg A + deg B - 1), F and G from A F + B G = T,
+// all three scaled so F is monic (the law needs it; scaling F, G, T together changes nothing), and
+// H = G (error feedback). Used by `epa design` and the commissioning sequence.
+struct RstDesign {
+  core::Polynomial F, G, H, T;
+  double condition_number = 0.0;  // of the Sylvester matrix: how many digits of F, G are determined
+};
+core::Result<RstDesign> design_for_T(const core::HammersteinModel& model, const core::Polynomial& T);
+core::Result<RstDesign> design_from_spec(const core::HammersteinModel& model, const DesignSpec& spec);
+
 struct ClosedLoopBranch {
   std::string name;   // "nominal", "left", "right"
   double gain = 1.0;  // the factor on B G: 1, 1 + m_l, 1 + m_r

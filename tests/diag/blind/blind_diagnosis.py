@@ -3,7 +3,7 @@
 training and 3 held-out runs per case (closed-loop FF-IDZ and NG-IDZ step sequences, open-loop
 ramps and pulse trains), the diagnosis run on each as a user would, and a score.
 
-    blind_diagnosis.py EPA_BINARY [--fast] [--seeds N] [--keep DIR] [--matrix FILE] [--check]
+    blind_diagnosis.py EPA_BINARY [--fast] [--seeds N] [--keep DIR] [--matrix FILE] [--check] [--only REGEX]
 
 A case is correct when: its effects are all named, nothing outside them and their allowed
 companions is named, and `unexplained` is false (a named effect with `unexplained: true` cannot
@@ -17,6 +17,7 @@ and the score line of the withheld benchmark:
 median reduction >= 70 %; median <= 10 s; >= 3/4 of the pairs with both named).
 """
 import argparse
+import re
 import json
 import os
 import random
@@ -118,9 +119,10 @@ def main():
     ap.add_argument("--keep", help="leave each case's runs and report here")
     ap.add_argument("--matrix", help="write the confusion matrix (Markdown) here")
     ap.add_argument("--check", action="store_true", help="exit 1 unless the issue's thresholds hold")
+    ap.add_argument("--only", help="only the cases whose name matches this regular expression (while working on one)")
     args = ap.parse_args()
 
-    cases = [c for c in CASES if not args.fast or c[0] in FAST]
+    cases = [c for c in CASES if (not args.fast or c[0] in FAST) and (not args.only or re.search(args.only, c[0]))]
     results = []
     with tempfile.TemporaryDirectory(prefix="epa-blind-") as tmp:
         for seed in range(1, args.seeds + 1):
