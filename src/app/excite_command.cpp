@@ -10,6 +10,8 @@
 #include "core/format.hpp"
 #include "core/run_file.hpp"
 #include "ident/excitation.hpp"
+#include "plant/plant_adapter.hpp"
+#include "plant/pneumatic_params.hpp"
 
 namespace epa::app {
 
@@ -18,6 +20,11 @@ void add_excite_command(CLI::App& app, ExciteOptions& o) {
       "excite", "Open-loop identification run on a simulated plant (ramps and pseudo-random pulses) for epa identify");
   cmd->add_option("--out", o.out_path, "Write the run here (epa-run/1 CSV, controller=open-loop)")->required();
   cmd->add_option("--model", o.model_path, "Plant model file (epa-model/1 TOML); default: the paper's eq 9-10")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--plant", o.plant, "hammerstein (the model) or physics (pneumatic cylinder and valve)")
+      ->capture_default_str()->check(CLI::IsMember({"hammerstein", "physics"}));
+  cmd->add_option("--physics-config", o.physics_config,
+                  "Physics plant parameters (epa-pneumatic/1 TOML) for --plant physics; default: built in")
       ->check(CLI::ExistingFile);
   cmd->add_option("--plot", o.plot_path, "Draw the run (position and valve command) as an SVG picture");
   cmd->add_option("--duration", o.duration_s, "Length of the run, s")->capture_default_str()->check(CLI::PositiveNumber);
@@ -52,13 +59,64 @@ std::string render_excitation_plot(const core::Run& run, double ramps_end_s, con
   return render_svg(title, panels, 1, 1100, 260);
 }
 
+constexpr std::uint64_t kNoiseStream = 0x6E6F697365ull;  // the noise's own stream: --noise does not change u
+constexpr double kPhysicsTs = 0.005;                      // the paper's Ts, as the built-in model's
+constexpr double kSensorSpanV = 10.0;                     // the physics plant's sensor: 0-10 V over the stroke
+
+struct ExcitedRun {
+  ident::ExcitationResult result;
+  std::string source;  // what ran, for the metadata and the report
+  double Ts = 0.0;
+};
+
+// The experiment on the pneumatic cylinder and valve, at rest in the middle of its stroke with
+// both chambers pressurised (the valve centred for a while, as plant-server starts it).
+core::Result<ExcitedRun> excite_physics(const ExciteOptions& o, ident::ExcitationOptions eo) {
+  plant::PneumaticParams params;  // the defaults, sized like the paper's rig
+  if (!o.physics_config.empty()) {
+    auto p = plant::read_pneumatic_file(o.physics_config);
+    if (!p) return p.error();
+    params = *p;
+  }
+  eo.stroke_mm = params.stroke_mm;
+  auto plant = plant::make_pneumatic_simulator(params, {.initial_position_mm = 0.5 * params.stroke_mm,
+                                                        .initial_pressure_bar = 3.0,
+                                                        .noise_std_mm = o.noise_mm,
+                                                        .seed = o.seed ^ kNoiseStream,
+                                                        .sensor_bits = 0,
+                                                        .Ts = kPhysicsTs,
+                                                        .substeps = 50});
+  if (!plant) return plant.error();
+  ExcitedRun r;
+  r.source = "physics plant (" + (o.physics_config.empty() ? std::string("built-in parameters") : o.physics_config) + ")";
+  r.Ts = kPhysicsTs;
+  auto result = ident::run_excitation(**plant, params.stroke_mm / kSensorSpanV, eo, o.noise_mm, "epa excite on " + r.source);
+  if (!result) return result.error();
+  r.result = std::move(*result);
+  return r;
+}
+
+core::Result<ExcitedRun> excite_model(const ExciteOptions& o, const ident::ExcitationOptions& eo) {
+  auto model_file = load_model(o.model_path);
+  if (!model_file) return model_file.error();
+  ExcitedRun r;
+  r.source = model_file->source;
+  r.Ts = model_file->model.Ts;
+  auto result = ident::run_excitation(model_file->model, eo, o.noise_mm, "epa excite on " + model_file->source);
+  if (!result) return result.error();
+  r.result = std::move(*result);
+  return r;
+}
+
 }  // namespace
 
 int run_excite(const ExciteOptions& o, std::ostream& out, std::ostream& err) {
   auto fail = [&](const std::string& message) { return err << "epa excite: " << message << "\n", 1; };
-  auto model_file = load_model(o.model_path);
-  if (!model_file) return fail(model_file.error().message);
-  const core::HammersteinModel& model = model_file->model;
+  const bool physics = o.plant == "physics";
+  if (physics && !o.model_path.empty())
+    return fail("--model applies to --plant hammerstein only (the physics plant takes --physics-config)");
+  if (!physics && !o.physics_config.empty())
+    return fail("--physics-config applies to --plant physics only");
 
   ident::ExcitationOptions eo;
   eo.duration_s = o.duration_s;
@@ -68,9 +126,10 @@ int run_excite(const ExciteOptions& o, std::ostream& out, std::ostream& err) {
   eo.ramp_travel_mm = o.ramp_travel_mm;
   eo.guard_mm = o.guard_mm;
   eo.seed = o.seed;
-  auto result = ident::run_excitation(model, eo, o.noise_mm, "epa excite on " + model_file->source);
-  if (!result) return fail(result.error().message);
-  const core::Run& run = result->run;
+  auto excited = physics ? excite_physics(o, eo) : excite_model(o, eo);
+  if (!excited) return fail(excited.error().message);
+  const ident::ExcitationResult& result = excited->result;
+  const core::Run& run = result.run;
 
   const auto [u_min, u_max] = std::minmax_element(run.u_V.begin(), run.u_V.end());
   const auto [y_min, y_max] = std::minmax_element(run.y_mm.begin(), run.y_mm.end());
@@ -81,22 +140,22 @@ int run_excite(const ExciteOptions& o, std::ostream& out, std::ostream& err) {
                 "    the break points lie just inside these (the piston needs a moment to move %g mm)\n"
                 "  pulses: %zu, %zu of them cut short by the %g mm guard; levels %g-%g V\n"
                 "  valve command in [%g, %g] V, position in [%.1f, %.1f] mm\n",
-                model_file->source.c_str(), model.Ts, o.duration_s, run.size(), static_cast<unsigned long long>(o.seed),
-                o.noise_mm, ident::ExcitationGenerator::kMotionThresholdMm, result->ramp_motion_up_v,
-                result->ramp_motion_down_v, ident::ExcitationGenerator::kMotionThresholdMm, result->pulses,
-                result->pulses_cut, o.guard_mm, o.amplitude_min_v, o.amplitude_max_v, *u_min, *u_max, *y_min, *y_max);
+                excited->source.c_str(), excited->Ts, o.duration_s, run.size(), static_cast<unsigned long long>(o.seed),
+                o.noise_mm, ident::ExcitationGenerator::kMotionThresholdMm, result.ramp_motion_up_v,
+                result.ramp_motion_down_v, ident::ExcitationGenerator::kMotionThresholdMm, result.pulses,
+                result.pulses_cut, o.guard_mm, o.amplitude_min_v, o.amplitude_max_v, *u_min, *u_max, *y_min, *y_max);
   out << buf;
-  if (std::isnan(result->ramp_motion_up_v) || std::isnan(result->ramp_motion_down_v))
+  if (std::isnan(result.ramp_motion_up_v) || std::isnan(result.ramp_motion_down_v))
     out << "  warning: a ramp reached --amplitude-max without moving the piston: the dead band may be wider than "
            "the amplitude; raise --amplitude-max\n";
-  if (result->samples_at_stops > 0)
-    out << "  warning: " << result->samples_at_stops
+  if (result.samples_at_stops > 0)
+    out << "  warning: " << result.samples_at_stops
         << " samples with the piston at an end stop (epa identify leaves them out); lower --amplitude-max or raise --guard\n";
 
   if (auto s = core::write_run_file(o.out_path, run); !s) return fail(s.error().message);
   out << "run written to " << o.out_path << "\n";
   if (!o.plot_path.empty()) {
-    if (auto s = write_output(o.plot_path, render_excitation_plot(run, result->ramps_end_s, "Excitation run (" + model_file->source + ")"), out);
+    if (auto s = write_output(o.plot_path, render_excitation_plot(run, result.ramps_end_s, "Excitation run (" + excited->source + ")"), out);
         !s)
       return fail(s.error().message);
     out << "picture written to " << o.plot_path << "\n";

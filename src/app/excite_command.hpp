@@ -1,7 +1,9 @@
 #pragma once
 // `epa excite`: the open-loop identification experiment (ident/excitation.hpp: slow ramps through
 // the dead band, then multi-level pseudo-random pulses with a position-keeping rule) run against a
-// simulated plant, written as an epa-run/1 file (controller=open-loop) for `epa identify`.
+// simulated plant (the paper's Hammerstein model or a model file, or with --plant physics the
+// pneumatic cylinder and valve of plant/pneumatic_plant.hpp), written as an epa-run/1 file
+// (controller=open-loop) for `epa identify`.
 //
 // On a rig: the signal reads the measured position (pulse signs, ramp turn-around, the guard), so it
 // must run in the loop with the plant, not be replayed from a file. Running it on the rig comes with
@@ -17,6 +19,8 @@ namespace epa::app {
 struct ExciteOptions {
   std::string out_path;         // required: the run file
   std::string model_path;       // empty: the paper's model
+  std::string plant = "hammerstein";  // or "physics": the pneumatic cylinder and valve
+  std::string physics_config;   // epa-pneumatic/1 for --plant physics; empty: the built-in parameters
   std::string plot_path;        // SVG of the run; empty: none
   double duration_s = 120.0;
   std::uint64_t seed = 1;

@@ -12,8 +12,9 @@
 #include "core/model_file.hpp"
 #include "core/paper_reference.hpp"
 #include "core/run_file.hpp"
-#include "ident/hammerstein_fit.hpp"
+#include "ident/hammerstein_identification.hpp"
 #include "ident/order_selection.hpp"
+#include "ident/ramp_reading.hpp"
 
 namespace epa::app {
 
@@ -40,6 +41,17 @@ void add_identify_command(CLI::App& app, IdentifyOptions& o) {
   cmd->add_option("--tolerance", o.tolerance_pct, "Order rule: fits within this many points of the best count as equal")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_option("--mm-per-volt", o.mm_per_volt, "Sensor scale of the model's output y")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--criterion", o.criterion,
+                  "simulation: refine A, B and the dead zone on the free-run simulation error, break points within "
+                  "the ramps' dead band; one-step: the swarm's least-squares (one-step prediction) fit alone")
+      ->capture_default_str()->check(CLI::IsMember({"simulation", "one-step"}));
+  cmd->add_option("--window", o.window_s, "Simulation criterion: restart the simulation from the measured position every "
+                                          "this many seconds (0: whole runs)")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--break-points", o.break_points,
+                  "Simulation criterion: ramps: keep each break point between where the ramps start the piston from "
+                  "rest and where it stops on the way back; free: wherever the simulation error puts it")
+      ->capture_default_str()->check(CLI::IsMember({"ramps", "free"}));
   cmd->add_option("--stroke", o.stroke_mm, "Stroke, mm (samples at an end stop are left out)")->capture_default_str()->check(CLI::PositiveNumber);
 }
 
@@ -96,6 +108,30 @@ core::Result<ident::ArxOrders> nesting_orders(const ident::OrderSearch& s) {
   return n;
 }
 
+void print_dead_band(std::ostream& out, const ident::DeadBandReading& band) {
+  out << "\nDead band read off the slow ramps (the piston moves from rest on the way out, stops on the way back):\n";
+  if (band.ramps.empty())
+    out << "  no slow ramps in the estimation runs: the break points are bounded by the commands only\n";
+  auto volts = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%+.3f V", v);
+    return std::isnan(v) ? std::string("(not seen)") : std::string(buf);
+  };
+  for (const auto& r : band.ramps) {
+    char buf[300];
+    std::snprintf(buf, sizeof buf, "  %s at %.2f s, towards %s up to %+.3f V: starts at %s, stops at %s\n", r.segment.c_str(),
+                  r.t_s, r.direction > 0 ? "+" : "-", r.peak_v, volts(r.start_v).c_str(), volts(r.stop_v).c_str());
+    out << buf;
+  }
+  for (const auto* side : {&band.right, &band.left}) {
+    if (!*side) continue;
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "  %s break point kept in [%+.3f, %+.3f] V\n", side == &band.right ? "right" : "left",
+                  (*side)->lo_v, (*side)->hi_v);
+    out << buf;
+  }
+}
+
 }  // namespace
 
 int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err) {
@@ -122,67 +158,58 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
       << o.generations << " generations) over m_r/m_l, b_r, b_l, with ARX " << nesting->to_string()
       << " by least squares inside each evaluation, then a compass-search polish\n"
       << std::flush;  // the progress lines go to err meanwhile
-  ident::HammersteinFitOptions fit_options;
-  fit_options.orders = *nesting;
-  fit_options.seed = o.seed;
-  fit_options.particles = o.particles;
-  fit_options.generations = o.generations;
-  fit_options.m_l = o.m_l;
-  fit_options.progress_every = std::max(1u, o.generations / 6);
-  fit_options.progress = [&err](const ident::FitProgress& p) {
+  const bool refining = o.criterion == "simulation";
+  ident::IdentificationOptions options;
+  options.search = search;
+  options.swarm.orders = *nesting;
+  options.swarm.seed = o.seed;
+  options.swarm.particles = o.particles;
+  options.swarm.generations = o.generations;
+  options.swarm.m_l = o.m_l;
+  options.swarm.progress_every = std::max(1u, o.generations / 6);
+  options.swarm.progress = [&err](const ident::FitProgress& p) {
     char buf[200];
     std::snprintf(buf, sizeof buf, "  generation %u/%u: V = %.4e, b_r = %.4f V, b_l = %.4f V, m_r/m_l = %.4f (%zu fits)\n",
                   p.generation, p.generations, p.best_loss, p.best.b_r, p.best.b_l, p.best.m_r / p.best.m_l, p.evaluations);
     err << buf << std::flush;
   };
-  auto first_fit = ident::fit_hammerstein(est_segments, fit_options);
-  if (!first_fit) return fail(first_fit.error().message);
-  if (first_fit->right_unidentified || first_fit->left_unidentified) {
-    const bool right = first_fit->right_unidentified;
-    char evidence[200];
-    std::snprintf(evidence, sizeof evidence, "b_%s = %g V, m_r/m_l = %g; with that side closed V grows only from %.3g to %.3g",
-                  right ? "r" : "l", right ? first_fit->dead_zone.b_r : first_fit->dead_zone.b_l, first_fit->ratio,
-                  first_fit->arx.loss, right ? first_fit->loss_without_right : first_fit->loss_without_left);
-    return fail(std::string("the ") + (right ? "right" : "left") + " side of the dead zone is not identified (" + evidence +
-                "): the runs never drive the valve far enough beyond the dead band on that side, so its break point "
-                "and slope cannot be identified; record runs with larger pulses (epa excite --amplitude-max)");
-  }
+  options.criterion = refining ? ident::FitCriterion::kSimulation : ident::FitCriterion::kOneStep;
+  options.window_s = o.window_s;
+  options.ramp_band = o.break_points == "ramps";
+  options.Ts = *Ts;
+  options.mm_per_volt = o.mm_per_volt;
+  auto identified = ident::identify_hammerstein(est_segments, val_segments, options);
+  if (!identified) return fail(identified.error().message);
 
-  // Step 2: the ARX order, on u_d through the dead zone just found.
-  const auto ud_est = ident::through_dead_zone(est_segments, first_fit->dead_zone);
-  const auto ud_val = ident::through_dead_zone(val_segments, first_fit->dead_zone);
-  auto selection = ident::select_order(ud_est, ud_val, search);
-  if (!selection) return fail(selection.error().message);
-  out << "\nOrder selection (ARX on u_d = dead zone(u); fit % = 100 (1 - |y - yhat| / |y - mean y|), pooled over runs):\n"
-      << ident::format_order_table(*selection) << "Recommended " << selection->reason << "\n";
-
-  // Step 3: the dead zone polished again for the recommended order (the swarm's answer as start).
-  const ident::ArxOrders chosen = selection->candidates[selection->recommended].estimate.model.orders;
-  const std::size_t first_evaluations = chosen == *nesting ? 0 : first_fit->evaluations;
-  ident::HammersteinFit fit = std::move(*first_fit);
-  if (!(chosen == *nesting)) {
-    ident::HammersteinFitOptions polish = fit_options;
-    polish.orders = chosen;
-    polish.generations = 0;
-    polish.start = fit.dead_zone;
-    auto refined = ident::fit_hammerstein(est_segments, polish);
-    if (!refined) return fail(refined.error().message);
-    fit = std::move(*refined);
+  if (refining) {
+    if (identified->dead_band) print_dead_band(out, *identified->dead_band);
+    out << "\nRefinement: every order's A, B and dead zone moved to minimise the free-run simulation error "
+        << (o.window_s > 0.0 ? "(restarted from the measured position every " + format_number(o.window_s) + " s)"
+                             : std::string("over whole runs"))
+        << " (Levenberg-Marquardt), starting from least squares on the swarm's dead zone"
+        << (identified->dead_band ? "" : "; break points free") << "\n";
+    out << "\nOrder selection (refined models; fit % = 100 (1 - |y - yhat| / |y - mean y|), pooled over runs; "
+           "loss V: the simulation error):\n";
+  } else {
+    out << "\nOrder selection (ARX on u_d = dead zone(u); fit % = 100 (1 - |y - yhat| / |y - mean y|), pooled over runs):\n";
   }
+  out << ident::format_order_table(identified->selection) << "Recommended " << identified->selection.reason << "\n";
+  ident::HammersteinFit fit = std::move(identified->fit);
+  fit.evaluations += identified->swarm_evaluations;
+  const ident::ArxOrders chosen = fit.arx.model.orders;
   const core::HammersteinModel model = fit.model(*Ts, o.mm_per_volt);
   if (auto s = model.validate(); !s) return fail("the identified model is not valid: " + s.error().message);
 
-  fit.evaluations += first_evaluations;
   const ModelFitSummary summary = summarise_fit(fit, est_segments, val_segments);
   print_identified_model(out, fit, model, summary, o.m_l);
 
   std::string runs_text;
   for (const auto& r : o.runs) runs_text += (runs_text.empty() ? "" : ", ") + r;
   char source[512];
-  std::snprintf(source, sizeof source, "epa identify: %s from %s; %s free-run fit %.2f %%; PSO seed %llu",
+  std::snprintf(source, sizeof source, "epa identify: %s from %s; %s free-run fit %.2f %%; PSO seed %llu%s",
                 chosen.to_string().c_str(), runs_text.c_str(), summary.validated ? "validation" : "estimation",
                 summary.validated ? summary.validation.simulation_pct : summary.estimation.simulation_pct,
-                static_cast<unsigned long long>(o.seed));
+                static_cast<unsigned long long>(o.seed), refining ? ", refined on the simulation error" : "");
   if (!o.out_path.empty()) {
     if (auto s = core::write_model_file(o.out_path, {model, source}); !s) return fail(s.error().message);
     out << "\nmodel written to " << o.out_path << "\n";
@@ -194,7 +221,7 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
         {"validation", summary.validated ? nlohmann::json{{"one_step_pct", summary.validation.one_step_pct},
                                                           {"simulation_pct", summary.validation.simulation_pct}}
                                          : nlohmann::json(nullptr)},
-        {"pso_seed", o.seed}};
+        {"pso_seed", o.seed}, {"criterion", o.criterion}};
     auto id = save_model(o.db_path, {.id = 0, .name = o.save_name, .created_ms = 0, .source = source, .model = model,
                                      .fit_json = fit_json.dump()});
     if (!id) return fail("--save: " + id.error().message);

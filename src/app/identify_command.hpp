@@ -1,8 +1,11 @@
 #pragma once
 // `epa identify`: the paper's two identification steps (section 2.2, 4.1) from run files, without
 // MATLAB. The dead zone and the ARX part are fitted together (PSO over the dead zone, least squares
-// for the ARX part), the ARX order is selected over the given ranges with the toolbox's figures
-// (fit %, loss, FPE, AIC), the chosen model is printed next to the paper's eq 9-10, written as an
+// for the ARX part), then, by default, every parameter is refined on the free-run simulation error
+// with the break points kept between the readings of the excitation's ramps (ident/
+// simulation_refinement.hpp, ident/ramp_reading.hpp); the ARX order is selected over the given
+// ranges with the toolbox's figures (fit %, loss, FPE, AIC), the chosen model is printed next to
+// the paper's eq 9-10, written as an
 // epa-model/1 file for `epa design --model` and `epa simulate --model`, and drawn against the
 // measured validation runs (like the paper's figure 5).
 #include <CLI/CLI.hpp>
@@ -28,6 +31,9 @@ struct IdentifyOptions {
   double tolerance_pct = 0.5;         // order rule: fit points from the best that count as equal
   double mm_per_volt = 50.0;          // sensor scale of the model's y
   double stroke_mm = 500.0;           // end stops
+  std::string criterion = "simulation";  // or "one-step": the swarm's least-squares fit alone (before issue 19)
+  double window_s = 0.0;              // simulation criterion: restart from measured y every window_s (0: whole runs)
+  std::string break_points = "ramps"; // simulation criterion: "ramps" (within the ramps' band) or "free"
 };
 
 void add_identify_command(CLI::App& app, IdentifyOptions& options);

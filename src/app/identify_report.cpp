@@ -68,8 +68,14 @@ void print_identified_model(std::ostream& out, const ident::HammersteinFit& fit,
     std::snprintf(buf, sizeof buf, ", validation %.2f %% / %.2f %%", s.validation.simulation_pct, s.validation.one_step_pct);
     out << buf;
   }
-  std::snprintf(buf, sizeof buf, "\n  loss V = %.4e, %zu least-squares fits in the dead-zone search\n", fit.arx.loss,
-                fit.evaluations);
+  if (fit.criterion == ident::FitCriterion::kSimulation)
+    std::snprintf(buf, sizeof buf,
+                  "\n  simulation error V = %.4e (%.3f mm RMS; %.4e at the least-squares start), %zu least-squares fits "
+                  "and simulations\n",
+                  fit.arx.loss, std::sqrt(fit.arx.loss) * model.mm_per_volt, fit.best_loss_after_swarm, fit.evaluations);
+  else
+    std::snprintf(buf, sizeof buf, "\n  loss V = %.4e, %zu least-squares fits in the dead-zone search\n", fit.arx.loss,
+                  fit.evaluations);
   out << buf;
 
   out << "\nCompared with the paper (eq 9-10):          identified        paper\n";

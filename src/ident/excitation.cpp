@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/format.hpp"
+#include "plant/plant_adapter.hpp"
 
 namespace epa::ident {
 
@@ -82,7 +83,9 @@ double ExcitationGenerator::next(double y_mm) {
     case ExcitationPhase::kRampUp:
       if (!ramp_started_) ramp_start_mm_ = y_mm, ramp_started_ = true;
       // y(k) shows the commands up to u(k-1), the u_ still held.
-      if (std::isnan(motion_v_[ramp_]) && std::abs(y_mm - ramp_start_mm_) > kMotionThresholdMm) motion_v_[ramp_] = u_;
+      // Motion in the ramp's direction only: a piston still creeping from the ramp before is not
+      // moved by this one.
+      if (std::isnan(motion_v_[ramp_]) && dir * (y_mm - ramp_start_mm_) > kMotionThresholdMm) motion_v_[ramp_] = u_;
       if (std::abs(y_mm - ramp_start_mm_) >= o_.ramp_travel_mm || std::abs(u_) >= o_.amplitude_max_v) {
         phase_ = ExcitationPhase::kRampBack;
         u_ -= dir * step;
@@ -137,20 +140,31 @@ double ExcitationGenerator::next(double y_mm) {
 
 core::Result<ExcitationResult> run_excitation(const core::HammersteinModel& model, const ExcitationOptions& options,
                                               double noise_std_mm, const std::string& source) {
+  ExcitationOptions checked = options;
+  checked.Ts = model.Ts;
+  if (auto s = checked.validate(); !s) return s.error();
+  // The noise gets its own stream, so changing --noise does not change the valve sequence.
+  auto plant = plant::make_hammerstein_simulator(model, {.initial_position_mm = 0.5 * options.stroke_mm,
+                                                         .noise_std_mm = noise_std_mm,
+                                                         .seed = options.seed ^ 0x6E6F697365ull,
+                                                         .stroke_mm = options.stroke_mm});
+  if (!plant) return plant.error();
+  return run_excitation(**plant, model.mm_per_volt, options, noise_std_mm, source);
+}
+
+core::Result<ExcitationResult> run_excitation(plant::PlantSimulator& plant, double mm_per_volt,
+                                              const ExcitationOptions& options, double noise_std_mm,
+                                              const std::string& source) {
   ExcitationOptions o = options;
-  o.Ts = model.Ts;
+  o.Ts = plant.sample_period_s();
+  if (!(mm_per_volt > 0.0 && std::isfinite(mm_per_volt)))
+    return core::invalid_argument("excitation: the sensor scale must be > 0 mm/V, got " + format_number(mm_per_volt));
   auto gen = ExcitationGenerator::make(o);
   if (!gen) return gen.error();
-  // The noise gets its own stream, so changing --noise does not change the valve sequence.
-  auto plant = plant::HammersteinPlant::make(model, {.initial_position_mm = 0.5 * o.stroke_mm,
-                                                     .noise_std_mm = noise_std_mm,
-                                                     .seed = o.seed ^ 0x6E6F697365ull,
-                                                     .stroke_mm = o.stroke_mm});
-  if (!plant) return plant.error();
 
   ExcitationResult r;
   core::Run& run = r.run;
-  run.Ts = model.Ts;
+  run.Ts = o.Ts;
   run.set_meta("controller", "open-loop");
   run.set_meta("source", source);
   run.set_meta("excitation_seed", std::to_string(o.seed));
@@ -161,16 +175,16 @@ core::Result<ExcitationResult> run_excitation(const core::HammersteinModel& mode
   run.y_mm.reserve(n);
   run.u_V.reserve(n);
   for (std::size_t k = 0; k < n; ++k) {
-    const double y_mm = plant->measured_mm();
+    const double y_mm = plant.measured_v() * mm_per_volt;
     const double u = gen->next(y_mm);
     if (r.ramps_end_s == 0.0 && (gen->phase() == ExcitationPhase::kPulse || gen->phase() == ExcitationPhase::kRest))
-      r.ramps_end_s = static_cast<double>(k) * model.Ts;
-    run.t_s.push_back(static_cast<double>(k) * model.Ts);
+      r.ramps_end_s = static_cast<double>(k) * o.Ts;
+    run.t_s.push_back(static_cast<double>(k) * o.Ts);
     run.y_mm.push_back(y_mm);
     run.u_V.push_back(u);
-    const double true_mm = plant->position_mm();
+    const double true_mm = plant.position_mm();
     if (true_mm <= kStopMarginMm || true_mm >= o.stroke_mm - kStopMarginMm) ++r.samples_at_stops;
-    plant->step(u);
+    plant.step(u);
   }
   r.ramp_motion_up_v = gen->ramp_motion_up_v();
   r.ramp_motion_down_v = gen->ramp_motion_down_v();

@@ -27,6 +27,7 @@
 #include "core/result.hpp"
 #include "core/run.hpp"
 #include "plant/hammerstein_plant.hpp"
+#include "plant/plant_simulator.hpp"
 
 namespace epa::ident {
 
@@ -61,8 +62,9 @@ class ExcitationGenerator {
   std::size_t total_samples() const { return total_; }
   bool done() const { return k_ >= total_; }
 
-  // Where each ramp first saw the piston move by more than motion_threshold_mm: the command at that
-  // moment (V; NaN when it never moved). An upper bound of the break point on that side.
+  // Where each ramp first saw the piston move by more than kMotionThresholdMm in the ramp's
+  // direction: the command at that moment (V; NaN when it never moved). An upper bound of the
+  // break point on that side.
   double ramp_motion_up_v() const { return motion_v_[0]; }
   double ramp_motion_down_v() const { return motion_v_[1]; }
   static constexpr double kMotionThresholdMm = 2.0;
@@ -96,9 +98,16 @@ struct ExcitationResult {
   double ramps_end_s = 0.0;         // when the pulses began (the ramps came before)
 };
 
-// Runs the excitation against a simulated plant, starting at rest in the middle of the stroke.
-// `source` goes into the run's metadata.
+// Runs the excitation against the paper's (or a file's) Hammerstein model, starting at rest in the
+// middle of the stroke. `source` goes into the run's metadata.
 core::Result<ExcitationResult> run_excitation(const core::HammersteinModel& model, const ExcitationOptions& options,
                                               double noise_std_mm, const std::string& source);
+
+// Runs the excitation against any simulated plant (the physics plant, a Hammerstein plant), from
+// the state it is in: options.Ts is taken from plant.sample_period_s(), the sensor reads
+// measured_v() * mm_per_volt. noise_std_mm is the plant's sensor noise, for the run's metadata.
+core::Result<ExcitationResult> run_excitation(plant::PlantSimulator& plant, double mm_per_volt,
+                                              const ExcitationOptions& options, double noise_std_mm,
+                                              const std::string& source);
 
 }  // namespace epa::ident

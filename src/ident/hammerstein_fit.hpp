@@ -50,12 +50,17 @@ struct HammersteinFitOptions {
   unsigned progress_every = 10;
 };
 
+// What a fit minimised: the one-step prediction error (the swarm with least squares inside) or the
+// simulation error (simulation_refinement.hpp).
+enum class FitCriterion { kOneStep, kSimulation };
+
 struct HammersteinFit {
   core::DeadZone dead_zone;        // scaled: dead_zone.m_l == options.m_l
-  ArxEstimate arx;                 // the linear part on the same scale (B divided by m_l)
+  ArxEstimate arx;                 // the linear part on the same scale (B divided by m_l); arx.loss is the criterion's V
+  FitCriterion criterion = FitCriterion::kOneStep;
   double ratio = 1.0;              // m_r / m_l
-  std::size_t evaluations = 0;     // least-squares solves used
-  double best_loss_after_swarm = 0.0;
+  std::size_t evaluations = 0;     // least-squares solves (one-step) or simulations (simulation error) used
+  double best_loss_after_swarm = 0.0;  // simulation criterion: V_sim of the least-squares start
   // V with one side closed (its break point moved beyond every command): the evidence for that side.
   double loss_without_right = 0.0, loss_without_left = 0.0;
   // A side the data never drive beyond its break point, so its break point and slope are unknown:

@@ -78,6 +78,11 @@ core::Result<OrderSelection> select_order(const std::vector<Segment>& est, const
         c.cancels = c.pole_zero_distance < search.cancellation_distance;
         sel.candidates.push_back(std::move(c));
       }
+  if (auto s = apply_order_rule(sel, search, validating); !s) return s.error();
+  return sel;
+}
+
+core::Status apply_order_rule(OrderSelection& sel, const OrderSearch& search, bool validating) {
   if (sel.candidates.empty())
     return core::numerical_error("no ARX order in the search could be estimated; first reason: " +
                                  (sel.skipped.empty() ? std::string("empty search") : sel.skipped.front()));
@@ -117,7 +122,7 @@ core::Result<OrderSelection> select_order(const std::vector<Segment>& est, const
                 validating ? "" : " No validation run was given: a larger model always fits its own data better, so "
                                   "give --validate for an honest choice.");
   sel.reason = buf;
-  return sel;
+  return core::ok();
 }
 
 std::string format_order_table(const OrderSelection& sel) {

@@ -70,6 +70,10 @@ std::size_t common_first_row(const OrderSearch& search);
 core::Result<OrderSelection> select_order(const std::vector<Segment>& estimation,
                                           const std::vector<Segment>& validation, const OrderSearch& search);
 
+// The rule above applied to candidates already scored (score_pct, cancels, criteria set): sets best,
+// recommended and reason. Errors: no candidates (the first skipped reason is given).
+core::Status apply_order_rule(OrderSelection& selection, const OrderSearch& search, bool validating);
+
 // The table as printed by `epa identify`: one line per candidate, the recommendation marked.
 std::string format_order_table(const OrderSelection& selection);
 

@@ -56,6 +56,83 @@ TEST_F(IdentifyCli, ExciteWritesAnOpenLoopRunFile) {
   EXPECT_NE(s.str().find("<svg"), std::string::npos);
 }
 
+TEST_F(IdentifyCli, ExciteRunsThePhysicsPlant) {
+  write("overlap.toml", "schema = \"epa-pneumatic/1\"\n[valve]\noverlap_pos_v = 1.4\noverlap_neg_v = -1.9\n");
+  std::string started[2];
+  for (int i = 0; i < 2; ++i) {
+    const std::string config = i == 0 ? "" : " --physics-config " + path("overlap.toml");
+    const auto o = run_epa("excite --plant physics" + config + " --out " + path("run.csv") + " --duration 20 --seed 3");
+    ASSERT_EQ(o.exit_code, 0) << o.output;
+    EXPECT_NE(o.output.find("physics plant (" + std::string(i == 0 ? "built-in parameters" : path("overlap.toml")) + ")"),
+              std::string::npos)
+        << o.output;
+    auto run = epa::core::read_run_file(path("run.csv"), 0.005);
+    ASSERT_TRUE(run.has_value()) << run.error().message;
+    EXPECT_EQ(run->meta("controller"), "open-loop");
+    EXPECT_NE(run->meta("source").find("physics plant"), std::string::npos) << run->meta("source");
+    EXPECT_EQ(run->size(), 4000u);
+    const auto first_moved = o.output.find("the piston first moved");
+    ASSERT_NE(first_moved, std::string::npos) << o.output;
+    started[i] = o.output.substr(first_moved, 80);
+  }
+  EXPECT_NE(started[0], started[1]);  // the wider overlap moves the piston later on the ramps
+}
+
+TEST_F(IdentifyCli, ExciteRefusesOptionsOfTheOtherPlant) {
+  write("plant.toml", "schema = \"epa-pneumatic/1\"\n");
+  auto o = run_epa("excite --out " + path("run.csv") + " --physics-config " + path("plant.toml"));
+  EXPECT_EQ(o.exit_code, 1);
+  EXPECT_NE(o.output.find("--physics-config applies to --plant physics only"), std::string::npos) << o.output;
+  o = run_epa("excite --plant physics --out " + path("run.csv") + " --model " + std::string(EPA_SOURCE_DIR) +
+              "/config/paper-model.toml");
+  EXPECT_EQ(o.exit_code, 1);
+  EXPECT_NE(o.output.find("--model applies to --plant hammerstein only"), std::string::npos) << o.output;
+  write("bad.toml", "schema = \"epa-pneumatic/1\"\n[valve]\noverlap_pos_v = 12\n");
+  o = run_epa("excite --plant physics --out " + path("run.csv") + " --physics-config " + path("bad.toml"));
+  EXPECT_EQ(o.exit_code, 1);
+  EXPECT_NE(o.output.find("overlap_pos_v"), std::string::npos) << o.output;
+  o = run_epa("excite --plant pneumatic --out " + path("run.csv"));
+  EXPECT_NE(o.exit_code, 0);
+}
+
+// Identification on the physics plant from the command line: refined on the simulation error, the
+// break points inside the dead band the ramps showed (the acceptance figures: ident_physics_test).
+TEST_F(IdentifyCli, IdentifiesThePhysicsPlant) {
+  for (int seed : {1, 2}) {
+    const auto o = run_epa("excite --plant physics --out " + path("p" + std::to_string(seed) + ".csv") + " --duration 60 --seed " +
+                           std::to_string(seed));
+    ASSERT_EQ(o.exit_code, 0) << o.output;
+  }
+  const auto o = run_epa("identify " + path("p1.csv") + " --validate " + path("p2.csv") + " --out " + path("model.toml") +
+                         kSmallBudget);
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  EXPECT_NE(o.output.find("Dead band read off the slow ramps"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("right break point kept in [+1.3"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("Refinement:"), std::string::npos);
+  EXPECT_NE(o.output.find("simulation error V ="), std::string::npos);
+  auto model = epa::core::read_model_file(path("model.toml"));
+  ASSERT_TRUE(model.has_value()) << model.error().message;
+  const auto& dz = model->model.dead_zone;
+  EXPECT_GT(dz.b_r, 1.2);  // beyond the spool overlap, [-1.7, +1.2] V
+  EXPECT_LT(dz.b_r, 1.6);
+  EXPECT_LT(dz.b_l, -1.7);
+  EXPECT_GT(dz.b_l, -2.1);
+  EXPECT_NE(model->source.find("refined on the simulation error"), std::string::npos) << model->source;
+  // Break points left to the simulation error alone: near the spool overlap.
+  const auto free = run_epa("identify " + path("p1.csv") + " --validate " + path("p2.csv") + " --break-points free --out " +
+                            path("free.toml") + kSmallBudget);
+  ASSERT_EQ(free.exit_code, 0) << free.output;
+  EXPECT_NE(free.output.find("break points free"), std::string::npos);
+  EXPECT_EQ(free.output.find("Dead band read off"), std::string::npos);
+  auto free_model = epa::core::read_model_file(path("free.toml"));
+  ASSERT_TRUE(free_model.has_value()) << free_model.error().message;
+  EXPECT_LT(free_model->model.dead_zone.b_r, dz.b_r);
+  // The one-step criterion alone (before issue 19) cannot see the right side of this plant.
+  const auto one_step = run_epa("identify " + path("p1.csv") + " --criterion one-step" + kSmallBudget);
+  EXPECT_EQ(one_step.exit_code, 1) << one_step.output;
+  EXPECT_NE(one_step.output.find("side of the dead zone is not identified"), std::string::npos) << one_step.output;
+}
+
 TEST_F(IdentifyCli, ExciteRefusesAnAmplitudeBeyondTheValve) {
   const auto o = run_epa("excite --out " + path("run.csv") + " --amplitude-max 12");
   EXPECT_EQ(o.exit_code, 1);

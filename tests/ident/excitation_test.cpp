@@ -7,6 +7,7 @@
 #include <set>
 
 #include "core/paper_reference.hpp"
+#include "plant/plant_adapter.hpp"
 
 namespace epa::ident {
 namespace {
@@ -53,6 +54,43 @@ TEST(Excitation, ThePistonStaysInsideTheStrokeOnThePapersPlant) {
     const auto [lo, hi] = std::minmax_element(r.run.y_mm.begin(), r.run.y_mm.end());
     EXPECT_GT(*lo, 1.0);
     EXPECT_LT(*hi, 499.0);
+  }
+}
+
+TEST(Excitation, AnyPlantRunsTheSameExperiment) {
+  // The model's run is the generic run on the model's plant: same commands, same readings.
+  ExcitationOptions o;
+  o.seed = 7;
+  o.duration_s = 30.0;
+  const auto by_model = run_excitation(core::paper::model(), o, 0.1, "test").value();
+  auto plant = plant::make_hammerstein_simulator(
+      core::paper::model(), {.initial_position_mm = 250.0, .noise_std_mm = 0.1, .seed = 7 ^ 0x6E6F697365ull, .stroke_mm = 500.0});
+  ASSERT_TRUE(plant.has_value());
+  const auto generic = run_excitation(**plant, core::paper::model().mm_per_volt, o, 0.1, "test").value();
+  EXPECT_EQ(generic.run.u_V, by_model.run.u_V);
+  EXPECT_EQ(generic.run.y_mm, by_model.run.y_mm);
+  EXPECT_EQ(generic.run.metadata, by_model.run.metadata);
+  EXPECT_FALSE(run_excitation(**plant, 0.0, o, 0.1, "test").has_value());  // no sensor scale
+}
+
+TEST(Excitation, ThePistonStaysInsideTheStrokeOnThePhysicsPlant) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    plant::PneumaticOptions po;
+    po.initial_position_mm = 250.0;
+    po.noise_std_mm = 0.1;
+    po.seed = seed;
+    auto plant = plant::make_pneumatic_simulator({}, po);
+    ASSERT_TRUE(plant.has_value());
+    ExcitationOptions o;
+    o.seed = seed;
+    o.duration_s = 90.0;
+    const auto r = run_excitation(**plant, 50.0, o, 0.1, "test").value();
+    EXPECT_EQ(r.samples_at_stops, 0u) << "seed " << seed;
+    EXPECT_EQ(r.run.meta("controller"), "open-loop");
+    // The slow ramp saw the piston move beyond the spool overlap, [-1.7, +1.2] V, each way.
+    EXPECT_GT(r.ramp_motion_up_v, 1.2) << "seed " << seed;
+    EXPECT_LT(r.ramp_motion_down_v, -1.7) << "seed " << seed;  // not the creep left from the ramp before
+    EXPECT_GT(r.pulses, 100u);
   }
 }
 
