@@ -53,7 +53,7 @@ function showStatus(s) {
   setText("mode", s.mode);
   mode.className = "badge " + s.mode;
   setText("controller", s.controller_name);
-  setText("uptime", `up ${num(s.time_s, 0)} s`);
+  setText("uptime", `up ${num(s.time_s, 0)} s` + (s.mode === "excite" ? ` \u2014 excitation: ${num(s.excite_left_s, 0)} s left` : ""));
   const fault = $("fault");
   fault.hidden = s.mode !== "fault";
   if (s.mode === "fault") { setText("fault-code", s.fault); setText("fault-text", s.fault_text || ""); }
@@ -137,6 +137,44 @@ function showAudit(a) {
   if (body.innerHTML !== html) body.innerHTML = html;
 }
 
+// Commissioning: start and abort need the [web] token (sent as a bearer token, kept only in this
+// page); the progress is polled with the slow data, and every 500 ms while a run is under way.
+let commissionRunning = false;
+
+function showCommission(c) {
+  commissionRunning = c.running;
+  const bar = $("c-bar");
+  if (bar) bar.style.width = `${Math.max(0, Math.min(100, c.percent || 0)).toFixed(0)}%`;
+  setText("c-message", c.running ? `${c.stage}: ${c.message}` : (c.verdict === "none" ? "idle" : c.message));
+  $("commission").dataset.verdict = c.verdict;
+  $("c-start").disabled = c.running;
+  $("c-abort").disabled = !c.running;
+  $("c-links").hidden = c.running || c.verdict === "none";
+}
+
+async function commissionCommand(path, body) {
+  const res = await fetch(path, {
+    method: "POST", cache: "no-store", body,
+    headers: { "Authorization": `Bearer ${$("c-token").value}`, "Content-Type": "application/json" },
+  });
+  const answer = await res.json().catch(() => ({}));
+  setText("c-answer", res.ok ? "accepted" : `refused (${res.status}): ${answer.error || res.statusText}`);
+  pollCommission();
+}
+
+async function pollCommission() {
+  try { showCommission(await getJson("/api/commission")); } catch (e) { /* no service, or no connection */ }
+}
+
+function commissionPanel() {
+  $("c-form").addEventListener("submit", (e) => { e.preventDefault(); commissionCommand("/api/commission", $("c-spec").value); });
+  $("c-abort").addEventListener("click", () => commissionCommand("/api/commission/abort", ""));
+  (async function loop() {
+    await pollCommission();
+    setTimeout(loop, commissionRunning ? 500 : SLOW_MS);
+  })();
+}
+
 function linkState(ok, message) {
   const link = $("link");
   link.classList.toggle("down", !ok);
@@ -172,3 +210,4 @@ async function slow() {
 makeCharts();
 fast();
 slow();
+commissionPanel();

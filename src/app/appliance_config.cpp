@@ -49,14 +49,15 @@ class TableReader {
     if (!range.contains(*v)) return fail(*n, key, core::format_number(*v) + " is outside " + range.text());
     out = *v;
   }
-  void integer(const char* key, int& out, long lo, long hi) {
+  template <typename Int>
+  void integer(const char* key, Int& out, std::int64_t lo, std::int64_t hi) {
     const toml::node* n = find(key);
     if (!n) return;
     // is_integer() first: toml++ converts a float such as 5e22 to int64 without a range check (UB).
     const auto v = n->is_integer() ? n->value<std::int64_t>() : std::nullopt;
     if (!v) return fail(*n, key, "must be a whole number");
     if (*v < lo || *v > hi) return fail(*n, key, "must be within " + std::to_string(lo) + ".." + std::to_string(hi));
-    out = static_cast<int>(*v);
+    out = static_cast<Int>(*v);
   }
   void boolean(const char* key, bool& out) {
     const toml::node* n = find(key);
@@ -237,7 +238,11 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   cal.refuse_unknown_keys();
 
   TableReader start(top.subtable("startup"), "startup", file, error);
-  start.choice<runtime::Mode>("mode", r.start_mode, runtime::parse_mode);
+  start.choice<runtime::Mode>("mode", r.start_mode, [](std::string_view v) -> core::Result<runtime::Mode> {
+    auto m = runtime::parse_mode(v);
+    if (m && (*m == runtime::Mode::kStop || *m == runtime::Mode::kRun)) return m;
+    return core::invalid_argument("'" + std::string(v) + "' is not a start mode: stop or run (manual and excite are entered by command)");
+  });
   start.number("setpoint_mm", r.start_setpoint_mm, closed(-10000, 10000, "mm"));
   start.refuse_unknown_keys();
 
@@ -247,6 +252,14 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   rec.number("buffer_s", r.record_buffer_s, above(0, 600, "s"));
   rec.number("move_window_s", r.move_window_s, above(0, 600, "s"));
   rec.refuse_unknown_keys();
+
+  TableReader ex(top.subtable("excite"), "excite", file, error);
+  ex.integer("seed", r.excitation.seed, 0, 4294967295);
+  ex.number("amplitude_min_v", r.excitation.amplitude_min_v, above(0, 10, "V"));
+  ex.number("amplitude_max_v", r.excitation.amplitude_max_v, above(0, 10, "V"));
+  ex.number("duration_s", r.excitation.duration_s, closed(1, 600, "s"));
+  ex.number("guard_mm", r.excitation.guard_mm, above(0, 10000, "mm"));
+  ex.refuse_unknown_keys();
 
   TableReader st(top.subtable("store"), "store", file, error);
   st.text("path", c.store_path);

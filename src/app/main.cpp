@@ -3,6 +3,7 @@
 #include <exception>
 #include <iostream>
 
+#include "app/commission_command.hpp"
 #include "app/design_command.hpp"
 #include "app/diagnose_command.hpp"
 #include "app/excite_command.hpp"
@@ -34,6 +35,8 @@ int main(int argc, char** argv) {
   epa::app::add_excite_command(app, excite);
   epa::app::add_identify_command(app, identify);
   epa::app::add_tuning_command(app, tuning);
+  epa::app::CommissionOptions commission;
+  epa::app::add_commission_command(app, commission);
   epa::app::DiagnoseOptions diagnose;
   epa::app::add_diagnose_command(app, diagnose);
   try {
@@ -46,6 +49,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("design")) return epa::app::run_design(design, std::cout, std::cerr);
     if (app.got_subcommand("excite")) return epa::app::run_excite(excite, std::cout, std::cerr);
     if (app.got_subcommand("identify")) return epa::app::run_identify(identify, std::cout, std::cerr);
+    if (app.got_subcommand("commission")) return epa::app::run_commission(commission, std::cout, std::cerr);
     if (app.got_subcommand("diagnose")) return epa::app::run_diagnose(diagnose, std::cout, std::cerr);
     if (app.got_subcommand("serve")) return epa::app::run_serve(serve, std::cerr);
     if (app.got_subcommand("registers")) return epa::app::run_registers(registers, std::cout, std::cerr);

@@ -10,6 +10,9 @@
 #include <thread>
 
 #include "app/daq_factory.hpp"
+#include "app/appliance_axis.hpp"
+#include "app/commission_identify.hpp"
+#include "app/commission_service.hpp"
 #include "app/log_audit_sink.hpp"
 #include "app/run_history.hpp"
 #include "app/store_setup.hpp"
@@ -156,18 +159,18 @@ core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const Appliance
 
 core::Result<std::unique_ptr<web::WebServer>> start_web(const ApplianceConfig& c, runtime::LoopChannels& channels,
                                                         points::WriteGate& gate, web::RecentAudit& audit, const modbus::ModbusServer* mb,
-                                                        const store::StoreWriter& store, const std::string& set_name) {
+                                                        const store::StoreWriter& store, web::CommissionPort* commission) {
   auto modbus_stats = [mb] {
     return mb ? web::ModbusStats{true, mb->clients(), mb->requests(), mb->exceptions()} : web::ModbusStats{};
   };
-  auto store_stats = [&store, set_name] {
+  auto store_stats = [&store] {
     const auto counters = store.counters();
     const auto health = store.health();
-    return web::StoreStats{true, health.ok, counters.accepted, counters.saved, health.last_error, set_name};
+    return web::StoreStats{true, health.ok, counters.accepted, counters.saved, health.last_error, store.running_set().name};
   };
   web::WebConfig config = c.web;
   config.log = [](const std::string& line) { spdlog::warn("{}", line); };
-  auto server = web::WebServer::start(config, channels, &gate, &audit, modbus_stats, store_stats);
+  auto server = web::WebServer::start(config, channels, &gate, &audit, modbus_stats, store_stats, commission);
   if (!server) return server.error();
   spdlog::info("web: listening on {}:{} (static files {}, commands {})", c.web.address, (*server)->port(), c.web.static_dir,
                c.web.token.empty() ? "disabled: no token configured" : "enabled with the token");
@@ -285,7 +288,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   sigaddset(&signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
-  runtime::LoopChannels channels(static_cast<std::size_t>(c.runtime.record_buffer_s / c.runtime.period_s));
+  runtime::LoopChannels channels(runtime::record_capacity_samples(c.runtime));
   runtime::MonotonicClock clock;
   runtime::ScanCycle loop(c.runtime, control->tuning, **daq, clock, channels);
   store_writer.start();
@@ -300,6 +303,17 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   LogAuditSink log_audit(&store_writer);
   web::RecentAudit audit(&log_audit);  // the last entries for the status page, the log, the store
   points::WriteGate gate(std::move(*limits), c.runtime, control->tuning_base, channels, &audit);  // every interface's writes
+  // Commissioning (issue 19): its axis is this loop, through the gate, the recorder and the store.
+  // Declared before the interfaces, so it outlives them on every way out (they reach it through
+  // the gate), and after the loop, which takes its last commands when it is aborted.
+  RecordedRuns recorded;
+  auto make_axis = [&](const std::string& source) -> std::unique_ptr<commission::Axis> {
+    return std::make_unique<ApplianceAxis>(c.runtime, channels, gate, store_writer, c.store_path, recorded,
+                                           points::Requester{source, true, "", /*tuning_unlocked=*/true});
+  };
+  auto commissioning = std::make_unique<CommissionService>(make_axis, identify_for_commissioning(c.runtime.mm_per_volt),
+                                                           [](const std::string& line) { spdlog::info("{}", line); });
+  gate.attach_commission(commissioning.get());
   std::unique_ptr<modbus::ModbusServer> modbus_server;
   if (register_map) {
     auto server = start_modbus(c, *register_map, gate, channels);
@@ -308,14 +322,17 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   }
   std::unique_ptr<web::WebServer> web_server;
   if (c.web_enabled) {
-    auto server = start_web(c, channels, gate, audit, modbus_server.get(), store_writer, control->store.set.name);
+    auto server = start_web(c, channels, gate, audit, modbus_server.get(), store_writer, commissioning.get());
     if (!server) return spdlog::error("{}", server.error().message), 1;
     web_server = std::move(*server);
   }
   runtime::Recorder recorder({.directory = c.record_directory, .per_move = c.record_per_move, .Ts = c.runtime.period_s,
                               .source = std::string("appliance/") + to_string(c.backend)},
                              channels, [](const std::string& line) { spdlog::info("{}", line); },
-                             [&store_writer](const std::string& path, const core::Run& run) { store_writer.record_run(to_run_record(path, run)); });
+                             [&store_writer, &recorded](const std::string& path, const core::Run& run) {
+                               store_writer.record_run(to_run_record(path, run));
+                               recorded.put(path, run);
+                             });
   recorder.start();
 
   sd_notify(0, "READY=1");
@@ -325,6 +342,8 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   sd_notify(0, "STOPPING=1");
   if (web_server) web_server->stop();        // no more commands from either interface;
   if (modbus_server) modbus_server->stop();  // then the loop's last cycle
+  gate.attach_commission(nullptr);
+  commissioning.reset();  // a commissioning run under way is aborted: valve safe, the previous set back
   loop_thread.join();  // the loop's last act: valve to its safe command
   recorder.stop();     // writes what is pending; the DAQ closes on the way out
   store_writer.stop(); // every accepted change and run on disk (or logged as not saved)

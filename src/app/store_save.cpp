@@ -23,7 +23,8 @@ core::Result<std::int64_t> save_model(const std::string& db_path, store::ModelRe
   return id;
 }
 
-core::Result<std::int64_t> save_tuning_set(const std::string& db_path, store::ModelRecord model, store::TuningSet set) {
+core::Result<std::int64_t> save_tuning_set(const std::string& db_path, store::ModelRecord model, store::TuningSet set,
+                                           const std::string& source) {
   if (auto s = store::validate(set, model.model); !s) return s.error();
   auto db = store::open_existing_store(db_path);
   if (!db) return db.error();
@@ -35,7 +36,7 @@ core::Result<std::int64_t> save_tuning_set(const std::string& db_path, store::Mo
   set.model_id = *model_id;
   auto id = store::TuningSetTable(*db).insert(set);
   if (!id) return id.error();
-  if (auto s = store::AuditLog(*db).append({core::unix_time_ms(), "cli", "save_tuning_set", std::nan(""), static_cast<double>(*id)}); !s)
+  if (auto s = store::AuditLog(*db).append({core::unix_time_ms(), source, "save_tuning_set", std::nan(""), static_cast<double>(*id)}); !s)
     return s.error();
   if (auto s = tx->commit(); !s) return s.error();
   return id;

@@ -15,6 +15,8 @@ core::Result<std::int64_t> save_model(const std::string& db_path, store::ModelRe
 
 // The set with its model (reused when already stored). Returns the set's id. The set is not
 // activated: `epa tuning activate` does that, after a look at `epa tuning diff`.
-core::Result<std::int64_t> save_tuning_set(const std::string& db_path, store::ModelRecord model, store::TuningSet set);
+// `source` goes into the audit trail ("cli", or the commissioning's requester).
+core::Result<std::int64_t> save_tuning_set(const std::string& db_path, store::ModelRecord model, store::TuningSet set,
+                                           const std::string& source = "cli");
 
 }  // namespace epa::app

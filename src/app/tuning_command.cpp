@@ -10,6 +10,7 @@
 #include "store/audit_log.hpp"
 #include "store/model_table.hpp"
 #include "store/run_table.hpp"
+#include "store/set_activation.hpp"
 #include "store/store_file.hpp"
 #include "store/transaction.hpp"
 #include "store/tuning_file.hpp"
@@ -104,30 +105,6 @@ std::vector<std::pair<std::string, std::string>> fields(const store::TuningSet& 
           {"model fit", m.fit_json}};
 }
 
-struct SetWithModel {
-  store::TuningSet set;
-  store::ModelRecord model;
-};
-
-core::Result<SetWithModel> find_set(store::Database& db, const std::string& key) {
-  auto set = store::TuningSetTable(db).find(key);
-  if (!set) return set.error();
-  auto model = store::ModelTable(db).get(set->model_id);
-  if (!model) return model.error();
-  return SetWithModel{std::move(*set), std::move(*model)};
-}
-
-// Makes set `id` the active one and audits the switch (old id -> new id), inside the caller's
-// transaction.
-core::Status activate_audited(store::Database& db, std::int64_t id) {
-  store::TuningSetTable sets(db);
-  auto before = sets.active_id();
-  if (!before) return before.error();
-  if (auto st = sets.activate(id); !st) return st;
-  const double old_id = *before ? static_cast<double>(**before) : std::nan("");
-  return store::AuditLog(db).append({core::unix_time_ms(), "cli", "active_tuning_set", old_id, static_cast<double>(id)});
-}
-
 std::string number_or_dash(const std::optional<double>& v) { return v ? core::format_number(*v) : "-"; }
 
 int list(store::Database& db, std::ostream& out) {
@@ -157,7 +134,7 @@ int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::os
     if (cmd->got_subcommand("list")) return list(*db, out);
 
     if (cmd->got_subcommand("show")) {
-      auto s = find_set(*db, o.set);
+      auto s = store::find_set_with_model(*db, o.set);
       if (!s) return fail(s.error().message);
       auto active = store::TuningSetTable(*db).active_id();
       out << "tuning set " << s->set.id << (active && *active && **active == s->set.id ? " (active)" : "") << "\n";
@@ -166,9 +143,9 @@ int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::os
     }
 
     if (cmd->got_subcommand("diff")) {
-      auto a = find_set(*db, o.set);
+      auto a = store::find_set_with_model(*db, o.set);
       if (!a) return fail(a.error().message);
-      auto b = find_set(*db, o.other);
+      auto b = store::find_set_with_model(*db, o.other);
       if (!b) return fail(b.error().message);
       const auto fa = fields(a->set, a->model), fb = fields(b->set, b->model);
       int differences = 0;
@@ -183,18 +160,18 @@ int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::os
     }
 
     if (cmd->got_subcommand("activate")) {
-      auto s = find_set(*db, o.set);
+      auto s = store::find_set_with_model(*db, o.set);
       if (!s) return fail(s.error().message);
       auto tx = store::Transaction::begin(*db);
       if (!tx) return fail(tx.error().message);
-      if (auto st = activate_audited(*db, s->set.id); !st) return fail(st.error().message);
+      if (auto st = store::activate_audited(*db, s->set.id, "cli"); !st) return fail(st.error().message);
       if (auto st = tx->commit(); !st) return fail(st.error().message);
       out << "tuning set '" << s->set.name << "' (id " << s->set.id << ") is active: a running appliance uses it from its next start\n";
       return 0;
     }
 
     if (cmd->got_subcommand("export")) {
-      auto s = find_set(*db, o.set);
+      auto s = store::find_set_with_model(*db, o.set);
       if (!s) return fail(s.error().message);
       if (auto st = write_output(o.file, store::format_tuning_toml(s->set, s->model), out); !st) return fail(st.error().message);
       if (o.file != "-") out << "tuning set '" << s->set.name << "' written to " << o.file << "\n";
@@ -220,7 +197,7 @@ int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::os
       if (auto st = store::AuditLog(*db).append({core::unix_time_ms(), "cli", "import_tuning_set", std::nan(""), static_cast<double>(*id)}); !st)
         return fail(st.error().message);
       if (o.activate)
-        if (auto st = activate_audited(*db, *id); !st) return fail(st.error().message);
+        if (auto st = store::activate_audited(*db, *id, "cli"); !st) return fail(st.error().message);
       if (auto st = tx->commit(); !st) return fail(st.error().message);
       out << "imported tuning set '" << file->set.name << "' (id " << *id << ")" << (o.activate ? ", active from the appliance's next start" : "") << "\n";
       return 0;

@@ -34,7 +34,8 @@ std::vector<PointDef> build() {
       {P::kVersionMajor, "version_major", "", "firmware version, major", A::kRead, 0, 0, true, true, [](const Ctx&, int) { return double(kVersionMajor); }},
       {P::kVersionMinor, "version_minor", "", "firmware version, minor", A::kRead, 0, 0, true, true, [](const Ctx&, int) { return double(kVersionMinor); }},
       {P::kVersionPatch, "version_patch", "", "firmware version, patch", A::kRead, 0, 0, true, true, [](const Ctx&, int) { return double(kVersionPatch); }},
-      {P::kMode, "mode", "", "0 stop, 1 run, 2 manual (3 fault: read only; leave it with reset)", A::kWrite, 0, 2, true, true,
+      {P::kMode, "mode", "", "0 stop, 1 run, 2 manual, 4 excite: the identification experiment, from STOP only, back to STOP by itself "
+                             "(3 fault: read only; leave it with reset)", A::kWrite, 0, 4, true, true,
        [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.mode)); }},
       {P::kFaultCode, "fault_code", "", "latched fault: 0 none, 1 sensor not finite, 2 sensor out of range, 3 soft limit, 4 I/O errors, "
                                         "5 overruns, 6 following error, 7 heartbeat lost, 8 controller fault, 9 store damaged, 10 sensor frozen",
@@ -81,6 +82,27 @@ std::vector<PointDef> build() {
       {P::kBr, "b_r", "V", "dead zone right break point", A::kTuning, -10, 10, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.b_r; }},
       {P::kBl, "b_l", "V", "dead zone left break point", A::kTuning, -10, 10, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.b_l; }},
       {P::kLc, "lc_mm", "mm", "FF-IDZ switch-off band l_c", A::kTuning, 0, 100, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.lc_mm; }},
+      // the excitation experiment: settings for the next EXCITE (a running one keeps its own)
+      {P::kExciteSeed, "excite_seed", "", "excitation: seed of the pseudo-random pulses (the same seed, the same signal)", A::kTuning, 0,
+       4294967295.0, true, true, [](const Ctx& c, int) { return double(c.snapshot.excitation.seed); }},
+      {P::kExciteAmplitudeMin, "excite_amplitude_min_v", "V", "excitation: smallest pulse level (at most excite_amplitude_max_v)", A::kTuning, 0.01,
+       10, false, true, [](const Ctx& c, int) { return c.snapshot.excitation.amplitude_min_v; }},
+      {P::kExciteAmplitudeMax, "excite_amplitude_max_v", "V", "excitation: largest valve command (either sign) of its ramps and pulses", A::kTuning, 0.01, 10,
+       false, true, [](const Ctx& c, int) { return c.snapshot.excitation.amplitude_max_v; }},
+      {P::kExciteDuration, "excite_duration_s", "s", "excitation: length of the experiment; then STOP by itself", A::kTuning, 1, 600, false, true,
+       [](const Ctx& c, int) { return c.snapshot.excitation.duration_s; }},
+      {P::kExciteLeft, "excite_left_s", "s", "excitation: time left of the running experiment (0 outside EXCITE)", A::kRead, 0, 0, false, true,
+       [](const Ctx& c, int) { return c.snapshot.excitation_left_s; }},
+      // commissioning (excite, identify, design, verify, deploy or roll back): the service's state
+      {P::kCommissionCommand, "commission_command", "", "1 start commissioning with the default spec, 2 abort it (after unlock); reads 0",
+       A::kTuning, 1, 2, true, true, [](const Ctx&, int) { return 0.0; }},
+      {P::kCommissionStage, "commission_stage", "", "0 idle, 1 exciting, 2 identifying, 3 designing, 4 simulating, 5 saving, "
+                                                    "6 verifying on the axis, 7 done",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.commission.stage); }},
+      {P::kCommissionVerdict, "commission_verdict", "", "of the last commissioning run: 0 none, 1 deployed, 2 rolled back, 3 aborted",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.commission.verdict); }},
+      {P::kCommissionProgress, "commission_progress_pct", "%", "commissioning: share of the sequence done", A::kRead, 0, 0, false, true,
+       [](const Ctx& c, int) { return c.status.commission.percent; }},
       // last move (NaN: never reached / never moved)
       {P::kMoveNumber, "move_number", "", "moves measured since start", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.last_move.number); }},
       {P::kMoveFrom, "move_from_mm", "mm", "last move: start", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.from_mm; }},
@@ -105,7 +127,8 @@ std::vector<PointDef> build() {
       {P::kCommandsRejected, "commands_rejected", "", "accepted commands the scan cycle refused after all (the state changed before it applied them)",
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.commands_rejected); }},
       {P::kLastCommandRefusal, "last_command_refusal", "", "why the scan cycle last refused a command: 0 none, 1 setpoint out of range, 2 manual valve out of range, "
-                                                            "3 not in MANUAL, 4 fault latched, 5 FAULT not settable, 6 recorder busy, 7 record seconds out of range",
+                                                            "3 not in MANUAL, 4 fault latched, 5 FAULT not settable, 6 recorder busy, 7 record seconds out of range, "
+                                                            "8 EXCITE not from STOP, 9 piston outside the excitation's guard lines, 10 excitation settings invalid",
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.last_refusal)); }},
   };
   const auto& names = coefficient_names();

@@ -1,15 +1,16 @@
 #pragma once
 // The catalog of points: everything an operator or integrator reads from the appliance (snapshot
 // values, tuning, metrics, loop statistics, counters) and the things they write (setpoint, mode,
-// controller, manual valve, tuning, reset, heartbeat, record, unlock), each with its public name,
-// unit, access, range and description. Every interface reads it: the register map binds Modbus
-// addresses to its points, the JSON API and /metrics name values by it, the store keys retained
-// points by it, and the write gate checks writes against its access and range. `epa registers
-// --points` lists it.
+// controller, manual valve, tuning, excitation settings, reset, heartbeat, record, unlock), each
+// with its public name, unit, access, range and description. Every interface reads it: the
+// register map binds Modbus addresses to its points, the JSON API and /metrics name values by it,
+// the store keys retained points by it, and the write gate checks writes against its access and
+// range. `epa registers --points` lists it.
 #include <cstdint>
 #include <span>
 #include <string_view>
 
+#include "points/commission_control.hpp"
 #include "points/point_id.hpp"
 #include "runtime/snapshot.hpp"
 
@@ -24,6 +25,7 @@ struct InterfaceStatus {
   int clients = 0;                   // connected Modbus clients
   bool locked = true;                // tuning points refuse this client's writes
   std::uint64_t unlock_failures = 0; // refused unlock attempts since start (wrong key, back-off)
+  CommissionView commission;         // the commissioning service's state (WriteGate::commission_view)
 };
 
 struct PointContext {

@@ -21,6 +21,10 @@ enum class PointId : std::uint16_t {
   kLocked, kStoreOk, kChangeCounter, kSavedCounter, kModbusRequests, kModbusClients, kUnlockFailures,
   // tuning
   kTs, kMr, kMl, kBr, kBl, kLc,
+  // the excitation experiment (mode EXCITE)
+  kExciteSeed, kExciteAmplitudeMin, kExciteAmplitudeMax, kExciteDuration, kExciteLeft,
+  // the commissioning service: its command (start, abort) and state
+  kCommissionCommand, kCommissionStage, kCommissionVerdict, kCommissionProgress,
   // the last move
   kMoveNumber, kMoveFrom, kMoveTo, kMoveRise, kMoveSettling, kMoveEss, kMoveOvershoot,
   // loop statistics and counters

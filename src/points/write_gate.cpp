@@ -13,6 +13,8 @@ struct WriteGate::Decision {
   std::vector<PointId> command_point;  // the point each command came from (a tuning command: the first tuning point)
   control::ControllerConfig tuning;
   bool tuning_changed = false;
+  runtime::ExcitationSettings excitation;
+  bool excitation_changed = false;  // then the excitation command is the group's first
 };
 
 namespace {
@@ -21,12 +23,20 @@ GateResult refuse(Refusal r, std::string reason) { return {r, std::move(reason)}
 
 std::string quoted(PointId id) { return "'" + std::string(name(id)) + "'"; }
 
+// The unlock-protected points that set the next excitation experiment rather than the control law.
+bool excitation_point(PointId id) {
+  return id == PointId::kExciteSeed || id == PointId::kExciteAmplitudeMin || id == PointId::kExciteAmplitudeMax ||
+         id == PointId::kExciteDuration;
+}
+
 // Which refusals of the loop's rules mean "not in this state" rather than "not this value".
 Refusal gate_refusal(runtime::CommandRefusal r) {
   switch (r) {
     case runtime::CommandRefusal::kNotManual:
     case runtime::CommandRefusal::kFaultLatched:
-    case runtime::CommandRefusal::kRecordQueueFull: return Refusal::kConflict;
+    case runtime::CommandRefusal::kRecordQueueFull:
+    case runtime::CommandRefusal::kNotStopped:
+    case runtime::CommandRefusal::kOutsideExcitationGuard: return Refusal::kConflict;
     default: return Refusal::kInvalidValue;
   }
 }
@@ -35,15 +45,26 @@ Refusal gate_refusal(runtime::CommandRefusal r) {
 
 WriteGate::WriteGate(WriteLimits limits, const runtime::RuntimeConfig& loop_rules, control::ControllerConfig tuning,
                      runtime::LoopChannels& channels, core::AuditSink* audit)
-    : limits_(std::move(limits)), loop_rules_(loop_rules), channels_(channels), audit_(audit), tuning_(std::move(tuning)) {}
+    : limits_(std::move(limits)),
+      loop_rules_(loop_rules),
+      channels_(channels),
+      audit_(audit),
+      tuning_(std::move(tuning)),
+      excitation_(loop_rules.excitation) {}
 
 control::ControllerConfig WriteGate::running_tuning() const {
   std::lock_guard lock(mutex_);
   return tuning_;
 }
 
+runtime::ExcitationSettings WriteGate::excitation_settings() const {
+  std::lock_guard lock(mutex_);
+  return excitation_;
+}
+
 GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester& who, const runtime::Snapshot& snap,
-                            const control::ControllerConfig& tuning, Decision& out) const {
+                            const control::ControllerConfig& tuning, const runtime::ExcitationSettings& excitation,
+                            Decision& out) const {
   if (writes.empty()) return refuse(Refusal::kInvalidValue, "nothing to write");
   // 1. Each value: a writable point, within the one set of limits, whole where it must be.
   for (const PointWrite& w : writes) {
@@ -59,9 +80,17 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
   for (const PointWrite& w : writes)
     if (point(w.id).tuning() && !who.tuning_unlocked)
       return refuse(Refusal::kForbidden, quoted(w.id) + " is a tuning point: unlock the tuning first");
+  // A commissioning command goes to the service, not the loop: alone, and only with a service.
+  for (const PointWrite& w : writes)
+    if (w.id == PointId::kCommissionCommand) {
+      if (writes.size() > 1) return refuse(Refusal::kInvalidValue, quoted(w.id) + " is written alone");
+      if (!commission_) return refuse(Refusal::kNotWritable, quoted(w.id) + ": this appliance runs no commissioning service");
+      return {};
+    }
   // 3. The commands, all of them or none.
   out.tuning = tuning;
-  PointId first_tuning_point = PointId::kCount;
+  out.excitation = excitation;
+  PointId first_tuning_point = PointId::kCount, first_excitation_point = PointId::kCount;
   for (const PointWrite& w : writes) {
     runtime::Command c;
     switch (w.id) {
@@ -77,7 +106,15 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
       case PointId::kBr: out.tuning.dead_zone.b_r = w.value; break;
       case PointId::kBl: out.tuning.dead_zone.b_l = w.value; break;
       case PointId::kLc: out.tuning.lc_v = w.value / loop_rules_.mm_per_volt; break;
+      case PointId::kExciteSeed: out.excitation.seed = static_cast<std::uint32_t>(w.value); break;
+      case PointId::kExciteAmplitudeMin: out.excitation.amplitude_min_v = w.value; break;
+      case PointId::kExciteAmplitudeMax: out.excitation.amplitude_max_v = w.value; break;
+      case PointId::kExciteDuration: out.excitation.duration_s = w.value; break;
       default: return refuse(Refusal::kNotWritable, quoted(w.id) + " has no command behind it");
+    }
+    if (excitation_point(w.id)) {
+      if (first_excitation_point == PointId::kCount) first_excitation_point = w.id;
+      continue;
     }
     if (point(w.id).tuning()) {
       if (first_tuning_point == PointId::kCount) first_tuning_point = w.id;
@@ -95,14 +132,26 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
     out.commands.push_back(runtime::tuning_command(*t));
     out.command_point.push_back(first_tuning_point);
   }
+  if (first_excitation_point != PointId::kCount) {
+    // Every excitation point of the group becomes one command, validated whole (e.g. a minimum
+    // above the maximum is refused), first in the group, so "settings and mode excite" in one
+    // write starts the experiment with the new settings.
+    if (const char* problem = runtime::excitation_problem(out.excitation, loop_rules_))
+      return refuse(Refusal::kInvalidValue, "the excitation settings would not validate: " + std::string(problem));
+    out.excitation_changed = true;
+    out.commands.insert(out.commands.begin(), runtime::excitation_command(out.excitation));
+    out.command_point.insert(out.command_point.begin(), first_excitation_point);
+  }
   // 4. The scan cycle's own rules, in the state it last published, carried through the group in
   // the order the loop applies it (mode MANUAL then a manual valve command is one valid group).
   runtime::Mode mode = snap.mode;
+  runtime::ExcitationSettings next_excitation = excitation;
   for (std::size_t i = 0; i < out.commands.size(); ++i) {
     const runtime::Command& c = out.commands[i];
-    if (const auto r = runtime::check_command(c, mode, loop_rules_); r != runtime::CommandRefusal::kNone)
+    if (const auto r = runtime::check_command(c, mode, snap.position_mm, next_excitation, loop_rules_); r != runtime::CommandRefusal::kNone)
       return refuse(gate_refusal(r), quoted(out.command_point[i]) + ": " + std::string(runtime::describe(r)));
     if (c.kind == runtime::CommandKind::kMode) mode = c.mode;
+    if (c.kind == runtime::CommandKind::kExcitation) next_excitation = c.excitation;
     if (c.kind == runtime::CommandKind::kReset && mode == runtime::Mode::kFault) mode = runtime::Mode::kStop;
   }
   return {};
@@ -112,22 +161,24 @@ GateResult WriteGate::decide(std::span<const PointWrite> writes, const Requester
                              std::vector<runtime::Command>* commands) const {
   Decision d;
   const auto tuning = running_tuning();
-  GateResult r = build(writes, who, snap, tuning, d);
+  GateResult r = build(writes, who, snap, tuning, excitation_settings(), d);
   if (r.accepted() && commands) *commands = d.commands;
   return r;
 }
 
 GateResult WriteGate::submit(std::span<const PointWrite> writes, const Requester& who) {
+  if (!writes.empty() && writes.front().id == PointId::kCommissionCommand) return commission(writes, who);
   std::lock_guard lock(mutex_);
   const runtime::Snapshot snap = channels_.snapshot.read();
   Decision d;
-  if (GateResult r = build(writes, who, snap, tuning_, d); !r.accepted()) return r;
+  if (GateResult r = build(writes, who, snap, tuning_, excitation_, d); !r.accepted()) return r;
   const std::uint64_t first = next_sequence_;
   for (std::size_t i = 0; i < d.commands.size(); ++i) d.commands[i].sequence = first + i;
   if (!d.commands.empty() && !channels_.commands.try_push_all(d.commands.data(), d.commands.size()))
     return refuse(Refusal::kBusy, "the scan cycle's command queue is full: try again");
   next_sequence_ += d.commands.size();
   if (d.tuning_changed) tuning_ = d.tuning;
+  if (d.excitation_changed) excitation_ = d.excitation;
 
   // Accepted: the audit trail (and so the store) gets the group. Each entry keeps its command's
   // sequence number while it is in flight, so a late refusal can be audited against it.
@@ -140,6 +191,7 @@ GateResult WriteGate::submit(std::span<const PointWrite> writes, const Requester
     if (!p.audited) continue;
     core::AuditEntry e{time_ms, who.source, std::string(p.name), p.value(ctx), w.value};
     std::uint64_t sequence = first + d.commands.size() - 1;  // a tuning point: the tuning command, last
+    if (excitation_point(w.id)) sequence = first;            // an excitation point: the excitation command, first
     for (std::size_t i = 0; i < d.commands.size() && !p.tuning(); ++i)
       if (d.command_point[i] == w.id) sequence = first + i;
     in_flight_.push_back({sequence, e});
@@ -147,6 +199,40 @@ GateResult WriteGate::submit(std::span<const PointWrite> writes, const Requester
     change.push_back(std::move(e));
   }
   if (audit_ && !change.empty()) audit_->record(change);
+  return {};
+}
+
+GateResult WriteGate::commission(std::span<const PointWrite> writes, const Requester& who) {
+  {
+    std::lock_guard lock(mutex_);
+    Decision d;
+    if (GateResult r = build(writes, who, channels_.snapshot.read(), tuning_, excitation_, d); !r.accepted()) return r;
+  }
+  // The service is called outside the gate's lock: its sequence writes through this gate.
+  const double value = writes.front().value;
+  if (value == 1.0) {
+    const auto started = commission_->start("", who.source);
+    if (started.result == CommissionStart::kBusy) return refuse(Refusal::kConflict, "commission_command: " + started.message);
+    if (started.result == CommissionStart::kBadSpec) return refuse(Refusal::kInvalidValue, "commission_command: " + started.message);
+  } else if (!commission_->abort(who.source)) {
+    return refuse(Refusal::kConflict, "commission_command: no commissioning run is under way");
+  }
+  if (audit_) audit_->record({{core::unix_time_ms(), who.source, std::string(name(PointId::kCommissionCommand)), 0.0, value}});
+  return {};
+}
+
+GateResult WriteGate::replace_tuning(const control::ControllerConfig& tuning, const Requester& who, const core::AuditEntry& entry) {
+  if (!who.may_write) return refuse(Refusal::kForbidden, who.no_write_reason);
+  if (!who.tuning_unlocked) return refuse(Refusal::kForbidden, "a tuning set is tuning: unlock the tuning first");
+  auto t = runtime::make_tuning(tuning);
+  if (!t) return refuse(Refusal::kInvalidValue, "the tuning set would not validate: " + t.error().message);
+  std::lock_guard lock(mutex_);
+  runtime::Command commands[] = {runtime::tuning_command(*t), runtime::controller_command(tuning.kind)};
+  for (auto& c : commands) c.sequence = next_sequence_++;
+  if (!channels_.commands.try_push_all(commands, std::size(commands)))
+    return refuse(Refusal::kBusy, "the scan cycle's command queue is full: try again");
+  tuning_ = tuning;
+  if (audit_) audit_->record({entry});
   return {};
 }
 

@@ -8,7 +8,8 @@
 // (Modbus exception 02/03/04/06, HTTP 400/403/409/503). Nothing is half-applied.
 //
 // The gate owns the running tuning: tuning writes edit its copy, which becomes the loop's whole
-// at the next cycle; everyone else reads it (running_tuning(), the snapshot).
+// at the next cycle; everyone else reads it (running_tuning(), the snapshot). It owns the next
+// excitation experiment's settings the same way (the excite_* points, unlock-protected too).
 //
 // A command the gate accepted is refused by the loop only when the state changed in between (a
 // fault latched, the recorder busy). take_refusals() collects those off the loop: each is logged
@@ -23,6 +24,7 @@
 
 #include "control/controller.hpp"
 #include "core/audit.hpp"
+#include "points/commission_control.hpp"
 #include "points/point_id.hpp"
 #include "points/write_limits.hpp"
 #include "runtime/scan_cycle.hpp"
@@ -78,17 +80,30 @@ class WriteGate {
     if (audit_) audit_->record(entries);
   }
 
+  // Another tuning set as a whole (the commissioning sequence deploying or rolling back): the loop
+  // runs `tuning` with its controller from the next cycle on, and `entry` (e.g. running_tuning_set
+  // old id -> new id) goes into the audit trail. Refused when the tuning does not validate or the
+  // requester may not change tuning.
+  GateResult replace_tuning(const control::ControllerConfig& tuning, const Requester& who, const core::AuditEntry& entry);
+
+  // The commissioning service behind commission_command (none: the point is refused). Attach it
+  // before the interfaces start; it must outlive them.
+  void attach_commission(CommissionControl* commission) { commission_ = commission; }
+  CommissionView commission_view() const { return commission_ ? commission_->view() : CommissionView{}; }
+
   // Logs and audits the commands the loop refused after the gate accepted them. Off the loop.
   void take_refusals(const std::function<void(const std::string&)>& log);
 
   control::ControllerConfig running_tuning() const;
+  runtime::ExcitationSettings excitation_settings() const;  // what the next EXCITE starts with
   const WriteLimits& limits() const { return limits_; }
   core::ChangeCounters counters() const { return audit_ ? audit_->counters() : core::ChangeCounters{}; }
 
  private:
   struct Decision;
+  GateResult commission(std::span<const PointWrite> writes, const Requester& who);
   GateResult build(std::span<const PointWrite> writes, const Requester& who, const runtime::Snapshot& snap,
-                   const control::ControllerConfig& tuning, Decision& out) const;
+                   const control::ControllerConfig& tuning, const runtime::ExcitationSettings& excitation, Decision& out) const;
 
   // An accepted, audited write whose command the loop may still refuse.
   struct InFlight {
@@ -100,9 +115,11 @@ class WriteGate {
   const runtime::RuntimeConfig loop_rules_;
   runtime::LoopChannels& channels_;
   core::AuditSink* audit_;
+  CommissionControl* commission_ = nullptr;
 
   mutable std::mutex mutex_;  // one writer at a time: Modbus and web threads
   control::ControllerConfig tuning_;
+  runtime::ExcitationSettings excitation_;
   std::uint64_t next_sequence_ = 1;
   std::deque<InFlight> in_flight_;  // the last kInFlight accepted writes, for late refusals
   static constexpr std::size_t kInFlight = 1024;

@@ -2,6 +2,7 @@
 
 #include "core/format.hpp"
 #include "points/point_catalog.hpp"
+#include "runtime/excitation_settings.hpp"
 
 namespace epa::points {
 
@@ -38,6 +39,14 @@ core::Result<WriteLimits> WriteLimits::from_config(const runtime::RuntimeConfig&
     r.min = {n.min, at + n.min_key};
     r.max = {n.max, at + n.max_key};
   }
+  // An experiment must fit in the recorder's ring, which the configuration sizes.
+  PointRange& duration = limits.ranges_[index(PointId::kExciteDuration)];
+  const double longest = runtime::max_excitation_duration_s(config);
+  if (!(longest >= duration.min.value))
+    return core::invalid_argument(at + "[excite] duration_s / [recorder] buffer_s: an experiment of at most " + core::format_number(longest) +
+                                  " s leaves '" + std::string(name(PointId::kExciteDuration)) + "' no value within " + range_text(duration));
+  if (longest < duration.max.value)
+    duration.max = {longest, at + (longest > config.excitation.duration_s ? "[recorder] buffer_s (less 1 s)" : "[excite] duration_s")};
   return limits;
 }
 

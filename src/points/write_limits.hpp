@@ -1,7 +1,8 @@
 #pragma once
 // One set of limits for every write, whichever interface it comes through: each writable point's
 // range from the catalog, narrowed by the configuration ([limits] setpoint_min_mm/max_mm,
-// manual_valve_limit_v) and by the register map's min/max columns. Each bound remembers where it
+// manual_valve_limit_v; the recorder's ring for excite_duration_s) and by the register map's
+// min/max columns. Each bound remembers where it
 // came from, so a refusal names the limit ("setpoint_mm 400 is outside [0, 300] mm: [limits]
 // setpoint_max_mm"). Limits that leave a point no value at all are refused at start-up.
 #include <array>

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "control/controller_kind.hpp"
+#include "runtime/excitation_settings.hpp"
 #include "runtime/mode.hpp"
 #include "runtime/tuning.hpp"
 
@@ -13,13 +14,14 @@ namespace epa::runtime {
 
 enum class CommandKind : std::uint8_t {
   kSetpoint,     // value = setpoint, mm
-  kMode,         // mode = stop, run or manual (refused while FAULT is latched)
+  kMode,         // mode = stop, run, manual or excite (refused while FAULT is latched; excite from STOP only)
   kManualValve,  // value = valve command for MANUAL, V
   kController,   // controller = the law to use from the next cycle on
   kTuning,       // tuning = new parameters for all three laws
   kReset,        // clears a latched fault: FAULT -> STOP
   kHeartbeat,    // heartbeat = the supervising client's counter
   kRecord,       // value = seconds of history to write as a run file
+  kExcitation,   // excitation = the settings of the next EXCITE, whole
 };
 
 struct Command {
@@ -30,6 +32,7 @@ struct Command {
   std::uint32_t heartbeat = 0;
   std::uint64_t sequence = 0;  // the producer's number for it: a refusal is reported with it
   Tuning tuning;
+  ExcitationSettings excitation;
 };
 
 inline Command setpoint_command(double mm) { Command c; c.kind = CommandKind::kSetpoint; c.value = mm; return c; }
@@ -40,5 +43,6 @@ inline Command tuning_command(const Tuning& t) { Command c; c.kind = CommandKind
 inline Command reset_command() { Command c; c.kind = CommandKind::kReset; return c; }
 inline Command heartbeat_command(std::uint32_t n) { Command c; c.kind = CommandKind::kHeartbeat; c.heartbeat = n; return c; }
 inline Command record_command(double seconds) { Command c; c.kind = CommandKind::kRecord; c.value = seconds; return c; }
+inline Command excitation_command(const ExcitationSettings& s) { Command c; c.kind = CommandKind::kExcitation; c.excitation = s; return c; }
 
 }  // namespace epa::runtime

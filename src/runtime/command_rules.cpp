@@ -4,19 +4,28 @@
 
 namespace epa::runtime {
 
-CommandRefusal check_command(const Command& c, Mode mode, const RuntimeConfig& config) noexcept {
+CommandRefusal check_command(const Command& c, Mode mode, double position_mm, const ExcitationSettings& excitation,
+                             const RuntimeConfig& config) noexcept {
   switch (c.kind) {
     case CommandKind::kSetpoint:
       return c.value >= config.setpoint_min_mm && c.value <= config.setpoint_max_mm ? CommandRefusal::kNone
                                                                                   : CommandRefusal::kSetpointOutOfRange;
     case CommandKind::kMode:
       if (c.mode == Mode::kFault) return CommandRefusal::kModeNotSettable;
-      return mode == Mode::kFault ? CommandRefusal::kFaultLatched : CommandRefusal::kNone;
+      if (mode == Mode::kFault) return CommandRefusal::kFaultLatched;
+      if (c.mode == Mode::kExcite && mode != Mode::kExcite) {
+        // An experiment starts at rest, without a controller's history to take over from.
+        if (mode != Mode::kStop) return CommandRefusal::kNotStopped;
+        if (!excitation_may_start_at(position_mm, excitation, config)) return CommandRefusal::kOutsideExcitationGuard;
+      }
+      return CommandRefusal::kNone;
     case CommandKind::kManualValve:
       if (!(std::abs(c.value) <= config.manual_valve_limit_v)) return CommandRefusal::kManualValveOutOfRange;
       return mode == Mode::kManual ? CommandRefusal::kNone : CommandRefusal::kNotManual;
     case CommandKind::kRecord:
       return c.value > 0.0 && std::isfinite(c.value) ? CommandRefusal::kNone : CommandRefusal::kRecordOutOfRange;
+    case CommandKind::kExcitation:  // taken in any mode: a running experiment keeps its own settings
+      return excitation_problem(c.excitation, config) ? CommandRefusal::kExcitationInvalid : CommandRefusal::kNone;
     case CommandKind::kController:
     case CommandKind::kTuning:  // validated whole by runtime::make_tuning before it is queued
     case CommandKind::kReset:   // a reset without a latched fault does nothing, and that is fine
@@ -36,6 +45,10 @@ std::string_view describe(CommandRefusal r) {
     case CommandRefusal::kModeNotSettable: return "FAULT is entered by faults only";
     case CommandRefusal::kRecordQueueFull: return "the recorder has not caught up with earlier requests";
     case CommandRefusal::kRecordOutOfRange: return "the seconds to record must be positive";
+    case CommandRefusal::kNotStopped: return "EXCITE is entered from STOP only";
+    case CommandRefusal::kOutsideExcitationGuard:
+      return "EXCITE starts only with the piston between the excitation's guard lines (guard_mm inside the soft limits): move it there first";
+    case CommandRefusal::kExcitationInvalid: return "the excitation settings do not validate together";
   }
   return "unknown";
 }

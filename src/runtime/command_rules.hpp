@@ -23,11 +23,17 @@ enum class CommandRefusal : std::uint8_t {
   kModeNotSettable = 5,        // FAULT is entered by faults only
   kRecordQueueFull = 6,        // the recorder has not caught up with earlier requests
   kRecordOutOfRange = 7,       // record seconds not positive or not finite
+  kNotStopped = 8,             // EXCITE is entered from STOP only
+  kOutsideExcitationGuard = 9, // EXCITE with the piston outside the excitation's guard lines
+  kExcitationInvalid = 10,     // excitation settings that do not validate together (excitation_problem)
 };
 
-// The state-dependent and range rules for one command in mode `mode`. kRecordQueueFull is the
-// loop's own (only it sees the recorder's queue). noexcept and allocation-free: the loop calls it.
-CommandRefusal check_command(const Command& c, Mode mode, const RuntimeConfig& config) noexcept;
+// The state-dependent and range rules for one command in mode `mode` with the piston at
+// `position_mm` (the last reading). `excitation` holds the settings EXCITE would start with.
+// kRecordQueueFull is the loop's own (only it sees the recorder's queue). noexcept and
+// allocation-free: the loop calls it.
+CommandRefusal check_command(const Command& c, Mode mode, double position_mm, const ExcitationSettings& excitation,
+                             const RuntimeConfig& config) noexcept;
 
 std::string_view describe(CommandRefusal r);  // for logs, the audit trail and HTTP answers
 

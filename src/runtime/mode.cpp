@@ -10,6 +10,7 @@ std::string_view to_string(Mode mode) {
     case Mode::kRun: return "run";
     case Mode::kManual: return "manual";
     case Mode::kFault: return "fault";
+    case Mode::kExcite: return "excite";
   }
   return "?";
 }
@@ -51,9 +52,9 @@ std::string_view describe(FaultCode code) {
 }
 
 core::Result<Mode> parse_mode(std::string_view name) {
-  for (Mode m : {Mode::kStop, Mode::kRun, Mode::kManual})
+  for (Mode m : {Mode::kStop, Mode::kRun, Mode::kManual, Mode::kExcite})
     if (to_string(m) == name) return m;
-  return core::invalid_argument("mode '" + std::string(name) + "' is not one of stop, run, manual");
+  return core::invalid_argument("mode '" + std::string(name) + "' is not one of stop, run, manual, excite");
 }
 
 }  // namespace epa::runtime

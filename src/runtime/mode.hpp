@@ -13,6 +13,7 @@ enum class Mode : std::uint8_t {
   kRun = 1,     // closed loop on the setpoint
   kManual = 2,  // open-loop valve command within the manual limit
   kFault = 3,   // latched: valve safe until an explicit reset
+  kExcite = 4,  // the open-loop identification experiment; back to STOP by itself when it ends
 };
 
 enum class FaultCode : std::uint8_t {
@@ -32,6 +33,6 @@ enum class FaultCode : std::uint8_t {
 std::string_view to_string(Mode mode);
 std::string_view to_string(FaultCode code);
 std::string_view describe(FaultCode code);  // a sentence for an operator
-core::Result<Mode> parse_mode(std::string_view name);  // "stop", "run", "manual"
+core::Result<Mode> parse_mode(std::string_view name);  // "stop", "run", "manual", "excite"
 
 }  // namespace epa::runtime

@@ -3,10 +3,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 
+#include "core/audit.hpp"
 #include "core/format.hpp"
 #include "core/run_file.hpp"
+#include "core/utc_stamp.hpp"
 
 namespace epa::runtime {
 
@@ -48,15 +51,37 @@ std::string Recorder::last_file() const {
   return last_file_;
 }
 
+namespace {
+
+const char* to_string(ExcitationEnd how) {
+  switch (how) {
+    case ExcitationEnd::kComplete: return "complete";
+    case ExcitationEnd::kStopped: return "stopped";
+    case ExcitationEnd::kFault: return "fault";
+  }
+  return "?";
+}
+
+// UTC, to the second: an experiment's file is never overwritten by one of a later start.
+std::string utc_stamp() { return core::utc_stamp(core::unix_time_ms()); }
+
+}  // namespace
+
 void Recorder::write(const RecordRequest& request) {
   core::Run run;
   run.Ts = config_.Ts;
-  run.set_meta("controller", std::string(control::to_string(request.controller)));
+  // As FORMATS.md: open-loop when no controller drove the samples, so `epa identify` takes them as
+  // open-loop data.
+  run.set_meta("controller", request.open_loop ? "open-loop" : std::string(control::to_string(request.controller)));
   run.set_meta("source", config_.source);
   const auto first = ch_.samples.copy_out(request.first, request.end, run);
   if (run.size() == 0) {
     if (log_) log_("recorder: no samples left to write (the ring was overwritten)");
     return;
+  }
+  if (request.open_loop) {  // no reference and no controller output: only what the valve got and the piston did
+    run.r_mm.clear();
+    run.uc_V.clear();
   }
   // Times restart at 0 so the file is a step response from its first sample.
   const double t0 = run.t_s.front();
@@ -70,6 +95,20 @@ void Recorder::write(const RecordRequest& request) {
     run.set_meta("step_mm", core::format_number(m.to_mm - m.from_mm));
     std::snprintf(name, sizeof name, "move-%04u-%s-%gto%gmm.csv", m.number,
                   std::string(control::to_string(request.controller)).c_str(), m.from_mm, m.to_mm);
+  } else if (request.reason == RecordRequest::Reason::kExcitation) {
+    const auto& e = request.excitation;  // the keys `epa excite` writes, and the rest of the settings
+    run.set_meta("excitation_seed", std::to_string(e.seed));
+    run.set_meta("amplitude_max_V", core::format_number(e.amplitude_max_v));
+    run.set_meta("amplitude_min_V", core::format_number(e.amplitude_min_v));
+    run.set_meta("duration_s", core::format_number(e.duration_s));
+    run.set_meta("guard_mm", core::format_number(e.guard_mm));
+    run.set_meta("excitation_end", to_string(request.excitation_end));
+    run.set_meta("pulses", std::to_string(request.pulses));
+    run.set_meta("pulses_cut", std::to_string(request.pulses_cut));
+    if (first != request.first) run.set_meta("samples_lost", std::to_string(first - request.first));
+    std::snprintf(name, sizeof name, "excite-%s-%04llu-seed%lu%s.csv", utc_stamp().c_str(),
+                  static_cast<unsigned long long>(++excitation_count_), static_cast<unsigned long>(e.seed),
+                  request.excitation_end == ExcitationEnd::kComplete ? "" : request.excitation_end == ExcitationEnd::kFault ? "-fault" : "-stopped");
   } else {
     std::snprintf(name, sizeof name, "record-%04llu-sample%llu.csv", static_cast<unsigned long long>(++request_count_),
                   static_cast<unsigned long long>(first));

@@ -1,8 +1,8 @@
 #pragma once
 // The run recorder's writer: a thread that takes RecordRequests from the loop and writes the
 // requested samples from the SampleRing as epa-run/1 files, off the real-time thread, so a rig's
-// runs feed `epa identify` and `epa diagnose` directly. One file per move (if enabled) and one
-// per explicit request.
+// runs feed `epa identify` and `epa diagnose` directly. One file per move (if enabled), one per
+// explicit request, and one per excitation experiment (EXCITE), complete or ended early.
 #include <atomic>
 #include <functional>
 #include <mutex>
@@ -51,6 +51,7 @@ class Recorder {
   std::thread thread_;
   std::atomic<std::uint64_t> files_written_{0};
   std::uint64_t request_count_ = 0;
+  std::uint64_t excitation_count_ = 0;
   mutable std::mutex last_file_mutex_;
   std::string last_file_;
 };

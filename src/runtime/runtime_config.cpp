@@ -1,5 +1,6 @@
 #include "runtime/runtime_config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -25,6 +26,9 @@ core::Status validate(const RuntimeConfig& c) {
   if (c.record_buffer_s / c.period_s > kMaxBufferSamples)
     return core::invalid_argument("record_buffer_s / period_s is " + core::format_number(c.record_buffer_s / c.period_s) +
                                   " samples, more than the recorder keeps (" + core::format_number(kMaxBufferSamples) + ")");
+  if ((c.excitation.duration_s + kExcitationRecorderSlackS) / c.period_s > kMaxBufferSamples)
+    return core::invalid_argument("[excite] duration_s / period_s is " + core::format_number(c.excitation.duration_s / c.period_s) +
+                                  " samples, more than the recorder keeps (" + core::format_number(kMaxBufferSamples) + ")");
   if (c.move_window_s / c.period_s > kMaxBufferSamples)
     return core::invalid_argument("move_window_s / period_s is " + core::format_number(c.move_window_s / c.period_s) +
                                   " samples, more than a move is measured over (" + core::format_number(kMaxBufferSamples) + ")");
@@ -42,12 +46,25 @@ core::Status validate(const RuntimeConfig& c) {
   if (!(c.sensor_frozen_drive_v > 0.0)) return core::invalid_argument("sensor_frozen_drive_v must be > 0 V");
   if (c.max_consecutive_io_errors < 1) return core::invalid_argument("max_consecutive_io_errors must be >= 1");
   if (c.max_consecutive_overruns < 1) return core::invalid_argument("max_consecutive_overruns must be >= 1");
-  if (c.start_mode == Mode::kFault || c.start_mode == Mode::kManual)
-    return core::invalid_argument("start mode must be stop or run");
+  if (c.start_mode != Mode::kStop && c.start_mode != Mode::kRun)
+    return core::invalid_argument("start mode must be stop or run (manual and excite are entered by command)");
   if (c.start_setpoint_mm < c.setpoint_min_mm || c.start_setpoint_mm > c.setpoint_max_mm)
     return core::invalid_argument("start setpoint " + core::format_number(c.start_setpoint_mm) + " mm lies outside the setpoint range");
   if (c.move_window_s > c.record_buffer_s) return core::invalid_argument("move_window_s must not exceed record_buffer_s");
+  if (const char* problem = excitation_problem(c.excitation, c)) {
+    const auto& e = c.excitation;
+    return core::invalid_argument(std::string("[excite] ") + problem + " (amplitude_min_v " + core::format_number(e.amplitude_min_v) +
+                                  ", amplitude_max_v " + core::format_number(e.amplitude_max_v) + ", duration_s " +
+                                  core::format_number(e.duration_s) + ", guard_mm " + core::format_number(e.guard_mm) +
+                                  "; soft limits [" + core::format_number(c.soft_min_mm) + ", " + core::format_number(c.soft_max_mm) + "] mm)");
+  }
   return core::ok();
+}
+
+std::size_t record_capacity_samples(const RuntimeConfig& c) {
+  const auto buffer = static_cast<std::size_t>(c.record_buffer_s / c.period_s);
+  const auto excitation = static_cast<std::size_t>(std::ceil((c.excitation.duration_s + kExcitationRecorderSlackS) / c.period_s));
+  return std::max(buffer, excitation);
 }
 
 }  // namespace epa::runtime

@@ -1,8 +1,11 @@
 #pragma once
 // Everything the scan cycle needs to know besides the controller parameters, with the defaults
 // of config/epa.toml. Validated once at start-up; the messages name the setting.
+#include <cstddef>
+
 #include "control/controller_kind.hpp"
 #include "core/result.hpp"
+#include "runtime/excitation_settings.hpp"
 #include "runtime/mode.hpp"
 
 namespace epa::runtime {
@@ -14,7 +17,7 @@ struct RuntimeConfig {
   double sensor_gain = 1.0;
 
   double sensor_min_v = -0.2, sensor_max_v = 10.2;  // outside: broken wire or wrong scaling
-  double soft_min_mm = -2.0, soft_max_mm = 502.0;   // fault when the piston leaves them in RUN/MANUAL
+  double soft_min_mm = -2.0, soft_max_mm = 502.0;   // fault when the piston leaves them in RUN/MANUAL/EXCITE
   double setpoint_min_mm = 0.0, setpoint_max_mm = 500.0;
   double manual_valve_limit_v = 3.0;
   double safe_valve_v = 0.0;        // 5/3 valve centred
@@ -34,9 +37,15 @@ struct RuntimeConfig {
   FaultCode start_fault = FaultCode::kNone;  // latched from the first cycle (e.g. a damaged store)
 
   double move_window_s = 5.0;       // online metrics: each move is measured over this window
-  double record_buffer_s = 60.0;    // recorder ring: seconds of history kept in memory
+  double record_buffer_s = 60.0;    // recorder ring: seconds of history kept in memory (see below)
+
+  ExcitationSettings excitation;    // the experiment of mode EXCITE, [excite]
 };
 
 core::Status validate(const RuntimeConfig& config);
+
+// The recorder ring's size in samples: record_buffer_s, or more when the configured excitation
+// needs it (the whole experiment and kExcitationRecorderSlackS), so an experiment is written whole.
+std::size_t record_capacity_samples(const RuntimeConfig& config);
 
 }  // namespace epa::runtime

@@ -22,6 +22,7 @@ ScanCycle::ScanCycle(const RuntimeConfig& config, const Tuning& tuning, hal::Daq
       setpoint_mm_(config.start_setpoint_mm),
       manual_valve_v_(config.safe_valve_v),
       valve_v_(config.safe_valve_v),
+      excitation_settings_(config.excitation),
       moves_(config.move_window_s, config.period_s) {
   if (config.start_fault != FaultCode::kNone) {
     mode_ = Mode::kFault;  // before any start mode: a fault found before the start is latched
@@ -43,7 +44,7 @@ void ScanCycle::apply_commands(std::int64_t now_ns) noexcept {
 }
 
 void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
-  CommandRefusal refusal = check_command(c, mode_, config_);
+  CommandRefusal refusal = check_command(c, mode_, position_mm_, excitation_settings_, config_);
   if (refusal == CommandRefusal::kNone) {
     switch (c.kind) {
       case CommandKind::kSetpoint:
@@ -54,12 +55,19 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
         break;
       case CommandKind::kMode:
         if (c.mode != mode_) {
+          // Entered from STOP only (check_command), so no move or experiment is under way here.
+          if (c.mode == Mode::kExcite && !excitation_.start(excitation_settings_, config_, ch_.samples.written())) {
+            refusal = CommandRefusal::kExcitationInvalid;  // cannot happen: the settings were checked when taken
+            break;
+          }
           if (moves_.active()) finish_move();
+          if (mode_ == Mode::kExcite) end_excitation(ExcitationEnd::kStopped);
           if (c.mode == Mode::kRun) enter_run(now_ns);
           if (c.mode == Mode::kManual) {
             manual_valve_v_ = config_.safe_valve_v;  // never resume a stale manual command
             heartbeat_changed_ns_ = now_ns;
           }
+          if (c.mode == Mode::kExcite) heartbeat_changed_ns_ = now_ns;  // the client gets a full timeout from here
           mode_ = c.mode;
         }
         break;
@@ -81,12 +89,16 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
         }
         break;
       case CommandKind::kRecord: {
-        const auto end = ch_.samples.written();
+        RecordRequest r;
+        r.end = ch_.samples.written();
         const auto n = static_cast<std::uint64_t>(c.value / config_.period_s);
-        if (!ch_.record_requests.try_push({RecordRequest::Reason::kRequest, end > n ? end - n : 0, end, {}, controller_}))
-          refusal = CommandRefusal::kRecordQueueFull;
+        r.first = r.end > n ? r.end - n : 0;
+        r.controller = controller_;
+        r.open_loop = run_samples_end_ <= r.first;  // MANUAL, EXCITE, STOP only: no controller in the loop
+        if (!ch_.record_requests.try_push(r)) refusal = CommandRefusal::kRecordQueueFull;
         break;
       }
+      case CommandKind::kExcitation: excitation_settings_ = c.excitation; break;  // for the next EXCITE
     }
   }
   if (refusal == CommandRefusal::kNone) {
@@ -104,6 +116,21 @@ void ScanCycle::enter_run(std::int64_t now_ns) noexcept {
   following_error_since_ns_ = -1;
 }
 
+void ScanCycle::end_excitation(ExcitationEnd how) noexcept {
+  RecordRequest r;
+  r.reason = RecordRequest::Reason::kExcitation;
+  r.first = excitation_.first_sample();
+  r.end = ch_.samples.written();  // this cycle's sample is not the experiment's
+  r.controller = controller_;
+  r.open_loop = true;
+  r.excitation = excitation_.settings();
+  r.excitation_end = how;
+  r.pulses = static_cast<std::uint32_t>(excitation_.pulses());
+  r.pulses_cut = static_cast<std::uint32_t>(excitation_.pulses_cut());
+  excitation_.end();
+  if (r.end > r.first) ch_.record_requests.try_push(r);  // a full queue drops the file, never the loop
+}
+
 void ScanCycle::start_move() noexcept {
   if (moves_.active()) finish_move();
   moves_.start(position_mm_, setpoint_mm_, ch_.samples.written());
@@ -111,8 +138,13 @@ void ScanCycle::start_move() noexcept {
 
 void ScanCycle::finish_move() noexcept {
   last_move_ = moves_.finish();
-  ch_.record_requests.try_push({RecordRequest::Reason::kMove, last_move_.first_sample, last_move_.end_sample, last_move_,
-                                controller_});  // a full queue drops the file, never the loop
+  RecordRequest r;
+  r.reason = RecordRequest::Reason::kMove;
+  r.first = last_move_.first_sample;
+  r.end = last_move_.end_sample;
+  r.move = last_move_;
+  r.controller = controller_;
+  ch_.record_requests.try_push(r);  // a full queue drops the file, never the loop
 }
 
 FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
@@ -124,7 +156,7 @@ FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
     if (!std::isfinite(sensor_v_)) return FaultCode::kSensorNotFinite;
     if (sensor_v_ < config_.sensor_min_v || sensor_v_ > config_.sensor_max_v) return FaultCode::kSensorOutOfRange;
   }
-  const bool moving = mode_ == Mode::kRun || mode_ == Mode::kManual;
+  const bool moving = mode_ == Mode::kRun || mode_ == Mode::kManual || mode_ == Mode::kExcite;
   if (!moving) return FaultCode::kNone;
   if (read_ok && (position_mm_ < config_.soft_min_mm || position_mm_ > config_.soft_max_mm)) return FaultCode::kSoftLimit;
   if (config_.heartbeat_timeout_s > 0.0 &&
@@ -155,6 +187,7 @@ FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
 
 void ScanCycle::enter_fault(FaultCode code) noexcept {
   if (moves_.active()) finish_move();
+  if (mode_ == Mode::kExcite) end_excitation(ExcitationEnd::kFault);
   mode_ = Mode::kFault;
   fault_ = code;
   ++faults_;
@@ -205,6 +238,17 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
       }
       break;
     case Mode::kManual: valve_v_ = manual_valve_v_; controller_v_ = 0.0; break;
+    case Mode::kExcite:
+      controller_v_ = 0.0;
+      if (excitation_.done()) {  // every command given: STOP by itself, the valve safe in this cycle
+        end_excitation(ExcitationEnd::kComplete);
+        mode_ = Mode::kStop;
+        valve_v_ = config_.safe_valve_v;
+        break;
+      }
+      if (!read_ok) break;  // hold the last command for a missed sample, as RUN does
+      valve_v_ = excitation_.next(position_mm_);
+      break;
     case Mode::kStop:
     case Mode::kFault: valve_v_ = config_.safe_valve_v; controller_v_ = 0.0; break;
   }
@@ -219,6 +263,7 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
   }
 
   ch_.samples.push({static_cast<double>(cycle_) * config_.period_s, setpoint_mm_, position_mm_, valve_v_, controller_v_});
+  if (mode_ == Mode::kRun) run_samples_end_ = ch_.samples.written();
   if (mode_ == Mode::kRun && moves_.active() && moves_.add(position_mm_)) finish_move();
   ++cycle_;
   publish();
@@ -248,6 +293,8 @@ void ScanCycle::publish(bool full_stats) noexcept {
   s.commands_applied = applied_;
   s.commands_rejected = rejected_;
   s.last_refusal = last_refusal_;
+  s.excitation = excitation_settings_;
+  s.excitation_left_s = excitation_.left_s();
   const auto& m = last_move_.metrics;
   s.last_move = {last_move_.number, last_move_.from_mm, last_move_.to_mm, or_nan(m.rise_s), or_nan(m.settling_s),
                  last_move_.number ? m.ess_mm : kNaN, or_nan(m.overshoot_pct)};
@@ -287,6 +334,7 @@ void ScanCycle::run(const std::atomic<bool>& stop) noexcept {
 
 void ScanCycle::shut_down() noexcept {
   if (moves_.active()) finish_move();
+  if (mode_ == Mode::kExcite) end_excitation(ExcitationEnd::kStopped);
   valve_v_ = config_.safe_valve_v;
   daq_.write_valve(valve_v_);
   if (mode_ != Mode::kFault) mode_ = Mode::kStop;

@@ -1,8 +1,8 @@
 #pragma once
 // The PLC-style scan cycle: every period Ts it applies queued commands, reads the sensor through
-// the DAQ, checks for faults, steps the active controller (or holds the valve safe / manual),
-// writes the valve, records the sample and publishes a snapshot. One cycle never allocates,
-// blocks on other threads, or does I/O other than the DAQ's.
+// the DAQ, checks for faults, steps the active controller (or holds the valve safe / manual, or
+// steps the excitation experiment), writes the valve, records the sample and publishes a
+// snapshot. One cycle never allocates, blocks on other threads, or does I/O other than the DAQ's.
 //
 // Timing (the same as sim::simulate_step): at cycle k the sensor is read, u(k) is computed and
 // written at once, and held until k+1. Against the sim backend, which steps its plant on each
@@ -16,6 +16,7 @@
 #include "runtime/command.hpp"
 #include "runtime/command_rules.hpp"
 #include "runtime/command_queue.hpp"
+#include "runtime/excitation_run.hpp"
 #include "runtime/loop_stats.hpp"
 #include "runtime/move_tracker.hpp"
 #include "runtime/runtime_config.hpp"
@@ -29,10 +30,14 @@ namespace epa::runtime {
 
 // Asks the recorder thread to write samples [first, end) as a run file.
 struct RecordRequest {
-  enum class Reason : std::uint8_t { kMove, kRequest } reason = Reason::kRequest;
+  enum class Reason : std::uint8_t { kMove, kRequest, kExcitation } reason = Reason::kRequest;
   std::uint64_t first = 0, end = 0;
   MoveResult move;  // for kMove
   control::ControllerKind controller = control::ControllerKind::kPpFfidz;
+  bool open_loop = false;  // no controller drove any of the samples (MANUAL, EXCITE, STOP): controller=open-loop
+  ExcitationSettings excitation;                          // for kExcitation
+  ExcitationEnd excitation_end = ExcitationEnd::kComplete;  // for kExcitation
+  std::uint32_t pulses = 0, pulses_cut = 0;                 // for kExcitation: pulses given, and cut at a guard line
 };
 
 inline constexpr std::size_t kCommandQueueCapacity = 64;
@@ -68,6 +73,7 @@ class ScanCycle {
   void apply_commands(std::int64_t now_ns) noexcept;
   void apply(const Command& c, std::int64_t now_ns) noexcept;
   void enter_run(std::int64_t now_ns) noexcept;
+  void end_excitation(ExcitationEnd how) noexcept;
   void start_move() noexcept;
   void finish_move() noexcept;
   FaultCode detect_fault(bool read_ok, std::int64_t now_ns) noexcept;
@@ -97,6 +103,10 @@ class ScanCycle {
   std::int64_t heartbeat_changed_ns_ = 0;
   std::uint64_t cycle_ = 0, faults_ = 0, io_errors_ = 0, applied_ = 0, rejected_ = 0;
   CommandRefusal last_refusal_ = CommandRefusal::kNone;
+  std::uint64_t run_samples_end_ = 0;  // one past the last sample a controller drove (RUN): labels recordings
+
+  ExcitationSettings excitation_settings_;  // what the next EXCITE starts with
+  ExcitationRun excitation_;                // the running experiment
 
   MoveTracker moves_;
   MoveResult last_move_;

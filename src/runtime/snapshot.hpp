@@ -7,6 +7,7 @@
 #include "control/controller_kind.hpp"
 #include "control/rst_law.hpp"
 #include "runtime/command_rules.hpp"
+#include "runtime/excitation_settings.hpp"
 #include "runtime/loop_stats.hpp"
 #include "runtime/mode.hpp"
 
@@ -38,6 +39,8 @@ struct Snapshot {
   std::uint32_t heartbeat = 0;
   std::uint64_t moves = 0, faults = 0, io_errors = 0, commands_applied = 0, commands_rejected = 0;
   CommandRefusal last_refusal = CommandRefusal::kNone;  // why the loop last refused a command
+  ExcitationSettings excitation;  // what the next EXCITE starts with
+  double excitation_left_s = 0;   // of the running experiment; 0 when none runs
   MoveMetricsView last_move;
   LoopStatsView loop;
   TuningView tuning;

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <system_error>
 
+#include "core/utc_stamp.hpp"
 #include "store/model_table.hpp"
 #include "store/schema.hpp"
 #include "store/statement.hpp"
@@ -64,12 +65,7 @@ core::Status move_aside(const std::string& path, const std::string& target) {
 }  // namespace
 
 std::string moved_aside_name(const std::string& path, std::int64_t now_ms) {
-  const std::time_t t = static_cast<std::time_t>(now_ms / 1000);
-  std::tm utc{};
-  gmtime_r(&t, &utc);
-  char stamp[32];
-  std::strftime(stamp, sizeof stamp, "%Y%m%dT%H%M%SZ", &utc);
-  return path + ".corrupt-" + stamp;
+  return path + ".corrupt-" + core::utc_stamp(now_ms);
 }
 
 core::Status seed_if_empty(Database& db, const StoreSeed& seed, std::int64_t now_ms, bool* seeded) {

@@ -6,6 +6,7 @@
 #include "store/audit_log.hpp"
 #include "store/retained_points.hpp"
 #include "store/run_table.hpp"
+#include "store/set_activation.hpp"
 #include "store/transaction.hpp"
 #include "points/point_catalog.hpp"
 #include "store/tuning_points.hpp"
@@ -54,6 +55,19 @@ void StoreWriter::record_run(const RunRecord& run) {
   wake_.notify_one();
 }
 
+void StoreWriter::switch_running_set(const TuningSet& set, bool persist, const std::string& source) {
+  {
+    std::lock_guard lock(mutex_);
+    pending_.emplace_back(SetSwitch{set, persist, source});
+  }
+  wake_.notify_one();
+}
+
+TuningSet StoreWriter::running_set() const {
+  std::lock_guard lock(mutex_);
+  return running_;
+}
+
 core::ChangeCounters StoreWriter::counters() const {
   std::lock_guard lock(mutex_);
   return {accepted_, saved_.load(), health_.ok};
@@ -78,6 +92,15 @@ core::Status StoreWriter::write(const std::deque<Item>& batch, TuningSet& runnin
       RunRecord r = *run;
       r.tuning_set_id = running.id;
       if (auto id = runs.insert(r); !id) return id.error();
+      continue;
+    }
+    if (const auto* sw = std::get_if<SetSwitch>(&item)) {
+      if (tuning_changed)  // the edits so far belong to the set that ran until now
+        if (auto s = TuningSetTable(db_).update(running); !s) return s;
+      tuning_changed = false;
+      running = sw->set;
+      if (sw->persist)
+        if (auto s = activate_audited(db_, sw->set.id, sw->source); !s) return s;
       continue;
     }
     for (const core::AuditEntry& e : std::get<std::vector<core::AuditEntry>>(item)) {
@@ -119,7 +142,7 @@ bool StoreWriter::flush() {
   health_.ok = true;
   running_ = running;
   std::uint64_t changes = 0;
-  for (const Item& item : batch) changes += std::holds_alternative<RunRecord>(item) ? 0 : 1;
+  for (const Item& item : batch) changes += std::holds_alternative<std::vector<core::AuditEntry>>(item) ? 1 : 0;
   pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(batch.size()));
   saved_.fetch_add(changes);
   return true;

@@ -50,15 +50,25 @@ class StoreWriter final : public core::AuditSink {
   void record(const std::vector<core::AuditEntry>& change) override;
   core::ChangeCounters counters() const override;
   void record_run(const RunRecord& run);
+  // The loop runs `set` from now on (the write gate switched it): persisted tuning points edit its
+  // row from here on, in order with the changes before. `persist`: it also becomes the store's
+  // active set (audited "active_tuning_set" with `source`), what the next start loads.
+  void switch_running_set(const TuningSet& set, bool persist, const std::string& source);
 
   StoreHealth health() const;
-  std::int64_t running_set_id() const { return running_.id; }
+  // The set the loop runs, as of the last write (a switch still pending is not in it yet).
+  TuningSet running_set() const;
 
   // One write attempt of everything pending (the thread calls this; tests may call it directly).
   bool flush();
 
  private:
-  using Item = std::variant<std::vector<core::AuditEntry>, RunRecord>;
+  struct SetSwitch {
+    TuningSet set;
+    bool persist = false;
+    std::string source;
+  };
+  using Item = std::variant<std::vector<core::AuditEntry>, RunRecord, SetSwitch>;
   core::Status write(const std::deque<Item>& batch, TuningSet& running);
   void loop();
 

@@ -23,7 +23,7 @@ std::optional<double> value_of(P id, const json& v, std::string& error) {
   if (v.is_string() && id == P::kMode) {
     auto m = runtime::parse_mode(v.get<std::string>());
     if (m && *m != runtime::Mode::kFault) return static_cast<double>(*m);
-    error = point + " must be one of \"stop\", \"run\", \"manual\"";
+    error = point + " must be one of \"stop\", \"run\", \"manual\", \"excite\"";
     return std::nullopt;
   }
   if (v.is_string() && id == P::kController) {
@@ -57,9 +57,9 @@ CommandBody parse_command_body(CommandEndpoint endpoint, const std::string& body
       if (k != key) return malformed("unknown field '" + k + "' (expected '" + key + "')");
     if (!j.contains(key))
       return malformed(id == P::kSetpoint ? key + " must be a number, e.g. {\"" + key + "\": 120}"
-                                          : key + " must be one of \"stop\", \"run\", \"manual\"");
+                                          : key + " must be one of \"stop\", \"run\", \"manual\", \"excite\"");
     std::string error;
-    if (id == P::kMode && !j[key].is_string()) return malformed(key + " must be one of \"stop\", \"run\", \"manual\"");
+    if (id == P::kMode && !j[key].is_string()) return malformed(key + " must be one of \"stop\", \"run\", \"manual\", \"excite\"");
     if (id == P::kSetpoint && !j[key].is_number()) return malformed(key + " must be a number, e.g. {\"" + key + "\": 120}");
     auto v = value_of(id, j[key], error);
     if (!v) return malformed(error);

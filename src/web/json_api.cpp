@@ -56,6 +56,7 @@ std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, b
       {"controller_v", num(s.controller_v)},
       {k(P::kManualValve), num(s.manual_valve_v)},
       {k(P::kHeartbeat), s.heartbeat},
+      {k(P::kExciteLeft), num(s.excitation_left_s)},
       {"counters",
        {{k(P::kMoves), s.moves}, {k(P::kFaults), s.faults}, {k(P::kIoErrors), s.io_errors},
         {k(P::kCommandsApplied), s.commands_applied}, {k(P::kCommandsRejected), s.commands_rejected},

@@ -14,6 +14,7 @@
 #include "core/address_backoff.hpp"
 #include "runtime/clock.hpp"
 #include "web/command_body.hpp"
+#include "web/commission_port.hpp"
 #include "web/deadline_http_server.hpp"
 #include "web/elastic_task_queue.hpp"
 #include "web/prometheus.hpp"
@@ -80,6 +81,7 @@ struct WebServer::Impl {
   RecentAudit* audit;
   ModbusStatsFn modbus_stats;
   StoreStatsFn store_stats;
+  CommissionPort* commission;
   DeadlineHttpServer server;
   TrendBuffer trend;
   std::string chart_js;
@@ -97,13 +99,15 @@ struct WebServer::Impl {
   core::AddressBackoff token_guesses;  // by client address, under token_mutex
   runtime::MonotonicClock clock;
 
-  Impl(const WebConfig& c, runtime::LoopChannels& ch, points::WriteGate* g, RecentAudit* a, ModbusStatsFn m, StoreStatsFn st)
+  Impl(const WebConfig& c, runtime::LoopChannels& ch, points::WriteGate* g, RecentAudit* a, ModbusStatsFn m, StoreStatsFn st,
+       CommissionPort* cp)
       : config(c),
         channels(ch),
         gate(g),
         audit(a),
         modbus_stats(std::move(m)),
         store_stats(std::move(st)),
+        commission(cp),
         server(request_limits(c)) {}
 
   static RequestLimits request_limits(const WebConfig& c) {
@@ -188,6 +192,44 @@ struct WebServer::Impl {
     res.set_content(R"({"accepted":true})", kJson);
   }
 
+  // Commissioning (issue 19): starting and aborting need the token; progress, result and report
+  // are read like the status.
+  void commission_routes() {
+    auto& s = server;
+    auto none = [](httplib::Response& res) { send_error(res, 404, "this appliance runs no commissioning service"); };
+    s.Get("/api/commission", [this, none](const httplib::Request&, httplib::Response& res) {
+      if (!commission) return none(res);
+      res.set_content(commission->status_json(), kJson);
+    });
+    s.Get("/api/commission/result", [this, none](const httplib::Request&, httplib::Response& res) {
+      if (!commission) return none(res);
+      const auto j = commission->result_json();
+      if (!j) return send_error(res, 404, "no commissioning run has ended yet");
+      res.set_content(*j, kJson);
+    });
+    s.Get("/api/commission/report", [this, none](const httplib::Request&, httplib::Response& res) {
+      if (!commission) return none(res);
+      const auto html = commission->report_html();
+      if (!html) return send_error(res, 404, "no commissioning run has ended yet");
+      res.set_content(*html, "text/html; charset=utf-8");
+    });
+    s.Post("/api/commission", [this, none](const httplib::Request& req, httplib::Response& res) {
+      if (!authorised(req, res)) return;
+      if (!commission) return none(res);
+      const auto r = commission->start(req.body, "web " + req.remote_addr);
+      if (r.result == points::CommissionStart::kBadSpec) return send_error(res, 400, r.message);
+      if (r.result == points::CommissionStart::kBusy) return send_error(res, 409, r.message);
+      res.status = 202;
+      res.set_content(R"({"accepted":true})", kJson);
+    });
+    s.Post("/api/commission/abort", [this, none](const httplib::Request& req, httplib::Response& res) {
+      if (!authorised(req, res)) return;
+      if (!commission) return none(res);
+      if (!commission->abort("web " + req.remote_addr)) return send_error(res, 409, "no commissioning run is under way");
+      res.set_content(R"({"accepted":true})", kJson);
+    });
+  }
+
   void routes() {
     auto& s = server;
     s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
@@ -244,6 +286,7 @@ struct WebServer::Impl {
     s.Post("/api/mode", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kMode, q, r); });
     s.Post("/api/reset", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kReset, q, r); });
     s.Post("/api/points", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kPoints, q, r); });
+    commission_routes();
     s.Get(R"(/.*)", [this](const httplib::Request& q, httplib::Response& r) { serve_static(q, r); });  // last: the page
 
     // Every error leaves as JSON: httplib's own (404 no route, 413 payload too large, 400 bad request) included.
@@ -273,9 +316,10 @@ struct WebServer::Impl {
 
 core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& config, runtime::LoopChannels& channels,
                                                           points::WriteGate* gate, RecentAudit* audit,
-                                                          ModbusStatsFn modbus_stats, StoreStatsFn store_stats) {
+                                                          ModbusStatsFn modbus_stats, StoreStatsFn store_stats,
+                                                   CommissionPort* commission) {
   if (config.worker_threads < 1) return core::invalid_argument("web: worker_threads must be >= 1");
-  auto impl = std::make_unique<Impl>(config, channels, gate, audit, std::move(modbus_stats), std::move(store_stats));
+  auto impl = std::make_unique<Impl>(config, channels, gate, audit, std::move(modbus_stats), std::move(store_stats), commission);
   if (!std::filesystem::is_directory(config.static_dir))
     return core::io_error("web: static_dir '" + config.static_dir + "' is not a folder (it holds index.html, app.js, style.css)");
   impl->static_root = std::filesystem::canonical(config.static_dir);

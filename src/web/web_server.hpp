@@ -31,6 +31,7 @@ struct WebConfig {
 };
 
 class RecentAudit;
+class CommissionPort;
 
 class WebServer {
  public:
@@ -38,10 +39,12 @@ class WebServer {
   using StoreStatsFn = std::function<StoreStats()>;
   // Binds, then serves on its own thread. channels, gate and audit must outlive the server.
   // `gate` takes the commands (null: commands answer 503); `audit` may be null, else /api/audit
-  // shows its entries (the gate records through it).
+  // shows its entries (the gate records through it). `commission` may be null (then /api/commission
+  // answers 404); it must outlive the server.
   static core::Result<std::unique_ptr<WebServer>> start(const WebConfig& config, runtime::LoopChannels& channels,
                                                         points::WriteGate* gate, RecentAudit* audit,
-                                                        ModbusStatsFn modbus_stats = {}, StoreStatsFn store_stats = {});
+                                                        ModbusStatsFn modbus_stats = {}, StoreStatsFn store_stats = {},
+                                                        CommissionPort* commission = nullptr);
   ~WebServer();
   WebServer(const WebServer&) = delete;
   WebServer& operator=(const WebServer&) = delete;

@@ -90,6 +90,38 @@ TEST(ApplianceConfig, CrossFieldRulesAreChecked) {
   EXPECT_NE(error_of("[hal.modbus_io]\nsensor = { tabel = \"input\" }\n").find("hal.modbus_io.sensor.tabel"), std::string::npos);
 }
 
+TEST(ApplianceConfig, TheExcitationSettingsAreReadAndTheirRulesNameTheKey) {
+  auto shipped = read_appliance_config(kShipped);
+  ASSERT_TRUE(shipped.has_value()) << shipped.error().message;
+  const runtime::ExcitationSettings defaults;
+  EXPECT_EQ(shipped->runtime.excitation.seed, defaults.seed);
+  EXPECT_EQ(shipped->runtime.excitation.amplitude_min_v, defaults.amplitude_min_v);
+  EXPECT_EQ(shipped->runtime.excitation.amplitude_max_v, defaults.amplitude_max_v);
+  EXPECT_EQ(shipped->runtime.excitation.duration_s, defaults.duration_s);
+  EXPECT_EQ(shipped->runtime.excitation.guard_mm, defaults.guard_mm);
+
+  auto c = parse_appliance_config("[excite]\nseed = 4000000000\namplitude_min_v = 0.5\namplitude_max_v = 2.5\n"
+                                  "duration_s = 120.0\nguard_mm = 80.0\n", "x.toml");
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  EXPECT_EQ(c->runtime.excitation.seed, 4000000000u);
+  EXPECT_EQ(c->runtime.excitation.amplitude_max_v, 2.5);
+  EXPECT_EQ(c->runtime.excitation.guard_mm, 80.0);
+  // The recorder keeps the whole experiment, even beyond [recorder] buffer_s (60 s).
+  EXPECT_GE(runtime::record_capacity_samples(c->runtime), static_cast<std::size_t>(121.0 / 0.005));
+
+  const auto range = error_of("[excite]\namplitude_max_v = 12.0\n");
+  EXPECT_NE(range.find("test.toml:2:"), std::string::npos) << range;
+  EXPECT_NE(range.find("excite.amplitude_max_v"), std::string::npos) << range;
+  EXPECT_NE(error_of("[excite]\nseed = -1\n").find("excite.seed"), std::string::npos);
+  EXPECT_NE(error_of("[excite]\nduration = 10.0\n").find("excite.duration"), std::string::npos);  // misspelt: refused
+  const auto crossed = error_of("[excite]\namplitude_min_v = 2.0\namplitude_max_v = 1.0\n");
+  EXPECT_NE(crossed.find("[excite]"), std::string::npos) << crossed;
+  EXPECT_NE(crossed.find("amplitude_min_v"), std::string::npos) << crossed;
+  const auto guard = error_of("[excite]\nguard_mm = 300.0\n");  // the soft limits span 504 mm
+  EXPECT_NE(guard.find("guard_mm"), std::string::npos) << guard;
+  EXPECT_NE(error_of("[startup]\nmode = \"excite\"\n").find("startup.mode"), std::string::npos);  // by command only
+}
+
 TEST(ApplianceConfig, ScalingIsGivenAsFullScaleVolts) {
   auto c = parse_appliance_config("[hal.modbus_io]\nsensor = { full_scale_v = 5.0 }\n", "t.toml");
   ASSERT_TRUE(c.has_value()) << c.error().message;

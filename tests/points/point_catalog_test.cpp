@@ -47,6 +47,8 @@ const std::map<std::string, std::string> kFormatFiles = {
     {"ident/excitation.cpp", "epa-run/1 metadata"},
     {"sim/closed_loop.cpp", "epa-run/1 metadata"},
     {"app/identify_report.cpp", "a report's row labels"},
+    {"commission/commission_spec.cpp", "the commissioning spec's keys"},
+    {"commission/commission_sequence.cpp", "epa-commission/1 keys"},
     {"app/tuning_command.cpp", "epa tuning show's labels"},
     {"web/json_api.cpp", "the loop statistics' cycle count and the recent-moves list, other values than the points"},
 };

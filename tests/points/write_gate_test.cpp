@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <utility>
+
 #include <cmath>
 #include <limits>
 
@@ -127,6 +129,50 @@ TEST(WriteGate, RightsLockAndAccessAreCheckedAfterTheValues) {
   EXPECT_EQ(sink.entries[0].point, "lc_mm");
 }
 
+// A commissioning service that records the calls the gate made.
+struct FakeCommission final : CommissionControl {
+  CommissionStartResult start(const std::string& spec, const std::string& source) override {
+    if (running) return {CommissionStart::kBusy, "a commissioning run is under way"};
+    running = true;
+    starts.push_back(source + (spec.empty() ? "" : " " + spec));
+    return {};
+  }
+  bool abort(const std::string&) override { return std::exchange(running, false); }
+  CommissionView view() const override { return {true, running, running ? 1 : 0, 0, 0.0}; }
+  bool running = false;
+  std::vector<std::string> starts;
+};
+
+TEST(WriteGate, CommissionCommandIsUnlockProtectedWrittenAloneAndGoesToTheServiceNotTheLoop) {
+  const runtime::RuntimeConfig config;
+  runtime::LoopChannels channels(16);
+  RecordingSink sink;
+  WriteGate gate(limits_of(config), config, paper(), channels, &sink);
+  const PointWrite start{PointId::kCommissionCommand, 1.0}, abort{PointId::kCommissionCommand, 2.0};
+  EXPECT_EQ(gate.submit({&start, 1}, kOperator).refusal, Refusal::kNotWritable);  // no service attached
+  FakeCommission service;
+  gate.attach_commission(&service);
+  EXPECT_EQ(gate.submit({&start, 1}, Requester{"modbus 127.0.0.1:5000", true, "", false}).refusal, Refusal::kForbidden);
+  const PointWrite three{PointId::kCommissionCommand, 3.0};
+  EXPECT_EQ(gate.submit({&three, 1}, kOperator).refusal, Refusal::kInvalidValue);
+  const std::vector<PointWrite> group = {{PointId::kSetpoint, 100.0}, {PointId::kCommissionCommand, 1.0}};
+  EXPECT_EQ(gate.submit(group, kOperator).refusal, Refusal::kInvalidValue);
+  EXPECT_TRUE(service.starts.empty());
+  EXPECT_TRUE(sink.entries.empty());
+
+  ASSERT_TRUE(gate.submit({&start, 1}, kOperator).accepted());
+  EXPECT_EQ(service.starts, std::vector<std::string>{"test"});
+  runtime::Command c;
+  EXPECT_FALSE(channels.commands.try_pop(c));  // nothing for the loop
+  EXPECT_TRUE(gate.commission_view().running);
+  EXPECT_EQ(gate.submit({&start, 1}, kOperator).refusal, Refusal::kConflict);  // one run at a time
+  ASSERT_TRUE(gate.submit({&abort, 1}, kOperator).accepted());
+  EXPECT_EQ(gate.submit({&abort, 1}, kOperator).refusal, Refusal::kConflict);  // nothing to abort
+  ASSERT_EQ(sink.entries.size(), 2u);
+  EXPECT_EQ(sink.entries[0].point, "commission_command");
+  EXPECT_DOUBLE_EQ(sink.entries[1].new_value, 2.0);
+}
+
 TEST(WriteGate, AGroupIsTakenWholeOrNotAtAll) {
   const runtime::RuntimeConfig config;
   runtime::LoopChannels channels(16);
@@ -147,6 +193,68 @@ TEST(WriteGate, AGroupIsTakenWholeOrNotAtAll) {
   EXPECT_EQ(sink.entries.size(), 4u);
 }
 
+TEST(WriteGate, ExcitationSettingsAreUnlockProtectedCheckedWholeAndQueuedBeforeTheModeChange) {
+  const runtime::RuntimeConfig config;
+  runtime::LoopChannels channels(16);
+  RecordingSink sink;
+  WriteGate gate(limits_of(config), config, paper(), channels, &sink);
+  runtime::Snapshot stopped;
+  stopped.position_mm = 250.0;
+  channels.snapshot.publish(stopped);
+
+  const PointWrite seed{PointId::kExciteSeed, 7.0};
+  EXPECT_EQ(gate.submit({&seed, 1}, Requester{"test", true, "", false}).refusal, Refusal::kForbidden);
+  const PointWrite crossed[] = {{PointId::kExciteAmplitudeMin, 2.5}, {PointId::kExciteAmplitudeMax, 2.0}};
+  const auto r = gate.submit(crossed, kOperator);
+  EXPECT_EQ(r.refusal, Refusal::kInvalidValue);
+  EXPECT_NE(r.reason.find("amplitude_min_v"), std::string::npos) << r.reason;
+  const PointWrite too_long{PointId::kExciteDuration, 120.0};  // the recorder keeps 60 s
+  const auto l = gate.submit({&too_long, 1}, kOperator);
+  EXPECT_EQ(l.refusal, Refusal::kInvalidValue);
+  EXPECT_NE(l.reason.find("[recorder] buffer_s"), std::string::npos) << l.reason;
+  EXPECT_TRUE(sink.entries.empty());
+
+  const PointWrite start[] = {{PointId::kMode, 4.0}, {PointId::kExciteSeed, 7.0}, {PointId::kExciteDuration, 20.0}};
+  ASSERT_TRUE(gate.submit(start, kOperator).accepted());
+  EXPECT_EQ(gate.excitation_settings().seed, 7u);
+  EXPECT_EQ(gate.excitation_settings().duration_s, 20.0);
+  EXPECT_EQ(gate.excitation_settings().amplitude_max_v, config.excitation.amplitude_max_v);  // the rest kept
+  std::vector<runtime::Command> queued;
+  runtime::Command c;
+  while (channels.commands.try_pop(c)) queued.push_back(c);
+  ASSERT_EQ(queued.size(), 2u);  // the settings first, whatever the order of the points
+  EXPECT_EQ(queued[0].kind, runtime::CommandKind::kExcitation);
+  EXPECT_EQ(queued[0].excitation.seed, 7u);
+  EXPECT_EQ(queued[1].kind, runtime::CommandKind::kMode);
+  EXPECT_EQ(queued[1].mode, Mode::kExcite);
+  EXPECT_EQ(sink.entries.size(), 3u);
+}
+
+TEST(WriteGate, ExciteIsEnteredFromStopOnlyWithThePistonBetweenTheGuardLines) {
+  const runtime::RuntimeConfig config;
+  runtime::LoopChannels channels(16);
+  WriteGate gate(limits_of(config), config, paper(), channels, nullptr);
+  const PointWrite excite{PointId::kMode, 4.0};
+  runtime::Snapshot snap;
+  snap.position_mm = 250.0;
+  for (Mode mode : {Mode::kRun, Mode::kManual}) {
+    snap.mode = mode;
+    const auto r = gate.decide({&excite, 1}, kOperator, snap);
+    EXPECT_EQ(r.refusal, Refusal::kConflict) << runtime::to_string(mode);
+    EXPECT_EQ(modbus_exception(r.refusal), 0x04);
+    EXPECT_EQ(http_status(r.refusal), 409);
+    EXPECT_NE(r.reason.find("STOP"), std::string::npos) << r.reason;
+  }
+  snap.mode = Mode::kStop;
+  EXPECT_TRUE(gate.decide({&excite, 1}, kOperator, snap).accepted());
+  snap.position_mm = 20.0;  // below the lower guard line (-2 + 100 mm)
+  const auto low = gate.decide({&excite, 1}, kOperator, snap);
+  EXPECT_EQ(low.refusal, Refusal::kConflict);
+  EXPECT_NE(low.reason.find("guard"), std::string::npos) << low.reason;
+  const PointWrite fault{PointId::kMode, 3.0};
+  EXPECT_EQ(gate.decide({&fault, 1}, kOperator, snap).refusal, Refusal::kInvalidValue);  // FAULT is entered by faults only
+}
+
 // ---- the gate against the loop: every accept-path ----
 
 // A scan cycle on a fake DAQ in `mode`, with the narrowed configuration.
@@ -161,6 +269,10 @@ struct Loop {
     if (mode == Mode::kFault) config.start_fault = runtime::FaultCode::kStoreDamaged;
     loop = std::make_unique<runtime::ScanCycle>(config, *runtime::make_tuning(paper()), daq, clock, channels);
     if (mode == Mode::kManual) channels.commands.try_push(runtime::mode_command(Mode::kManual));
+    if (mode == Mode::kExcite) {  // from STOP, once a reading placed the piston between the guard lines
+      cycle();
+      channels.commands.try_push(runtime::mode_command(Mode::kExcite));
+    }
     cycle();
   }
   void cycle() {
@@ -201,7 +313,7 @@ TEST(WriteGate, EveryWriteTheGateAcceptsIsAppliedByTheScanCycleInTheSameState) {
         << writes[0].value << " (" << runtime::describe(after.last_refusal) << ")";
     EXPECT_EQ(after.commands_applied, before.commands_applied + commands.size());
   };
-  for (Mode mode : {Mode::kStop, Mode::kRun, Mode::kManual, Mode::kFault}) {
+  for (Mode mode : {Mode::kStop, Mode::kRun, Mode::kManual, Mode::kFault, Mode::kExcite}) {
     for (const PointDef* p : gated_points())
       for (double v : candidates(gate.limits().range(p->id))) hold({{p->id, v}}, mode);
     // Groups as HMIs send them: mode and setpoint, a manual move, a whole dead zone.
@@ -209,6 +321,9 @@ TEST(WriteGate, EveryWriteTheGateAcceptsIsAppliedByTheScanCycleInTheSameState) {
     hold({{PointId::kMode, 2.0}, {PointId::kManualValve, 1.5}}, mode);
     hold({{PointId::kReset, 1.0}, {PointId::kMode, 1.0}}, mode);  // a fault cleared and RUN asked in one write
     hold({{PointId::kMr, 2.0}, {PointId::kMl, 2.1}, {PointId::kBr, 1.3}, {PointId::kBl, -1.5}, {PointId::kLc, 4.0}}, mode);
+    hold({{PointId::kExciteSeed, 7.0}, {PointId::kExciteAmplitudeMax, 2.0}, {PointId::kMode, 4.0}}, mode);
+    hold({{PointId::kMode, 0.0}, {PointId::kMode, 4.0}}, mode);
+    hold({{PointId::kExciteAmplitudeMin, 2.5}, {PointId::kExciteAmplitudeMax, 2.0}}, mode);  // minimum above maximum
   }
   // Neither side of the check is empty: the walk exercised both.
   EXPECT_GT(accepted, 100);

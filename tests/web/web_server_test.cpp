@@ -17,11 +17,14 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
+#include <utility>
 #include <filesystem>
 
+#include "web/commission_port.hpp"
 #include "web/recent_audit.hpp"
 
 namespace {
@@ -40,6 +43,25 @@ class Collecting : public epa::core::AuditSink {
   epa::core::ChangeCounters counters() const override { return {changes, changes}; }
   std::vector<epa::core::AuditEntry> entries;
   std::uint64_t changes = 0;
+};
+
+// A commissioning service that records what it was asked and answers as told.
+class FakeCommission final : public epa::web::CommissionPort {
+ public:
+  epa::points::CommissionStartResult start(const std::string& spec, const std::string& source) override {
+    if (spec.find("bad") != std::string::npos) return {epa::points::CommissionStart::kBadSpec, "commission spec: unknown key 'bad'"};
+    if (running) return {epa::points::CommissionStart::kBusy, "a commissioning run is under way"};
+    running = true, last_spec = spec, last_source = source;
+    return {};
+  }
+  bool abort(const std::string&) override { return std::exchange(running, false); }
+  epa::points::CommissionView view() const override { return {true, running, running ? 1 : 7, 0, running ? 10.0 : 100.0}; }
+  std::string status_json() const override { return running ? R"({"running":true})" : R"({"running":false})"; }
+  std::optional<std::string> result_json() const override { return result; }
+  std::optional<std::string> report_html() const override { return result ? std::optional<std::string>("<html></html>") : std::nullopt; }
+  bool running = false;
+  std::string last_spec, last_source;
+  std::optional<std::string> result;
 };
 
 class WebServerTest : public ::testing::Test {
@@ -75,9 +97,8 @@ class WebServerTest : public ::testing::Test {
     gate_ = std::make_unique<epa::points::WriteGate>(std::move(*limits), limits_,
                                                      epa::control::paper_controller_config(epa::control::ControllerKind::kPpFfidz),
                                                      channels_, &audit_);
-    auto server = epa::web::WebServer::start(config, channels_, gate_.get(), &audit_, [] {
-      return epa::web::ModbusStats{true, 2, 77, 1};
-    });
+    auto server = epa::web::WebServer::start(
+        config, channels_, gate_.get(), &audit_, [] { return epa::web::ModbusStats{true, 2, 77, 1}; }, {}, commission_);
     ASSERT_TRUE(server.has_value()) << server.error().message;
     server_ = std::move(*server);
     client_ = std::make_unique<httplib::Client>("127.0.0.1", server_->port());
@@ -111,6 +132,7 @@ class WebServerTest : public ::testing::Test {
   Collecting log_;
   epa::web::RecentAudit audit_{&log_};
   std::unique_ptr<epa::points::WriteGate> gate_;
+  epa::web::CommissionPort* commission_ = nullptr;
   std::unique_ptr<epa::web::WebServer> server_;
   std::unique_ptr<httplib::Client> client_;
 };
@@ -284,6 +306,50 @@ TEST_F(WebServerTest, WithATokenOnlyTheRightBearerIsObeyedAndAudited) {
   EXPECT_TRUE(get_json("/api/status")["commands_enabled"].get<bool>());
 }
 
+TEST_F(WebServerTest, CommissioningIsStartedAndAbortedWithTheTokenAndReadLikeTheStatus) {
+  FakeCommission fake;
+  commission_ = &fake;
+  start("s3cret-token");
+  EXPECT_EQ(get_json("/api/commission/result", 404)["error"], "no commissioning run has ended yet");
+  auto anonymous = post("/api/commission", "{}");
+  ASSERT_TRUE(anonymous);
+  EXPECT_EQ(anonymous->status, 401);
+  EXPECT_FALSE(fake.running);
+  auto bad = post("/api/commission", R"({"bad": 1})", "s3cret-token");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_NE(json::parse(bad->body)["error"].get<std::string>().find("'bad'"), std::string::npos);
+  auto started = post("/api/commission", R"({"excitation_s": 30})", "s3cret-token");
+  ASSERT_TRUE(started);
+  EXPECT_EQ(started->status, 202) << started->body;
+  EXPECT_EQ(fake.last_spec, R"({"excitation_s": 30})");
+  EXPECT_EQ(fake.last_source, "web 127.0.0.1");
+  EXPECT_TRUE(get_json("/api/commission")["running"].get<bool>());
+  auto again = post("/api/commission", "", "s3cret-token");
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->status, 409);
+  auto abort = post("/api/commission/abort", "", "s3cret-token");
+  ASSERT_TRUE(abort);
+  EXPECT_EQ(abort->status, 200);
+  auto nothing = post("/api/commission/abort", "", "s3cret-token");
+  ASSERT_TRUE(nothing);
+  EXPECT_EQ(nothing->status, 409);
+  fake.result = R"({"schema":"epa-commission/1"})";
+  EXPECT_EQ(get_json("/api/commission/result")["schema"], "epa-commission/1");
+  auto report = client_->Get("/api/commission/report");
+  ASSERT_TRUE(report);
+  EXPECT_EQ(report->status, 200);
+  EXPECT_EQ(report->get_header_value("Content-Type"), "text/html; charset=utf-8");
+}
+
+TEST_F(WebServerTest, WithoutACommissioningServiceItsPathsAre404) {
+  start("t");
+  EXPECT_EQ(get_json("/api/commission", 404)["error"], "this appliance runs no commissioning service");
+  auto post_start = post("/api/commission", "{}", "t");
+  ASSERT_TRUE(post_start);
+  EXPECT_EQ(post_start->status, 404);
+}
+
 TEST_F(WebServerTest, CommandsAreValidatedLikeModbusWrites) {
   start("t");
   auto far = post("/api/setpoint", R"({"setpoint_mm": 600})", "t");
@@ -312,6 +378,33 @@ TEST_F(WebServerTest, CommandsAreValidatedLikeModbusWrites) {
   auto reset = post("/api/reset", "", "t");  // reset is what a latched fault needs
   ASSERT_TRUE(reset);
   EXPECT_EQ(reset->status, 200);
+}
+
+// Mode EXCITE over HTTP: by its name, from STOP only (409 otherwise, naming why); its time left in the status.
+TEST_F(WebServerTest, ExciteIsAModeByNameEnteredFromStopOnly) {
+  start("t");
+  auto from_run = post("/api/mode", R"({"mode": "excite"})", "t");  // the fixture's snapshot: RUN
+  ASSERT_TRUE(from_run);
+  EXPECT_EQ(from_run->status, 409);
+  EXPECT_NE(json::parse(from_run->body)["error"].get<std::string>().find("STOP"), std::string::npos) << from_run->body;
+  EXPECT_TRUE(queued().empty());
+
+  snap_.mode = epa::runtime::Mode::kStop;
+  snap_.position_mm = 250.0;
+  channels_.snapshot.publish(snap_);
+  auto from_stop = post("/api/mode", R"({"mode": "excite"})", "t");
+  ASSERT_TRUE(from_stop);
+  EXPECT_EQ(from_stop->status, 200) << from_stop->body;
+  const auto q = queued();
+  ASSERT_EQ(q.size(), 1u);
+  EXPECT_EQ(q[0].mode, epa::runtime::Mode::kExcite);
+
+  snap_.mode = epa::runtime::Mode::kExcite;
+  snap_.excitation_left_s = 12.5;
+  channels_.snapshot.publish(snap_);
+  const json s = get_json("/api/status");
+  EXPECT_EQ(s["mode"], "excite");
+  EXPECT_DOUBLE_EQ(s["excite_left_s"].get<double>(), 12.5);
 }
 
 // The catalog over HTTP: GET /api/points lists every point with the gate's ranges, and

@@ -1,0 +1,95 @@
+#include "app/commission_service.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include "app/commission_report.hpp"
+#include "commission/commission_spec.hpp"
+
+namespace epa::app {
+
+CommissionService::CommissionService(AxisFactory make_axis, commission::Identify identify, Log log)
+    : make_axis_(std::move(make_axis)), identify_(std::move(identify)), log_(std::move(log)) {}
+
+CommissionService::~CommissionService() {
+  {
+    std::lock_guard lock(mutex_);
+    if (sequence_) sequence_->abort();
+  }
+  if (thread_.joinable()) thread_.join();
+}
+
+points::CommissionStartResult CommissionService::start(const std::string& spec_json, const std::string& source) {
+  auto spec = spec_json.find_first_not_of(" \t\r\n") == std::string::npos ? core::Result<commission::CommissionSpec>(commission::CommissionSpec{})
+                                                                          : commission::parse_commission_spec(spec_json);
+  if (!spec) return {points::CommissionStart::kBadSpec, spec.error().message};
+  std::lock_guard lock(mutex_);
+  if (running_) return {points::CommissionStart::kBusy, "a commissioning run is under way: " + sequence_->progress().message};
+  if (thread_.joinable()) thread_.join();  // the last run's thread has ended (running_ is false)
+  axis_ = make_axis_("commission (" + source + ")");
+  sequence_ = std::make_unique<commission::CommissionSequence>(*axis_, identify_, log_);
+  running_ = true;
+  if (log_) log_("commission: started by " + source + " with spec " + commission::format_commission_spec(*spec));
+  thread_ = std::thread([this, s = *spec] {
+    const auto outcome = sequence_->run(s);
+    auto json = commission::format_commission_json(outcome);
+    auto html = commission_report_html(outcome);
+    std::lock_guard done(mutex_);
+    result_json_ = std::move(json);
+    report_html_ = std::move(html);
+    last_progress_ = sequence_->progress();
+    running_ = false;
+  });
+  return {};
+}
+
+bool CommissionService::abort(const std::string& source) {
+  std::lock_guard lock(mutex_);
+  if (!running_) return false;
+  if (log_) log_("commission: abort requested by " + source);
+  sequence_->abort();
+  return true;
+}
+
+bool CommissionService::running() const {
+  std::lock_guard lock(mutex_);
+  return running_;
+}
+
+commission::Progress CommissionService::progress() const {
+  std::lock_guard lock(mutex_);
+  return running_ ? sequence_->progress() : last_progress_;
+}
+
+points::CommissionView CommissionService::view() const {
+  std::lock_guard lock(mutex_);
+  const auto p = running_ ? sequence_->progress() : last_progress_;
+  return {true, running_, static_cast<int>(p.stage), static_cast<int>(p.verdict), p.percent};
+}
+
+std::string CommissionService::status_json() const {
+  bool is_running;
+  commission::Progress p;
+  {
+    std::lock_guard lock(mutex_);
+    is_running = running_;
+    p = running_ ? sequence_->progress() : last_progress_;
+  }
+  const nlohmann::json j = {{"running", is_running},
+                            {"stage", std::string(commission::to_string(p.stage))},
+                            {"verdict", std::string(commission::to_string(p.verdict))},
+                            {"percent", p.percent},
+                            {"message", p.message}};
+  return j.dump();
+}
+
+std::optional<std::string> CommissionService::result_json() const {
+  std::lock_guard lock(mutex_);
+  return result_json_;
+}
+
+std::optional<std::string> CommissionService::report_html() const {
+  std::lock_guard lock(mutex_);
+  return report_html_;
+}
+
+}  // namespace epa::app

@@ -1,0 +1,256 @@
+#include "commission/commission_sequence.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "control/controller.hpp"
+#include "core/audit.hpp"
+#include "core/step_metrics.hpp"
+#include "core/utc_stamp.hpp"
+
+namespace epa::commission {
+
+namespace {
+
+constexpr double kIdentifyWeightS = 20.0;  // what identification and design weigh in the progress, as seconds
+
+nlohmann::json optional_number(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
+
+nlohmann::json move_json(const JudgedMove& m) {
+  return {{"from_mm", m.from_mm},
+          {"to_mm", m.to_mm},
+          {"rise_s", optional_number(m.metrics.rise_s)},
+          {"settling_s", optional_number(m.metrics.settling_s)},
+          {"ess_mm", m.metrics.ess_mm},
+          {"overshoot_pct", optional_number(m.metrics.overshoot_pct)},
+          {"passed", m.passed},
+          {"why", m.why}};
+}
+
+}  // namespace
+
+std::string_view to_string(Stage s) {
+  switch (s) {
+    case Stage::kIdle: return "idle";
+    case Stage::kExciting: return "exciting";
+    case Stage::kIdentifying: return "identifying";
+    case Stage::kDesigning: return "designing";
+    case Stage::kSimulating: return "simulating";
+    case Stage::kSaving: return "saving";
+    case Stage::kVerifying: return "verifying";
+    case Stage::kDone: return "done";
+  }
+  return "?";
+}
+
+std::string_view to_string(Verdict v) {
+  switch (v) {
+    case Verdict::kNone: return "none";
+    case Verdict::kDeployed: return "deployed";
+    case Verdict::kRolledBack: return "rolled-back";
+    case Verdict::kAborted: return "aborted";
+  }
+  return "?";
+}
+
+Progress CommissionSequence::progress() const {
+  std::lock_guard lock(mutex_);
+  return progress_;
+}
+
+void CommissionSequence::step(Stage stage, double percent, const std::string& message, CommissionOutcome& out) {
+  {
+    std::lock_guard lock(mutex_);
+    progress_.stage = stage;
+    progress_.percent = percent;
+    progress_.message = message;
+  }
+  out.log.push_back(std::string(to_string(stage)) + ": " + message);
+  if (log_) log_("commission: " + message);
+}
+
+bool CommissionSequence::aborted(CommissionOutcome& out) {
+  if (!abort_) return false;
+  finish(Verdict::kAborted, "aborted by the operator", out);
+  return true;
+}
+
+CommissionOutcome& CommissionSequence::finish(Verdict verdict, const std::string& reason, CommissionOutcome& out) {
+  Stage stage;
+  {
+    std::lock_guard lock(mutex_);
+    stage = progress_.stage;
+  }
+  if (verdict != Verdict::kDeployed) {
+    out.failed_stage = stage;
+    axis_.stop();  // the valve safe first, whatever happens next
+    if (new_set_running_) {
+      const auto back = axis_.use_set(out.previous_set_id, false, "commissioning " + std::string(to_string(verdict)) + ": " + reason);
+      out.log.push_back(back ? "rolled back to '" + out.previous_set + "'"
+                             : "ROLL-BACK FAILED: " + back.error().message);
+      if (log_) log_("commission: " + out.log.back());
+      new_set_running_ = !back;
+    }
+  }
+  out.verdict = verdict;
+  out.reason = reason;
+  std::lock_guard lock(mutex_);
+  progress_.stage = Stage::kDone;
+  progress_.verdict = verdict;
+  progress_.percent = 100.0;
+  progress_.message = std::string(to_string(verdict)) + ": " + reason;
+  out.log.push_back(progress_.message);
+  if (log_) log_("commission: " + progress_.message);
+  return out;
+}
+
+CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
+  CommissionOutcome out;
+  out.spec = spec_in;
+  CommissionSpec& spec = out.spec;
+  abort_ = false;
+  new_set_running_ = false;
+  {
+    std::lock_guard lock(mutex_);
+    progress_ = {};
+  }
+  if (spec.name.empty()) spec.name = "commissioned-" + core::utc_stamp(core::unix_time_ms());
+  const double total_s = spec.excitation_runs * spec.excitation_s + kIdentifyWeightS +
+                         static_cast<double>(spec.moves_mm.size()) * spec.move_hold_s;
+  double done_s = 0.0;
+  auto pct = [&] { return 100.0 * done_s / total_s; };
+
+  if (auto s = spec.validate(axis_.setpoint_min_mm(), axis_.setpoint_max_mm()); !s) return finish(Verdict::kRolledBack, s.error().message, out);
+  auto previous = axis_.running();
+  if (!previous) return finish(Verdict::kRolledBack, "the running tuning set: " + previous.error().message, out);
+  out.previous_set = previous->set.name;
+  out.previous_set_id = previous->set.id;
+  const core::HammersteinModel& old_model = previous->model.model;
+
+  // 1. The experiment.
+  for (int i = 0; i < spec.excitation_runs; ++i) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "excitation run %d of %d (%.0f s, seed %llu)", i + 1, spec.excitation_runs, spec.excitation_s,
+                  static_cast<unsigned long long>(spec.seed + static_cast<std::uint64_t>(i)));
+    step(Stage::kExciting, pct(), buf, out);
+    auto run = axis_.excite({spec.excitation_s, spec.seed + static_cast<std::uint64_t>(i), spec.amplitude_max_v}, abort_);
+    if (aborted(out)) return out;
+    if (!run) return finish(Verdict::kRolledBack, std::string(buf) + ": " + run.error().message, out);
+    out.experiment.push_back(std::move(*run));
+    done_s += spec.excitation_s;
+  }
+
+  // 2. Identification: all runs but the last estimate, the last validates.
+  step(Stage::kIdentifying, pct(), "identifying the Hammerstein model", out);
+  std::vector<core::Run> estimation(out.experiment.begin(), out.experiment.end() - 1);
+  auto identified = identify_(estimation, out.experiment.back());
+  if (aborted(out)) return out;
+  if (!identified) return finish(Verdict::kRolledBack, "identification: " + identified.error().message, out);
+  identified->model.Ts = old_model.Ts;  // the loop's period; identify checked the runs have it
+  out.identified = *identified;
+  out.log.push_back("identified: " + identified->summary);
+  if (log_) log_("commission: identified: " + identified->summary);
+
+  // 3. Design.
+  step(Stage::kDesigning, pct(), "pole placement from the spec", out);
+  auto design = control::design_from_spec(identified->model, {spec.overshoot_pct, spec.settling_s, identified->model.Ts, spec.observer_pole});
+  if (!design) return finish(Verdict::kRolledBack, "design: " + design.error().message, out);
+  out.design = *design;
+  store::TuningSet set = previous->set;  // l_c and the valve limit carry over
+  set.id = 0;
+  set.name = spec.name;
+  set.controller = spec.controller;
+  set.F = design->F, set.G = design->G, set.H = design->H;
+  set.dead_zone = identified->model.dead_zone;
+  set.model_id = 0;
+  set.source = "epa commission: " + identified->summary;
+  set.design_json = format_commission_spec(spec);
+  if (auto s = store::validate(set, identified->model); !s) return finish(Verdict::kRolledBack, "design: " + s.error().message, out);
+
+  // 4. Simulation on the identified model and its perturbations.
+  step(Stage::kSimulating, pct(), "verification moves in simulation (identified model and robustness cases)", out);
+  auto config = store::controller_config(set, identified->model, 0.0);
+  auto params = control::ControllerParams::make(config);
+  if (!params) return finish(Verdict::kRolledBack, "design: " + params.error().message, out);
+  out.simulation = verify_in_simulation(identified->model, *params, spec, axis_.position_mm());
+  if (!out.simulation->passed) return finish(Verdict::kRolledBack, out.simulation->why, out);
+  done_s += kIdentifyWeightS;
+  if (aborted(out)) return out;
+
+  // 5. Store the set (not active), then run it.
+  step(Stage::kSaving, pct(), "saving tuning set '" + set.name + "'", out);
+  store::ModelRecord model{.id = 0, .name = set.name, .created_ms = 0, .source = "identified by epa commission",
+                           .model = identified->model, .fit_json = {}};
+  nlohmann::json fit = {{"estimation_fit_pct", identified->estimation_fit_pct}, {"validation_fit_pct", identified->validation_fit_pct}};
+  model.fit_json = fit.dump();
+  auto id = axis_.save(model, set);
+  if (!id) return finish(Verdict::kRolledBack, "saving the set: " + id.error().message, out);
+  out.new_set = set.name;
+  out.new_set_id = *id;
+  new_set_running_ = true;  // from here on a failure switches back, even if use_set failed half-way
+  if (auto s = axis_.use_set(*id, false, "commissioning: verifying '" + set.name + "'"); !s)
+    return finish(Verdict::kRolledBack, "switching to the new set: " + s.error().message, out);
+
+  // 6. Verification on the axis.
+  double from = axis_.position_mm();
+  for (double to : spec.moves_mm) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "verification move %.1f -> %.1f mm", from, to);
+    step(Stage::kVerifying, pct(), buf, out);
+    auto run = axis_.move(to, spec.move_hold_s, abort_);
+    if (aborted(out)) return out;
+    if (!run) return finish(Verdict::kRolledBack, std::string(buf) + ": " + run.error().message, out);
+    const auto metrics = core::step_metrics(run->y_mm, to, {.Ts = run->Ts});
+    out.verification.push_back(judge_move(from, to, metrics, spec.limits));
+    out.measured_moves.push_back(std::move(*run));
+    done_s += spec.move_hold_s;
+    if (!out.verification.back().passed) return finish(Verdict::kRolledBack, "on the axis: " + out.verification.back().why, out);
+    from = to;
+  }
+
+  // 7. Keep it.
+  axis_.stop();
+  if (auto s = axis_.use_set(*id, true, "commissioning: '" + set.name + "' passed its verification"); !s)
+    return finish(Verdict::kRolledBack, "making the new set active in the store: " + s.error().message, out);
+  new_set_running_ = false;
+  return finish(Verdict::kDeployed, "'" + set.name + "' passed every verification move and is the active set", out);
+}
+
+std::string format_commission_json(const CommissionOutcome& o) {
+  nlohmann::json j = {{"schema", "epa-commission/1"},
+                      {"verdict", std::string(to_string(o.verdict))},
+                      {"reason", o.reason},
+                      {"failed_stage", o.verdict == Verdict::kDeployed ? nlohmann::json(nullptr) : nlohmann::json(std::string(to_string(o.failed_stage)))},
+                      {"previous_set", o.previous_set},
+                      {"new_set", o.new_set.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.new_set)},
+                      {"spec", nlohmann::json::parse(format_commission_spec(o.spec))},
+                      {"log", o.log}};
+  if (o.identified) {
+    const auto& m = o.identified->model;
+    j["model"] = {{"A", m.A.coefficients()},
+                  {"B", m.B.coefficients()},
+                  {"dead_zone", {{"m_r", m.dead_zone.m_r}, {"m_l", m.dead_zone.m_l}, {"b_r", m.dead_zone.b_r}, {"b_l", m.dead_zone.b_l}}},
+                  {"Ts", m.Ts},
+                  {"estimation_fit_pct", o.identified->estimation_fit_pct},
+                  {"validation_fit_pct", o.identified->validation_fit_pct},
+                  {"summary", o.identified->summary}};
+  }
+  if (o.design)
+    j["design"] = {{"F", o.design->F.coefficients()}, {"G", o.design->G.coefficients()}, {"H", o.design->H.coefficients()},
+                   {"T", o.design->T.coefficients()}, {"condition_number", o.design->condition_number}};
+  if (o.simulation) {
+    nlohmann::json cases = nlohmann::json::array();
+    for (const auto& c : o.simulation->cases) {
+      nlohmann::json moves = nlohmann::json::array();
+      for (const auto& m : c.moves) moves.push_back(move_json(m));
+      cases.push_back({{"case", c.name}, {"passed", c.passed}, {"moves", moves}});
+    }
+    j["simulation"] = cases;
+  }
+  j["verification"] = nlohmann::json::array();
+  for (const auto& m : o.verification) j["verification"].push_back(move_json(m));
+  return j.dump(1) + "\n";
+}
+
+}  // namespace epa::commission

@@ -1,0 +1,135 @@
+#include "commission/commission_spec.hpp"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "core/format.hpp"
+
+namespace epa::commission {
+
+namespace {
+
+core::Status in_range(const char* key, double v, double lo, double hi, bool lo_open = false) {
+  const bool ok = std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi;
+  if (ok) return core::ok();
+  return core::invalid_argument(std::string("commission spec: ") + key + " " + core::format_number(v) + " is outside " +
+                                (lo_open ? "(" : "[") + core::format_number(lo) + ", " + core::format_number(hi) + "]");
+}
+
+// A number from `j[key]` into `out`, or the error naming the key.
+core::Status read_number(const nlohmann::json& j, const char* key, double& out, const char* parent = "") {
+  if (!j.contains(key)) return core::ok();
+  if (!j[key].is_number()) return core::invalid_argument(std::string("commission spec: ") + parent + key + " must be a number");
+  out = j[key].get<double>();
+  return core::ok();
+}
+
+nlohmann::json limits_json(const MoveLimits& l) {
+  return {{"ess_mm", l.ess_mm}, {"overshoot_pct", l.overshoot_pct}, {"settling_s", l.settling_s}};
+}
+
+}  // namespace
+
+core::Status CommissionSpec::validate(double lo_mm, double hi_mm) const {
+  if (excitation_runs < 2 || excitation_runs > 10)
+    return core::invalid_argument("commission spec: excitation_runs " + std::to_string(excitation_runs) +
+                                  " is outside [2, 10] (one run is held out for validation)");
+  for (auto s : {in_range("excitation_s", excitation_s, 5.0, 600.0), in_range("amplitude_max_v", amplitude_max_v, 0.5, 10.0),
+                 in_range("overshoot_pct", overshoot_pct, 0.0, 50.0), in_range("settling_s", settling_s, 0.05, 30.0, true),
+                 in_range("observer_pole", observer_pole, 0.0, 0.95), in_range("move_hold_s", move_hold_s, 3.0, 60.0),
+                 in_range("limits.ess_mm", limits.ess_mm, 0.0, 100.0, true),
+                 in_range("limits.overshoot_pct", limits.overshoot_pct, 0.0, 1000.0),
+                 in_range("limits.settling_s", limits.settling_s, 0.0, 60.0),
+                 in_range("robust_limits.ess_mm", robust_limits.ess_mm, 0.0, 100.0, true),
+                 in_range("robust_limits.overshoot_pct", robust_limits.overshoot_pct, 0.0, 1000.0),
+                 in_range("robust_limits.settling_s", robust_limits.settling_s, 0.0, 60.0),
+                 in_range("robust_gain", robust_gain, 0.0, 0.9), in_range("robust_breakpoint_v", robust_breakpoint_v, 0.0, 2.0)})
+    if (!s) return s;
+  if (moves_mm.empty() || moves_mm.size() > 32)
+    return core::invalid_argument("commission spec: moves_mm needs 1 to 32 targets, got " + std::to_string(moves_mm.size()));
+  for (double m : moves_mm)
+    if (auto s = in_range("moves_mm", m, lo_mm, hi_mm); !s) return s;
+  if (name.size() > 64) return core::invalid_argument("commission spec: name is longer than 64 characters");
+  for (char c : name)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.'))
+      return core::invalid_argument("commission spec: name '" + name + "' may hold only letters, digits, '-', '_' and '.'");
+  return core::ok();
+}
+
+core::Result<CommissionSpec> parse_commission_spec(const std::string& text) {
+  const auto j = nlohmann::json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return core::parse_error("commission spec: not a JSON object");
+  static const std::set<std::string> known = {"excitation_runs", "excitation_s", "seed", "amplitude_max_v", "controller",
+                                              "overshoot_pct", "settling_s", "observer_pole", "moves_mm", "move_hold_s",
+                                              "limits", "robust_gain", "robust_breakpoint_v", "robust_limits", "name"};
+  for (const auto& [key, value] : j.items())
+    if (!known.contains(key)) return core::invalid_argument("commission spec: unknown key '" + key + "'");
+  CommissionSpec s;
+  if (j.contains("excitation_runs")) {
+    if (!j["excitation_runs"].is_number_integer()) return core::invalid_argument("commission spec: excitation_runs must be a whole number");
+    s.excitation_runs = j["excitation_runs"].get<int>();
+  }
+  if (j.contains("seed")) {
+    if (!j["seed"].is_number_unsigned()) return core::invalid_argument("commission spec: seed must be a whole number >= 0");
+    s.seed = j["seed"].get<std::uint64_t>();
+  }
+  if (j.contains("controller")) {
+    if (!j["controller"].is_string()) return core::invalid_argument("commission spec: controller must be a name");
+    auto k = control::parse_controller_kind(j["controller"].get<std::string>());
+    if (!k) return core::invalid_argument("commission spec: controller: " + k.error().message);
+    s.controller = *k;
+  }
+  if (j.contains("moves_mm")) {
+    if (!j["moves_mm"].is_array()) return core::invalid_argument("commission spec: moves_mm must be a list of targets in mm");
+    s.moves_mm.clear();
+    for (const auto& m : j["moves_mm"]) {
+      if (!m.is_number()) return core::invalid_argument("commission spec: moves_mm must be a list of numbers");
+      s.moves_mm.push_back(m.get<double>());
+    }
+  }
+  if (j.contains("name")) {
+    if (!j["name"].is_string()) return core::invalid_argument("commission spec: name must be a string");
+    s.name = j["name"].get<std::string>();
+  }
+  for (auto [key, limits] : {std::pair<const char*, MoveLimits*>{"limits", &s.limits}, {"robust_limits", &s.robust_limits}}) {
+    if (!j.contains(key)) continue;
+    const auto& l = j[key];
+    const std::string parent = std::string(key) + ".";
+    if (!l.is_object()) return core::invalid_argument(std::string("commission spec: ") + key + " must be an object");
+    for (const auto& [k, value] : l.items())
+      if (k != "ess_mm" && k != "overshoot_pct" && k != "settling_s")
+        return core::invalid_argument("commission spec: unknown key '" + parent + k + "'");
+    for (auto st : {read_number(l, "ess_mm", limits->ess_mm, parent.c_str()), read_number(l, "overshoot_pct", limits->overshoot_pct, parent.c_str()),
+                    read_number(l, "settling_s", limits->settling_s, parent.c_str())})
+      if (!st) return st.error();
+  }
+  for (auto st : {read_number(j, "excitation_s", s.excitation_s), read_number(j, "amplitude_max_v", s.amplitude_max_v),
+                  read_number(j, "overshoot_pct", s.overshoot_pct), read_number(j, "settling_s", s.settling_s),
+                  read_number(j, "observer_pole", s.observer_pole), read_number(j, "move_hold_s", s.move_hold_s),
+                  read_number(j, "robust_gain", s.robust_gain), read_number(j, "robust_breakpoint_v", s.robust_breakpoint_v)})
+    if (!st) return st.error();
+  if (auto st = s.validate(); !st) return st.error();
+  return s;
+}
+
+std::string format_commission_spec(const CommissionSpec& s) {
+  const nlohmann::json j = {{"excitation_runs", s.excitation_runs},
+                            {"excitation_s", s.excitation_s},
+                            {"seed", s.seed},
+                            {"amplitude_max_v", s.amplitude_max_v},
+                            {"controller", std::string(control::to_string(s.controller))},
+                            {"overshoot_pct", s.overshoot_pct},
+                            {"settling_s", s.settling_s},
+                            {"observer_pole", s.observer_pole},
+                            {"moves_mm", s.moves_mm},
+                            {"move_hold_s", s.move_hold_s},
+                            {"limits", limits_json(s.limits)},
+                            {"robust_gain", s.robust_gain},
+                            {"robust_breakpoint_v", s.robust_breakpoint_v},
+                            {"robust_limits", limits_json(s.robust_limits)},
+                            {"name", s.name}};
+  return j.dump();
+}
+
+}  // namespace epa::commission

@@ -1,0 +1,166 @@
+// The commissioning sequence against a simulated axis: deploys a set that passes, rolls back one
+// that does not (at once, with the reason, the store's active set never changed), aborts cleanly.
+#include "commission/commission_sequence.hpp"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "commission/commission_spec.hpp"
+#include "core/paper_reference.hpp"
+#include "simulated_axis.hpp"
+
+namespace epa::commission {
+namespace {
+
+RunningTuning paper_tuning() {
+  RunningTuning t;
+  t.model.name = "paper";
+  t.model.model = core::paper::model();
+  t.set.name = "paper";
+  t.set.controller = control::ControllerKind::kPpFfidz;
+  t.set.F = core::paper::F();
+  t.set.G = core::paper::G();
+  t.set.H = core::paper::G();
+  t.set.dead_zone = t.model.model.dead_zone;
+  return t;
+}
+
+// Identification stand-in: the sequence's logic is under test here, not the fit (tests/ident).
+Identify returns(const core::HammersteinModel& model) {
+  return [model](const std::vector<core::Run>& estimation, const core::Run&) -> core::Result<IdentifiedModel> {
+    if (estimation.empty()) return core::invalid_argument("no runs");
+    return IdentifiedModel{model, 99.0, 98.0, {}, "stand-in"};
+  };
+}
+
+CommissionSpec short_spec() {
+  CommissionSpec s;
+  s.excitation_runs = 2;
+  s.excitation_s = 10.0;
+  s.controller = control::ControllerKind::kPpNgidz;
+  s.settling_s = 0.5;
+  s.overshoot_pct = 0.0;
+  s.moves_mm = {150.0, 350.0, 250.0};
+  s.move_hold_s = 4.0;
+  s.name = "test-set";
+  return s;
+}
+
+TEST(CommissionSequence, DeploysASetThatPassesEveryCheck) {
+  const auto plant = core::paper::model();
+  testing::SimulatedAxis axis(plant, paper_tuning());
+  CommissionSequence seq(axis, returns(plant));
+  const auto out = seq.run(short_spec());
+  ASSERT_EQ(out.verdict, Verdict::kDeployed) << out.reason;
+  EXPECT_EQ(axis.excitations, 2);
+  EXPECT_EQ(out.experiment.size(), 2u);
+  ASSERT_EQ(out.verification.size(), 3u);
+  for (const auto& m : out.verification) EXPECT_TRUE(m.passed) << m.why;
+  EXPECT_EQ(axis.loop_set, out.new_set_id);
+  EXPECT_EQ(axis.stored_active, out.new_set_id);
+  ASSERT_EQ(axis.switches.size(), 2u);  // runs it unpersisted, then keeps it
+  EXPECT_FALSE(axis.switches[0].persist);
+  EXPECT_TRUE(axis.switches[1].persist);
+  EXPECT_LE(axis.max_abs_valve_v, 5.0 + 1e-9);
+  const auto j = nlohmann::json::parse(format_commission_json(out));
+  EXPECT_EQ(j["schema"], "epa-commission/1");
+  EXPECT_EQ(j["verdict"], "deployed");
+  EXPECT_EQ(j["new_set"], "test-set");
+  EXPECT_EQ(j["previous_set"], "paper");
+  EXPECT_EQ(j["verification"].size(), 3u);
+  EXPECT_TRUE(j["verification"][0].contains("rise_s"));
+  EXPECT_EQ(j["model"]["validation_fit_pct"], 98.0);
+  EXPECT_EQ(seq.progress().verdict, Verdict::kDeployed);
+  EXPECT_EQ(seq.progress().percent, 100.0);
+}
+
+TEST(CommissionSequence, AVerificationLimitTheAxisCannotMeetRollsBackAtOnce) {
+  // The axis's valve has a dead band 0.6 V wider than the model identification returned: the
+  // simulation on the model passes, the axis stops short.
+  auto plant = core::paper::model();
+  plant.dead_zone.b_r += 0.6, plant.dead_zone.b_l -= 0.6;
+  testing::SimulatedAxis axis(plant, paper_tuning());
+  CommissionSequence seq(axis, returns(core::paper::model()));
+  auto spec = short_spec();
+  spec.limits.ess_mm = 0.3;
+  const auto out = seq.run(spec);
+  ASSERT_EQ(out.verdict, Verdict::kRolledBack) << out.reason;
+  EXPECT_EQ(out.failed_stage, Stage::kVerifying);
+  EXPECT_NE(out.reason.find("on the axis"), std::string::npos) << out.reason;
+  ASSERT_TRUE(out.simulation);
+  EXPECT_TRUE(out.simulation->passed);
+  EXPECT_EQ(axis.loop_set, 1);       // the previous set runs again
+  EXPECT_EQ(axis.stored_active, 1);  // and the store never made the new one active
+  EXPECT_GE(axis.stops, 1);
+  EXPECT_EQ(axis.moves, 1);  // at once: no further move after the first failure
+  ASSERT_EQ(axis.switches.size(), 2u);
+  EXPECT_EQ(axis.switches[1].id, 1);
+  EXPECT_NE(axis.switches[1].reason.find("rolled-back"), std::string::npos);
+  EXPECT_LE(axis.max_abs_valve_v, 5.0 + 1e-9);
+}
+
+TEST(CommissionSequence, ASpecTheSimulationCannotMeetNeverReachesTheAxis) {
+  const auto plant = core::paper::model();
+  testing::SimulatedAxis axis(plant, paper_tuning());
+  CommissionSequence seq(axis, returns(plant));
+  auto spec = short_spec();
+  spec.limits.settling_s = 0.05;  // no pneumatic axis settles a 100 mm move in 50 ms
+  const auto out = seq.run(spec);
+  EXPECT_EQ(out.verdict, Verdict::kRolledBack);
+  EXPECT_EQ(out.failed_stage, Stage::kSimulating);
+  EXPECT_NE(out.reason.find("simulation"), std::string::npos) << out.reason;
+  EXPECT_EQ(axis.moves, 0);
+  EXPECT_TRUE(axis.switches.empty());
+  EXPECT_EQ(axis.stored_active, 1);
+}
+
+TEST(CommissionSequence, AbortMidMoveStopsTheValveAndRunsThePreviousSet) {
+  const auto plant = core::paper::model();
+  testing::SimulatedAxis axis(plant, paper_tuning());
+  CommissionSequence seq(axis, returns(plant));
+  axis.abort_target = &seq;
+  axis.abort_after_samples = 300;  // 1.5 s into the first verification move
+  const auto out = seq.run(short_spec());
+  EXPECT_EQ(out.verdict, Verdict::kAborted);
+  EXPECT_EQ(out.failed_stage, Stage::kVerifying);
+  EXPECT_EQ(axis.loop_set, 1);
+  EXPECT_EQ(axis.stored_active, 1);
+  EXPECT_GE(axis.stops, 1);
+  EXPECT_EQ(seq.progress().verdict, Verdict::kAborted);
+}
+
+TEST(CommissionSequence, AFailedIdentificationLeavesEverythingAsItWas) {
+  testing::SimulatedAxis axis(core::paper::model(), paper_tuning());
+  CommissionSequence seq(axis, [](const std::vector<core::Run>&, const core::Run&) -> core::Result<IdentifiedModel> {
+    return core::numerical_error("the right side of the dead zone is not identified");
+  });
+  const auto out = seq.run(short_spec());
+  EXPECT_EQ(out.verdict, Verdict::kRolledBack);
+  EXPECT_EQ(out.failed_stage, Stage::kIdentifying);
+  EXPECT_NE(out.reason.find("not identified"), std::string::npos);
+  EXPECT_TRUE(axis.switches.empty());
+  EXPECT_TRUE(out.new_set.empty());
+}
+
+TEST(CommissionSpec, UnknownKeysAndOutOfRangeValuesAreNamed) {
+  EXPECT_NE(parse_commission_spec(R"({"excitation_s": 1})").error().message.find("excitation_s"), std::string::npos);
+  EXPECT_NE(parse_commission_spec(R"({"colour": 1})").error().message.find("colour"), std::string::npos);
+  EXPECT_NE(parse_commission_spec(R"({"limits": {"ess": 1}})").error().message.find("limits.ess"), std::string::npos);
+  EXPECT_NE(parse_commission_spec(R"({"limits": {"ess_mm": "x"}})").error().message.find("limits.ess_mm"), std::string::npos);
+  EXPECT_NE(parse_commission_spec(R"({"moves_mm": [100, 900]})").error().message.find("moves_mm"), std::string::npos);
+  EXPECT_NE(parse_commission_spec(R"({"controller": "pid"})").error().message.find("controller"), std::string::npos);
+  EXPECT_NE(parse_commission_spec(R"({"name": "a b"})").error().message.find("name"), std::string::npos);
+  EXPECT_FALSE(parse_commission_spec("[1,2]"));
+  auto s = parse_commission_spec(R"({"excitation_runs": 3, "moves_mm": [100, 200], "limits": {"ess_mm": 0.5}, "name": "x-1"})");
+  ASSERT_TRUE(s) << s.error().message;
+  auto back = parse_commission_spec(format_commission_spec(*s));
+  ASSERT_TRUE(back);
+  EXPECT_EQ(back->excitation_runs, 3);
+  EXPECT_EQ(back->moves_mm, (std::vector<double>{100, 200}));
+  EXPECT_EQ(back->limits.ess_mm, 0.5);
+  EXPECT_EQ(back->name, "x-1");
+}
+
+}  // namespace
+}  // namespace epa::commission

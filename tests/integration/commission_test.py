@@ -1,0 +1,219 @@
+#!/usr/bin/env python3
+"""Commissioning over two processes (issue 19): `epa plant-server --plant physics` with hidden
+perturbations (the valve's gain x0.8 through its orifice, the spool overlap shifted +0.2 V) behind a
+simulated remote I/O module, `epa serve --hal modbus-io` in real time, and `epa commission` driving
+the appliance over HTTP, unattended, with a shortened excitation.
+
+    commission_test.py <epa binary> <source dir>
+
+Checks, each printed with its figures:
+  * deployed: `epa commission` exits 0 with verdict "deployed", the new set is the running and the
+    stored active set; then moves of 25-200 mm in both directions, commanded over HTTP like an HMI
+    would, hold the spec's limits (how many end within 1 mm is printed: the paper's laws have no
+    integral action and end 1-4 mm short on this rig);
+  * a verification limit the axis cannot meet (e_ss <= 1 mm with NG-IDZ, which meets it on the
+    identified model only): exit 2, verdict "rolled-back" at the first move, the previous set runs
+    again and is still the stored active set, the switches are in the audit trail, and the valve
+    command never left its +-5 V limits;
+  * a wrong spec is refused before anything moves (HTTP 400, exit 1).
+Exit 1 on any failure.
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.error
+import urllib.request
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from epa_appliance import Appliance, free_port  # noqa: E402
+
+TOKEN = "commissioning-test-token-0123"
+FAILURES = []
+
+
+def check(ok, what):
+    print(("ok    " if ok else "FAIL  ") + what, flush=True)
+    if not ok:
+        FAILURES.append(what)
+
+
+class PlantServer:
+    """`epa plant-server --plant physics`; its output goes to a file (a pipe nobody reads would fill
+    and stop it)."""
+
+    def __init__(self, epa, physics_config, folder):
+        self.port = free_port()
+        self.log_path = os.path.join(folder, "plant-server.log")
+        self.log = open(self.log_path, "w")
+        self.proc = subprocess.Popen([epa, "plant-server", "--plant", "physics", "--physics-config", physics_config, "--port",
+                                      str(self.port), "--initial-position", "250", "--noise", "0.05", "--seed", "7"],
+                                     stdout=self.log, stderr=subprocess.STDOUT)
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline and "listening" not in open(self.log_path).read():
+            if self.proc.poll() is not None:
+                break
+            time.sleep(0.05)
+        if "listening" not in open(self.log_path).read():
+            raise RuntimeError(f"plant-server did not start: {open(self.log_path).read()}")
+
+    def stop(self):
+        self.proc.terminate()
+        try:
+            self.proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait(timeout=5)
+        self.log.close()
+
+
+def http(app, method, path, body=None):
+    req = urllib.request.Request(f"http://127.0.0.1:{app.web_port}{path}", method=method,
+                                 data=json.dumps(body).encode() if body is not None else None,
+                                 headers={"Authorization": f"Bearer {TOKEN}", "Content-Type": "application/json"})
+    try:
+        with urllib.request.urlopen(req, timeout=5) as r:
+            return r.status, json.loads(r.read() or b"null")
+    except urllib.error.HTTPError as e:
+        return e.code, json.loads(e.read() or b"null")
+
+
+def commission(epa, app, spec, folder, name):
+    spec_path = os.path.join(folder, f"{name}-spec.json")
+    with open(spec_path, "w") as f:
+        json.dump(spec, f)
+    out, report = os.path.join(folder, f"{name}.json"), os.path.join(folder, f"{name}.html")
+    t0 = time.monotonic()
+    r = subprocess.run([epa, "commission", "--url", f"http://127.0.0.1:{app.web_port}", "--token", TOKEN, "--spec", spec_path,
+                        "--json", out, "--report", report, "--poll", "0.5", "--timeout", "600"],
+                       capture_output=True, text=True, timeout=700)
+    took = time.monotonic() - t0
+    outcome = json.load(open(out)) if os.path.exists(out) else None
+    return r, outcome, report, took
+
+
+def move(app, target_mm, hold_s):
+    """RUN to target over HTTP; samples the position from /api/status until hold_s has passed."""
+    start = http(app, "GET", "/api/status")[1]["position_mm"]
+    code, _ = http(app, "POST", "/api/points", {"setpoint_mm": target_mm, "mode": 1})
+    assert code == 200, f"setpoint/mode refused: {code}"
+    positions = []
+    t_end = time.monotonic() + hold_s
+    while time.monotonic() < t_end:
+        positions.append(http(app, "GET", "/api/status")[1]["position_mm"])
+        time.sleep(0.02)
+    final = sum(positions[-10:]) / 10
+    span = target_mm - start
+    peak = max(positions) if span > 0 else min(positions)
+    overshoot = max(0.0, (peak - target_mm) / span * 100.0) if span > 0 else max(0.0, (target_mm - peak) / -span * 100.0)
+    return start, final, overshoot
+
+
+HMI_TARGETS = (225, 275, 175, 275, 125, 325, 250, 50, 250, 450)  # moves of 25-200 mm both ways
+
+
+def hmi_moves(app):
+    """The same moves an HMI would command, each held 3 s: [(start, target, final, overshoot)]."""
+    out = []
+    for target in HMI_TARGETS:
+        start, final, overshoot = move(app, target, 3.0)
+        out.append((start, target, final, overshoot))
+    http(app, "POST", "/api/mode", {"mode": "stop"})
+    return out
+
+
+def summary(moves):
+    errors = [abs(final - target) for _, target, final, _ in moves]
+    return (f"|error| {min(errors):.2f}-{max(errors):.2f} mm (mean {sum(errors) / len(errors):.2f}), "
+            f"{sum(e <= 1.0 for e in errors)} of {len(errors)} within 1 mm, overshoot up to {max(m[3] for m in moves):.1f} %")
+
+
+def main():
+    epa, src = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+    folder = tempfile.mkdtemp(prefix="epa-commission-test.")
+    physics = os.path.join(folder, "rig.toml")
+    with open(physics, "w") as f:  # the rig differs from the built-in defaults in ways the appliance is not told
+        f.write('schema = "epa-pneumatic/1"\n[valve]\norifice_area_mm2 = 3.2\noverlap_pos_v = 1.4\noverlap_neg_v = -1.5\n')
+    plant = PlantServer(epa, physics, folder)
+    app = Appliance(epa, os.path.join(src, "registers", "epa.csv"),
+                    f'[hal]\nbackend = "modbus-io"\n[hal.modbus_io]\nport = {plant.port}\n',
+                    web_static_dir=os.path.join(src, "web"), web_extra=f'token = "{TOKEN}"\n')
+    try:
+        # The paper's laws have no integral action: on this rig they end 1-4 mm short (friction, a dead
+        # band the model can only approximate), so the spec asks for what they can hold; a 2 % band
+        # of a 100 mm move is as wide as that offset, so settling is not judged.
+        base = {"excitation_runs": 2, "excitation_s": 40, "seed": 3, "controller": "pp-ffidz", "settling_s": 0.3,
+                "overshoot_pct": 0, "moves_mm": [150, 350, 250], "move_hold_s": 4,
+                "limits": {"ess_mm": 8, "overshoot_pct": 20, "settling_s": 0}}
+        before = http(app, "GET", "/api/status")[1]["store"]["tuning_set"]
+        paper_moves = hmi_moves(app)  # the paper's tuning, which the appliance starts with
+        print(f"      before commissioning ({before}): {summary(paper_moves)}")
+
+        # A wrong spec: refused before anything moves.
+        r, outcome, _, _ = commission(epa, app, dict(base, limits={"ess_mm": -1}), folder, "wrong")
+        check(r.returncode == 1 and "limits.ess_mm" in r.stderr, f"a wrong spec is refused naming the key (exit {r.returncode}: {r.stderr.strip()})")
+
+        # Deployed.
+        r, outcome, report, took = commission(epa, app, dict(base, name="rig-1"), folder, "deployed")
+        check(r.returncode == 0 and outcome and outcome["verdict"] == "deployed",
+              f"epa commission exits 0 with verdict deployed in {took:.0f} s (exit {r.returncode}; {outcome and outcome['reason']})\n{r.stdout}{r.stderr[-2000:]}")
+        if outcome and outcome.get("model"):
+            m = outcome["model"]
+            print(f"      identified: b_l {m['dead_zone']['b_l']:.3f} V, b_r {m['dead_zone']['b_r']:.3f} V, "
+                  f"validation fit {m['validation_fit_pct']:.1f} %")
+        for v in (outcome or {}).get("verification", []):
+            print(f"      verification {v['from_mm']:.1f} -> {v['to_mm']:.1f} mm: settling {v['settling_s']}, e_ss {v['ess_mm']:.3f} mm, "
+                  f"overshoot {v['overshoot_pct']}")
+        check(os.path.getsize(report) > 2000 if os.path.exists(report) else False, "the report was written")
+        status = http(app, "GET", "/api/status")[1]
+        check(status["store"]["tuning_set"] == "rig-1", f"the new set runs (running set {status['store']['tuning_set']})")
+        listing = subprocess.run([epa, "tuning", "--db", app.db, "list"], capture_output=True, text=True).stdout
+        active = [line for line in listing.splitlines() if line.startswith("*")]
+        check(any("rig-1" in line for line in active), f"the new set is the stored active set: {active or listing}")
+        if outcome and outcome["verdict"] == "deployed":
+            # What the verification promised, held by the moves an HMI commands afterwards.
+            deployed_moves = hmi_moves(app)
+            for start, target, final, overshoot in deployed_moves:
+                check(abs(final - target) <= base["limits"]["ess_mm"] and overshoot <= base["limits"]["overshoot_pct"],
+                      f"after deployment: move {start:.1f} -> {target} mm ends {abs(final - target):.2f} mm from its target "
+                      f"(spec: {base['limits']['ess_mm']} mm), overshoot {overshoot:.1f} % (spec: {base['limits']['overshoot_pct']} %)")
+            print(f"      after commissioning (rig-1): {summary(deployed_moves)}")
+
+        # A verification limit the axis cannot meet: NG-IDZ ends on the identified model within 0.01 mm
+        # (the simulation passes), on this rig 2-4 mm short of 1 mm: rolled back at the first move.
+        r, outcome, _, took = commission(epa, app, dict(base, controller="pp-ngidz", limits={"ess_mm": 1.0, "overshoot_pct": 15, "settling_s": 0},
+                                                        name="rig-2"), folder, "rolled-back")
+        # (Identification can also refuse these runs, a side of the dead zone not identified: then the
+        # roll-back comes before the axis, which the checks below hold as well.)
+        stage = outcome and outcome["failed_stage"]
+        check(r.returncode == 2 and outcome and outcome["verdict"] == "rolled-back" and stage in ("verifying", "identifying"),
+              f"a limit the axis cannot meet: exit 2, verdict rolled-back at stage {stage} in {took:.0f} s ({outcome and outcome['reason']})")
+        status = http(app, "GET", "/api/status")[1]
+        check(status["store"]["tuning_set"] == "rig-1", f"the previous set runs again ({status['store']['tuning_set']})")
+        listing = subprocess.run([epa, "tuning", "--db", app.db, "list"], capture_output=True, text=True).stdout
+        active = [line for line in listing.splitlines() if line.startswith("*")]
+        check(any("rig-1" in line for line in active), f"the stored active set is still the previous one: {active}")
+        if stage == "verifying":
+            audit = json.dumps(http(app, "GET", "/api/audit")[1])
+            check("running_tuning_set" in audit and "rolled-back" in audit, "the switch and the roll-back are audited")
+        valves = http(app, "GET", "/api/trend")[1].get("valve_v", [])
+        check(valves and max(abs(v) for v in valves) <= 5.0 + 1e-9, f"the valve never left +-5 V (max |u| {max(abs(v) for v in valves) if valves else 'n/a'} V over the trend)")
+        print(f"      (the set before the test: {before})")
+    finally:
+        app.stop()
+        plant.stop()
+        if FAILURES:  # what the appliance said about it
+            print("appliance log (faults, commissioning, modes):")
+            for line in app.log_text().splitlines():
+                if any(w in line for w in ("FAULT", "commission", "mode ", "refused", "error")):
+                    print("   ", line[-220:])
+    if FAILURES:
+        print(f"{len(FAILURES)} failure(s)")
+        sys.exit(1)
+    print("all checks passed")
+
+
+if __name__ == "__main__":
+    main()
