@@ -49,7 +49,8 @@ class PlantServer:
         self.log_path = os.path.join(folder, "plant-server.log")
         self.log = open(self.log_path, "w")
         self.proc = subprocess.Popen([epa, "plant-server", "--plant", "physics", "--physics-config", physics_config, "--port",
-                                      str(self.port), "--initial-position", "250", "--noise", "0.05", "--seed", "7"],
+                                      str(self.port), "--initial-position", "250", "--noise", "0.05", "--seed", "7",
+                                      "--realtime-priority", "70"],
                                      stdout=self.log, stderr=subprocess.STDOUT)
         deadline = time.monotonic() + 10
         while time.monotonic() < deadline and "listening" not in open(self.log_path).read():
