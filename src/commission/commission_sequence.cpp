@@ -147,7 +147,7 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
   auto identified = identify_(estimation, out.experiment.back());
   if (aborted(out)) return out;
   if (!identified) return finish(Verdict::kRolledBack, "identification: " + identified.error().message, out);
-  identified->model.Ts = old_model.Ts;  // the loop's period; identify checked the runs have it
+  identified->model.Ts = old_model.Ts;  // the runs were recorded by this loop, at its period
   out.identified = *identified;
   out.log.push_back("identified: " + identified->summary);
   if (log_) log_("commission: identified: " + identified->summary);
