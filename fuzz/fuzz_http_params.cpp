@@ -42,8 +42,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       std::vector<runtime::Command> commands;
       const auto r = rig.gate.decide(parsed.writes, who, snap, &commands);
       if (!r.accepted() && (r.reason.empty() || !commands.empty())) __builtin_trap();
+      // Each command against the loop's rules in the state the group leaves it, as the gate promises.
+      runtime::Mode m = mode;
+      runtime::ExcitationSettings excitation = rig.gate.excitation_settings();
       for (const auto& c : commands) {
-        if (runtime::check_command(c, mode, rig.config) != runtime::CommandRefusal::kNone) __builtin_trap();
+        if (runtime::check_command(c, m, snap.position_mm, excitation, rig.config) != runtime::CommandRefusal::kNone)
+          __builtin_trap();
+        if (c.kind == runtime::CommandKind::kMode) m = c.mode;
+        if (c.kind == runtime::CommandKind::kExcitation) excitation = c.excitation;
+        if (c.kind == runtime::CommandKind::kReset && m == runtime::Mode::kFault) m = runtime::Mode::kStop;
         if (c.kind == runtime::CommandKind::kSetpoint &&
             !(c.value >= rig.config.setpoint_min_mm && c.value <= rig.config.setpoint_max_mm))
           __builtin_trap();
