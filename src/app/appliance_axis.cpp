@@ -80,8 +80,13 @@ core::Result<core::Run> ApplianceAxis::excite(const commission::ExcitationReques
       return core::invalid_argument("the excitation did not end within its duration");
     }
   }
-  auto run = runs_.wait_after(seen, kRunWritten);
+  // The experiment's own file: a move that ended before it writes one too.
+  const std::string seed = std::to_string(request.seed);
+  auto run = runs_.wait_for(
+      seen, [&seed](const core::Run& r) { return !r.meta("excitation_end").empty() && r.meta("excitation_seed") == seed; }, kRunWritten);
   if (!run) return core::io_error("the excitation's run file was not written within 10 s");
+  if (run->meta("excitation_end") != "complete")
+    return core::invalid_argument("the excitation ended early (" + run->meta("excitation_end") + ")");
   return *run;
 }
 
