@@ -14,6 +14,7 @@ const char* color_of(control::ControllerKind k) {
     case control::ControllerKind::kPp: return "#7f7f7f";
     case control::ControllerKind::kPpNgidz: return "#1f77b4";
     case control::ControllerKind::kPpFfidz: return "#d62728";
+    case control::ControllerKind::kPpTraj: return "#2ca02c";
   }
   return "#000000";
 }

@@ -1,6 +1,8 @@
 #include "app/simulate_command.hpp"
 
+#include <cmath>
 #include <cstdio>
+#include <span>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -13,13 +15,29 @@
 #include "core/format.hpp"
 #include "core/paper_reference.hpp"
 #include "core/run_file.hpp"
+#include "core/units.hpp"
+#include "plant/plant_adapter.hpp"
+#include "plant/pneumatic_params.hpp"
+#include "sim/model_perturbation.hpp"
 
 namespace epa::app {
 
 void add_simulate_command(CLI::App& app, SimulateOptions& o) {
   auto* cmd = app.add_subcommand("simulate", "Closed-loop step responses on a plant model, next to the paper's Table 1");
-  cmd->add_option("--controller", o.controllers, "Controllers to run: pp, pp-ngidz, pp-ffidz")->delimiter(',')->capture_default_str();
-  cmd->add_option("--steps", o.steps_mm, "Step sizes from rest at 0 mm, mm")->delimiter(',')->capture_default_str();
+  cmd->add_option("--controller", o.controllers, "Controllers to run: pp, pp-ngidz, pp-ffidz, pp-traj")->delimiter(',')->capture_default_str();
+  cmd->add_option("--steps", o.steps_mm, "Step sizes from rest at --start, mm (negative: towards 0)")->delimiter(',')->capture_default_str();
+  cmd->add_option("--start", o.start_mm, "Position every run starts at rest from, mm")->capture_default_str();
+  cmd->add_option("--plant", o.plant, "paper (the model: the paper's or --model) or physics (pneumatic cylinder and valve)")
+      ->capture_default_str()->check(CLI::IsMember({"paper", "hammerstein", "physics"}));
+  cmd->add_option("--physics-config", o.physics_config, "Physics plant parameters (epa-pneumatic/1 TOML); default: built in")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--gain-factor", o.gain_factor, "Robustness: the plant's gain (B) is this times the model's")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--break-point-error", o.break_point_error_v,
+                  "Robustness: the plant's dead band is wider by this on each side, V (negative: narrower)")->capture_default_str();
+  cmd->add_option("--delay", o.delay_samples, "Robustness: samples of transport delay before the valve")
+      ->capture_default_str()->check(CLI::Range(std::size_t{0}, sim::kMaxDelaySamples));
+  cmd->add_option("--valve-lag", o.valve_lag_s, "Robustness: first-order lag of the valve, s")->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_option("--duration", o.duration_s, "Length of each run, s")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--Ts", o.Ts, "Sample time, s (default: the model's, 0.005 for the paper)")->check(CLI::PositiveNumber);
   cmd->add_option("--lc", o.lc_mm, "FF-IDZ switch-off band l_c, mm")->capture_default_str()->check(CLI::NonNegativeNumber);
@@ -36,6 +54,12 @@ void add_simulate_command(CLI::App& app, SimulateOptions& o) {
 namespace {
 
 nlohmann::json optional_json(std::optional<double> v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
+
+// The last `seconds` of a column (all of it when the run is shorter): where chatter is judged.
+std::span<const double> last_seconds(const std::vector<double>& column, double seconds, double Ts) {
+  const auto n = std::min(column.size(), static_cast<std::size_t>(std::llround(seconds / Ts)));
+  return std::span<const double>(column).subspan(column.size() - n);
+}
 
 }  // namespace
 
@@ -54,16 +78,42 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
     kinds.push_back(*kind);
   }
 
+  const bool physics = o.plant == "physics";
+  if (physics && (o.gain_factor != 1.0 || o.break_point_error_v != 0.0))
+    return err << "epa simulate: --gain-factor and --break-point-error perturb the model plant; the physics plant has its own (--physics-config)\n", 1;
+  if (!physics && !o.physics_config.empty()) return err << "epa simulate: --physics-config applies to --plant physics only\n", 1;
+  plant::PneumaticParams physics_params;
+  if (!o.physics_config.empty()) {
+    auto p = plant::read_pneumatic_file(o.physics_config);
+    if (!p) return err << "epa simulate: " << p.error().message << "\n", 1;
+    physics_params = *p;
+  }
+  const core::HammersteinModel plant_model =
+      sim::perturbed(model, {.gain_factor = o.gain_factor, .dead_band_widening_v = o.break_point_error_v});
+  if (auto s = plant_model.validate(); !s) return err << "epa simulate: the perturbed plant: " << s.error().message << "\n", 1;
+  auto make_plant = [&]() -> core::Result<std::unique_ptr<plant::PlantSimulator>> {
+    if (physics)
+      return plant::make_pneumatic_simulator(physics_params, {.initial_position_mm = o.start_mm, .noise_std_mm = o.noise_mm,
+                                                               .seed = o.seed, .Ts = model.Ts});
+    return plant::make_hammerstein_simulator(plant_model, {.initial_position_mm = o.start_mm, .noise_std_mm = o.noise_mm,
+                                                           .seed = o.seed, .stroke_mm = core::kStrokeMm});
+  };
+
   std::vector<SimulationCase> cases;
   for (auto kind : kinds) {
     control::ControllerConfig config{.kind = kind, .F = polynomials->F, .G = polynomials->G, .H = polynomials->H,
                                      .dead_zone = model.dead_zone, .lc_v = o.lc_mm / model.mm_per_volt,
-                                     .valve_limit_v = core::paper::kValveLimitV, .safe_valve_v = 0.0};
+                                     .valve_limit_v = core::paper::kValveLimitV, .safe_valve_v = 0.0,
+                                     .A = model.A, .B = model.B, .Ts = model.Ts, .trajectory = {}};
     auto params = control::ControllerParams::make(config);
     if (!params) return err << "epa simulate: " << params.error().message << "\n", 1;
     for (double step : o.steps_mm) {
-      auto run = sim::simulate_step(model, *params, {.step_mm = step, .initial_mm = 0.0, .duration_s = o.duration_s,
-                                                     .noise_std_mm = o.noise_mm, .seed = o.seed});
+      auto plant = make_plant();
+      if (!plant) return err << "epa simulate: " << plant.error().message << "\n", 1;
+      auto run = sim::simulate_step_on(**plant, model.mm_per_volt, *params,
+                                       {.step_mm = step, .initial_mm = o.start_mm, .duration_s = o.duration_s,
+                                        .noise_std_mm = o.noise_mm, .seed = o.seed},
+                                       {.delay_samples = o.delay_samples, .lag_s = o.valve_lag_s});
       if (!run) return err << "epa simulate: step " << step << " mm: " << run.error().message << "\n", 1;
       if (kind == control::ControllerKind::kPpFfidz) run->run.set_meta("lc_mm", core::format_number(o.lc_mm));
       cases.push_back({kind, step, std::move(*run)});
@@ -71,8 +121,12 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
   }
 
   char summary[256];
-  std::snprintf(summary, sizeof summary, "Step responses: model %s, controller %s, Ts = %g s, %g s per run, l_c = %g mm, sensor noise %g mm\n\n",
+  std::snprintf(summary, sizeof summary, "Step responses: model %s, controller %s, Ts = %g s, %g s per run, l_c = %g mm, sensor noise %g mm\n",
                 model_file->source.c_str(), polynomials->source.c_str(), model.Ts, o.duration_s, o.lc_mm, o.noise_mm);
+  out << summary;
+  std::snprintf(summary, sizeof summary, "Plant: %s, from rest at %g mm; gain x%g, dead band %+g V each side, delay %zu samples, valve lag %g s\n\n",
+                physics ? ("physics (" + (o.physics_config.empty() ? std::string("built-in parameters") : o.physics_config) + ")").c_str()
+                        : "the model", o.start_mm, o.gain_factor, o.break_point_error_v, o.delay_samples, o.valve_lag_s);
   out << summary;
   print_table1_comparison(out, cases);
 
@@ -90,12 +144,19 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
   }
 
   if (!o.json_path.empty()) {
-    nlohmann::json j = {{"schema", "epa-sim/1"}, {"Ts", model.Ts}, {"duration_s", o.duration_s}, {"results", nlohmann::json::array()}};
+    nlohmann::json j = {{"schema", "epa-sim/1"}, {"Ts", model.Ts}, {"duration_s", o.duration_s},
+                        {"plant", physics ? "physics" : "model"}, {"start_mm", o.start_mm}, {"noise_mm", o.noise_mm},
+                        {"gain_factor", o.gain_factor}, {"break_point_error_v", o.break_point_error_v},
+                        {"delay_samples", o.delay_samples}, {"valve_lag_s", o.valve_lag_s}, {"results", nlohmann::json::array()}};
     for (const auto& c : cases) {
       const auto& m = c.result.metrics;
       j["results"].push_back({{"controller", control::to_string(c.kind)}, {"step_mm", c.step_mm},
                               {"rise_s", optional_json(m.rise_s)}, {"settling_s", optional_json(m.settling_s)},
-                              {"ess_mm", m.ess_mm}, {"overshoot_pct", optional_json(m.overshoot_pct)}});
+                              {"ess_mm", m.ess_mm}, {"overshoot_pct", optional_json(m.overshoot_pct)},
+                              {"overshoot_mm", optional_json(m.overshoot_pct ? std::optional<double>(*m.overshoot_pct / 100.0 * std::abs(c.step_mm)) : std::nullopt)},
+                              {"valve_sign_changes", c.result.valve_sign_changes},
+                              {"valve_sign_changes_last_10s", sim::count_sign_changes(last_seconds(c.result.run.u_V, 10.0, model.Ts))},
+                              {"faults", c.result.faults}});
     }
     if (auto s = write_output(o.json_path, j.dump(1) + "\n", out); !s) return err << "epa simulate: " << s.error().message << "\n", 1;
     out << "metrics written to " << o.json_path << "\n";

@@ -9,8 +9,16 @@
 namespace epa::app {
 
 struct SimulateOptions {
-  std::vector<std::string> controllers = {"pp", "pp-ngidz", "pp-ffidz"};
-  std::vector<double> steps_mm = {25, 50, 100, 200};
+  std::vector<std::string> controllers = {"pp", "pp-ngidz", "pp-ffidz", "pp-traj"};
+  std::vector<double> steps_mm = {25, 50, 100, 200};  // signed: a negative step moves towards 0
+  double start_mm = 0.0;      // every run starts at rest here
+  std::string plant = "paper";  // paper (the model: the paper's or --model) or physics
+  std::string physics_config;   // epa-pneumatic/1 for --plant physics; empty: built in
+  // Robustness: the plant differs from the controller's model, or the line to the valve is slow.
+  double gain_factor = 1.0;
+  double break_point_error_v = 0.0;  // the plant's dead band wider by this on each side
+  std::size_t delay_samples = 0;
+  double valve_lag_s = 0.0;
   double duration_s = 20.0;
   double Ts = 0.0;           // 0: the model's own
   double lc_mm = 5.0;

@@ -33,6 +33,7 @@ const core::paper::Table1Row* paper_row(double step_mm, ControllerKind kind) {
       case ControllerKind::kPp: return &e.pp;
       case ControllerKind::kPpNgidz: return &e.ngidz;
       case ControllerKind::kPpFfidz: return &e.ffidz;
+      case ControllerKind::kPpTraj: return nullptr;  // not in the paper
     }
   }
   return nullptr;

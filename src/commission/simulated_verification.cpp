@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "sim/closed_loop.hpp"
+#include "sim/model_perturbation.hpp"
 
 namespace epa::commission {
 
@@ -18,17 +19,14 @@ std::vector<Variant> variants(const core::HammersteinModel& m, const CommissionS
   std::vector<Variant> out = {{"identified", m}};
   if (spec.robust_gain > 0.0)
     for (double f : {1.0 - spec.robust_gain, 1.0 + spec.robust_gain}) {
-      Variant v{{}, m};
-      v.model.B = m.B * f;
+      Variant v{{}, sim::perturbed(m, {.gain_factor = f})};
       std::snprintf(buf, sizeof buf, "gain x%.2f", f);
       v.name = buf;
       out.push_back(std::move(v));
     }
   if (spec.robust_breakpoint_v > 0.0)
     for (double d : {spec.robust_breakpoint_v, -spec.robust_breakpoint_v}) {
-      Variant v{{}, m};
-      v.model.dead_zone.b_r = std::max(0.0, m.dead_zone.b_r + d);  // d > 0: the dead band wider on both sides
-      v.model.dead_zone.b_l = std::min(0.0, m.dead_zone.b_l - d);
+      Variant v{{}, sim::perturbed(m, {.dead_band_widening_v = d})};
       std::snprintf(buf, sizeof buf, "dead band %+.2f V each side", d);
       v.name = buf;
       out.push_back(std::move(v));

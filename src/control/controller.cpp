@@ -47,6 +47,11 @@ core::Result<ControllerParams> ControllerParams::make(const ControllerConfig& c)
   p.lc_v_ = c.lc_v;
   p.valve_limit_v_ = c.valve_limit_v;
   p.safe_valve_v_ = c.safe_valve_v;
+  if (c.kind == ControllerKind::kPpTraj) {
+    auto t = make_trajectory_params(c.trajectory, c.A, c.B, c.dead_zone, c.valve_limit_v, c.Ts);
+    if (!t) return core::invalid_argument("controller: " + t.error().message);
+    p.trajectory_ = *t;
+  }
   return p;
 }
 
@@ -55,6 +60,24 @@ ControllerOutput controller_step(const ControllerParams& p, ControllerState& sta
   if (!std::isfinite(r_v) || !std::isfinite(y_v)) {
     out.valve_v = p.safe_valve_v();
     out.fault = true;
+    return out;
+  }
+  if (p.kind() == ControllerKind::kPpTraj) {
+    const ControllerState before = state;
+    const TrajectoryOutput t = trajectory_step(p.trajectory(), state.trajectory, r_v, y_v, state.saturated_sign);
+    if (!std::isfinite(t.u)) {  // overflow of a diverging loop: do not poison the state
+      state = before;
+      out.valve_v = p.safe_valve_v();
+      out.fault = true;
+      return out;
+    }
+    const double valve = t.holding   ? 0.0
+                         : t.arrived ? creeping_idz_command(p.dead_zone(), t.u, p.trajectory().creep_margin_v)
+                                     : smooth_idz_command(p.dead_zone(), t.u, p.trajectory().idz_ramp);
+    out.controller_v = t.u;
+    out.valve_v = std::clamp(valve, -p.valve_limit_v(), p.valve_limit_v());
+    out.saturated = out.valve_v != valve;
+    state.saturated_sign = out.saturated ? (valve > 0.0 ? 1 : -1) : 0;
     return out;
   }
   const RstState before = state.rst;
@@ -70,10 +93,12 @@ ControllerOutput controller_step(const ControllerParams& p, ControllerState& sta
     case ControllerKind::kPp: break;
     case ControllerKind::kPpNgidz: valve = ngidz_command(p.dead_zone(), u); break;
     case ControllerKind::kPpFfidz: valve = ffidz_command(p.dead_zone(), u, r_v - y_v, p.lc_v()); break;
+    case ControllerKind::kPpTraj: break;  // handled above
   }
   out.controller_v = u;
   out.valve_v = std::clamp(valve, -p.valve_limit_v(), p.valve_limit_v());
   out.saturated = out.valve_v != valve;
+  state.saturated_sign = out.saturated ? (valve > 0.0 ? 1 : -1) : 0;
   return out;
 }
 

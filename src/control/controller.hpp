@@ -1,9 +1,10 @@
 #pragma once
-// The three position controllers as pure control laws: validated immutable ControllerParams,
+// The four position controllers as pure control laws: validated immutable ControllerParams,
 // explicit ControllerState, and controller_step() which allocates nothing, reads no clock and does
 // no I/O. All signals are in the model's units: reference and position in sensor volts, valve in V.
 #include "control/controller_kind.hpp"
 #include "control/rst_law.hpp"
+#include "control/trajectory_law.hpp"
 #include "core/dead_zone.hpp"
 #include "core/polynomial.hpp"
 #include "core/result.hpp"
@@ -18,6 +19,11 @@ struct ControllerConfig {
   double lc_v = 0.1;         // FF-IDZ switch-off band l_c, sensor volts (5 mm at 50 mm/V)
   double valve_limit_v = 5.0;  // final valve command saturates at +-limit (paper section 4.1)
   double safe_valve_v = 0.0;   // command on a fault (non-finite input): 5/3 valve centred
+  // pp-traj only: the model it computes its feed-forward from, its sample period and its own
+  // parameters (trajectory_law.hpp). The other laws ignore them.
+  core::Polynomial A, B;
+  double Ts = 0.005;
+  TrajectoryConfig trajectory;
 };
 
 class ControllerParams {
@@ -35,16 +41,21 @@ class ControllerParams {
   double lc_v() const { return lc_v_; }
   double valve_limit_v() const { return valve_limit_v_; }
   double safe_valve_v() const { return safe_valve_v_; }
+  const TrajectoryParams& trajectory() const { return trajectory_; }
 
  private:
   ControllerKind kind_ = ControllerKind::kPp;
   RstCoefficients rst_;
   core::DeadZone dead_zone_;
   double lc_v_ = 0.0, valve_limit_v_ = 5.0, safe_valve_v_ = 0.0;
+  TrajectoryParams trajectory_;
 };
 
+// A default-constructed state is "not started": pp-traj starts its profile at the first y it reads.
 struct ControllerState {
   RstState rst;
+  TrajectoryState trajectory;
+  int saturated_sign = 0;  // sign of the last command's saturation, 0: not saturated (anti-windup)
 };
 
 struct ControllerOutput {

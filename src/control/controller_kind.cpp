@@ -11,7 +11,8 @@ struct KindNames {
 };
 constexpr KindNames kNames[] = {{ControllerKind::kPp, "pp", "PP"},
                                 {ControllerKind::kPpNgidz, "pp-ngidz", "PP NG-IDZ"},
-                                {ControllerKind::kPpFfidz, "pp-ffidz", "PP FF-IDZ"}};
+                                {ControllerKind::kPpFfidz, "pp-ffidz", "PP FF-IDZ"},
+                                {ControllerKind::kPpTraj, "pp-traj", "PP-TRAJ"}};
 
 const KindNames& names_of(ControllerKind kind) {
   for (const auto& n : kNames)
@@ -26,7 +27,7 @@ std::string_view display_name(ControllerKind kind) { return names_of(kind).displ
 core::Result<ControllerKind> parse_controller_kind(std::string_view name) {
   for (const auto& n : kNames)
     if (n.name == name) return n.kind;
-  return core::invalid_argument("unknown controller '" + std::string(name) + "': expected pp, pp-ngidz or pp-ffidz");
+  return core::invalid_argument("unknown controller '" + std::string(name) + "': expected pp, pp-ngidz, pp-ffidz or pp-traj");
 }
 
 }  // namespace epa::control

@@ -1,6 +1,6 @@
 #pragma once
 // The paper's controller (eq 12-13, H = G) with its dead zone (eq 10) and l_c = 5 mm, as a
-// ControllerConfig for any of the three laws.
+// ControllerConfig for any of the four laws (pp-traj with its default parameters).
 #include "control/controller.hpp"
 #include "core/paper_reference.hpp"
 #include "core/units.hpp"
@@ -15,6 +15,9 @@ inline ControllerConfig paper_controller_config(ControllerKind kind) {
   c.dead_zone = core::paper::model().dead_zone;
   c.lc_v = core::mm_to_sensor_v(core::paper::kLcDefaultMm);
   c.valve_limit_v = core::paper::kValveLimitV;
+  c.A = core::paper::model().A;
+  c.B = core::paper::model().B;
+  c.Ts = core::paper::model().Ts;
   return c;
 }
 

@@ -23,7 +23,7 @@ namespace {
 constexpr std::string_view kVersionTag = "epa-run/1";
 constexpr std::string_view kVersionPrefix = "epa-run/";
 constexpr std::string_view kBom = "\xEF\xBB\xBF";
-constexpr std::array<std::string_view, 4> kControllers = {"pp", "pp-ngidz", "pp-ffidz", "open-loop"};
+constexpr std::array<std::string_view, 5> kControllers = {"pp", "pp-ngidz", "pp-ffidz", "pp-traj", "open-loop"};
 constexpr double kTsRelTolerance = 1e-9;
 
 struct ColumnSpec {
@@ -153,7 +153,7 @@ Result<Run> parse_run_impl(std::istream& in, const std::string& src, std::option
       } else {
         if (key == "controller" && !is_controller(value))
           return error_at(src, line_no, "unknown controller '" + std::string(value) +
-                                            "', expected one of pp, pp-ngidz, pp-ffidz, open-loop");
+                                            "', expected one of pp, pp-ngidz, pp-ffidz, pp-traj, open-loop");
         run.metadata.emplace_back(key, value);
       }
       continue;

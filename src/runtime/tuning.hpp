@@ -1,18 +1,24 @@
 #pragma once
-// A tuning set ready for the loop: validated parameters of all three laws from one base
+// A tuning set ready for the loop: validated parameters of all four laws from one base
 // configuration, so switching the controller is a lookup at a cycle boundary, never a rebuild.
+#include <string>
+
 #include "control/controller.hpp"
 
 namespace epa::runtime {
 
 struct Tuning {
-  control::ControllerParams pp, ngidz, ffidz;
+  control::ControllerParams pp, ngidz, ffidz, traj;
+  // Why pp-traj cannot run on this set's model (it needs one that integrates), empty when it can.
+  // The other three laws stay usable; selecting pp-traj is refused with this reason.
+  std::string traj_unavailable;
 
   const control::ControllerParams& for_kind(control::ControllerKind kind) const noexcept {
     switch (kind) {
       case control::ControllerKind::kPp: return pp;
       case control::ControllerKind::kPpNgidz: return ngidz;
       case control::ControllerKind::kPpFfidz: return ffidz;
+      case control::ControllerKind::kPpTraj: return traj;
     }
     return pp;
   }
@@ -21,10 +27,15 @@ struct Tuning {
 // Validates `base` (its kind is ignored) once per law; the error says what is wrong.
 inline core::Result<Tuning> make_tuning(control::ControllerConfig base) {
   Tuning t;
-  control::ControllerParams* slots[] = {&t.pp, &t.ngidz, &t.ffidz};
-  for (std::size_t i = 0; i < 3; ++i) {
+  control::ControllerParams* slots[] = {&t.pp, &t.ngidz, &t.ffidz, &t.traj};
+  for (std::size_t i = 0; i < 4; ++i) {
     base.kind = control::kAllControllerKinds[i];
     auto p = control::ControllerParams::make(base);
+    if (!p && base.kind == control::ControllerKind::kPpTraj) {
+      t.traj_unavailable = p.error().message;
+      t.traj = t.pp;  // never run: selecting pp-traj is refused while traj_unavailable is set
+      continue;
+    }
     if (!p) return p.error();
     *slots[i] = *p;
   }

@@ -13,6 +13,11 @@
 #include "core/result.hpp"
 #include "core/run.hpp"
 #include "core/step_metrics.hpp"
+#include "sim/valve_line.hpp"
+
+namespace epa::plant {
+class PlantSimulator;
+}
 
 namespace epa::sim {
 
@@ -33,6 +38,12 @@ struct StepRun {
 
 core::Result<StepRun> simulate_step(const core::HammersteinModel& model, const control::ControllerParams& params,
                                     const StepRunOptions& options);
+
+// The same against any plant (the physics plant, a perturbed model) already at rest at
+// options.initial_mm with its own noise, through `line` (delay, valve lag). `options.noise_std_mm`
+// and `seed` are only recorded: the plant was made with them.
+core::Result<StepRun> simulate_step_on(plant::PlantSimulator& plant, double mm_per_volt, const control::ControllerParams& params,
+                                       const StepRunOptions& options, const ValveLineOptions& line = {});
 
 // Number of times the sign flips between strictly positive and strictly negative (zeros skipped).
 std::size_t count_sign_changes(std::span<const double> values);

@@ -8,7 +8,8 @@ namespace epa::store {
 
 control::ControllerConfig controller_config(const TuningSet& set, const core::HammersteinModel& model, double safe_valve_v) {
   return {.kind = set.controller, .F = set.F, .G = set.G, .H = set.H, .dead_zone = set.dead_zone,
-          .lc_v = set.lc_mm / model.mm_per_volt, .valve_limit_v = set.valve_limit_v, .safe_valve_v = safe_valve_v};
+          .lc_v = set.lc_mm / model.mm_per_volt, .valve_limit_v = set.valve_limit_v, .safe_valve_v = safe_valve_v,
+          .A = model.A, .B = model.B, .Ts = model.Ts, .trajectory = {}};
 }
 
 core::Status validate(const TuningSet& set, const core::HammersteinModel& model) {
@@ -20,6 +21,8 @@ core::Status validate(const TuningSet& set, const core::HammersteinModel& model)
   for (const auto kind : control::kAllControllerKinds) {
     auto config = controller_config(set, model, 0.0);
     config.kind = kind;
+    // pp-traj needs an integrating model; a set on another model stays valid for the other laws.
+    if (kind == control::ControllerKind::kPpTraj && set.controller != kind) continue;
     if (auto p = control::ControllerParams::make(config); !p) return fail(p.error().message);
   }
   return core::ok();

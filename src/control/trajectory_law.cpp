@@ -1,0 +1,154 @@
+#include "control/trajectory_law.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/format.hpp"
+
+namespace epa::control {
+
+namespace {
+
+double sum_of(const core::Polynomial& p) {
+  double s = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) s += p[i];
+  return s;
+}
+
+core::Error field_error(const std::string& field, double value, const std::string& expected) {
+  return core::invalid_argument("pp-traj: " + field + " = " + core::format_number(value) + ": expected " + expected);
+}
+
+}  // namespace
+
+core::Result<ModelSpeeds> model_top_speeds(const core::Polynomial& A, const core::Polynomial& B, const core::DeadZone& dz,
+                                           double valve_limit_v, double Ts) {
+  const double b1 = sum_of(B);
+  double a_slope = 0.0;  // A1(1) = -A'(1) = -sum i a_i when A(1) = 0
+  double a_scale = 0.0;
+  for (std::size_t i = 0; i < A.size(); ++i) {
+    a_slope -= static_cast<double>(i) * A[i];
+    a_scale += std::abs(A[i]);
+  }
+  const double a1 = sum_of(A);
+  if (!(std::abs(a1) <= 1e-3 * a_scale))
+    return core::invalid_argument("pp-traj needs a model that integrates (A(1) = 0, valve opening -> speed); A(1) = " +
+                                  core::format_number(a1));
+  if (!(b1 > 0.0) || !(a_slope > 0.0))
+    return core::invalid_argument("pp-traj needs a model whose static speed gain B(1) / A1(1) is positive; B(1) = " +
+                                  core::format_number(b1) + ", A1(1) = " + core::format_number(a_slope));
+  const double per_u = b1 / (a_slope * Ts);  // V/s of speed per unit of u_d
+  ModelSpeeds s;
+  s.pos_v_s = std::max(0.0, dz.m_r * (valve_limit_v - dz.b_r)) * per_u;
+  s.neg_v_s = std::max(0.0, dz.m_l * (valve_limit_v + dz.b_l)) * per_u;
+  if (!(s.pos_v_s > 0.0) || !(s.neg_v_s > 0.0))
+    return core::invalid_argument("pp-traj: the valve limit " + core::format_number(valve_limit_v) +
+                                  " V lies inside the dead zone: the model cannot move");
+  return s;
+}
+
+core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c, const core::Polynomial& A,
+                                                      const core::Polynomial& B, const core::DeadZone& dz,
+                                                      double valve_limit_v, double Ts) {
+  if (!(Ts > 0.0) || !std::isfinite(Ts)) return field_error("Ts", Ts, "> 0 s");
+  if (A.size() == 0 || B.size() == 0) return core::invalid_argument("pp-traj needs the model's A and B");
+  if (A.size() > kMaxLawOrder + 1 || B.size() > kMaxLawOrder + 1)
+    return core::invalid_argument("pp-traj: the model's order is above " + std::to_string(kMaxLawOrder));
+  if (!(c.speed_fraction > 0.0 && c.speed_fraction <= 1.0)) return field_error("speed_fraction", c.speed_fraction, "in (0, 1]");
+  if (!(c.accel_v_s2 >= 0.0) || !std::isfinite(c.accel_v_s2)) return field_error("accel", c.accel_v_s2, ">= 0 (0: derived)");
+  if (!(c.accel_per_distance >= 0.0) || !std::isfinite(c.accel_per_distance))
+    return field_error("accel_per_distance", c.accel_per_distance, ">= 0 1/s^2 (0: off)");
+  if (!(c.smoothing_s >= 0.0) || !std::isfinite(c.smoothing_s)) return field_error("smoothing_s", c.smoothing_s, ">= 0 s");
+  if (!(c.feedback_bandwidth_rad_s > 0.0) || !std::isfinite(c.feedback_bandwidth_rad_s))
+    return field_error("feedback_bandwidth_rad_s", c.feedback_bandwidth_rad_s, "> 0 rad/s");
+  if (!(c.filter_ratio > 0.0) || !std::isfinite(c.filter_ratio)) return field_error("filter_ratio", c.filter_ratio, "> 0");
+  if (!(c.integral_gain_per_s >= 0.0) || !std::isfinite(c.integral_gain_per_s))
+    return field_error("integral_gain", c.integral_gain_per_s, ">= 0 (0: derived)");
+  if (!(c.integrator_band_v >= 0.0) || !std::isfinite(c.integrator_band_v)) return field_error("integrator_band", c.integrator_band_v, ">= 0");
+  if (!(c.hold_band_v >= 0.0) || !std::isfinite(c.hold_band_v)) return field_error("hold_band", c.hold_band_v, ">= 0");
+  if (!(c.error_filter_s >= 0.0) || !std::isfinite(c.error_filter_s)) return field_error("error_filter_s", c.error_filter_s, ">= 0 s");
+  if (!(c.creep_margin_v >= 0.0) || !std::isfinite(c.creep_margin_v)) return field_error("creep_margin_v", c.creep_margin_v, ">= 0 V");
+  if (!(c.idz_ramp >= 0.0) || !std::isfinite(c.idz_ramp)) return field_error("idz_ramp", c.idz_ramp, ">= 0");
+  for (std::size_t i = 0; i < A.size(); ++i)
+    if (!std::isfinite(A[i])) return core::invalid_argument("pp-traj: the model's A[" + std::to_string(i) + "] is not finite");
+  for (std::size_t i = 0; i < B.size(); ++i)
+    if (!std::isfinite(B[i])) return core::invalid_argument("pp-traj: the model's B[" + std::to_string(i) + "] is not finite");
+  auto speeds = model_top_speeds(A, B, dz, valve_limit_v, Ts);
+  if (!speeds) return speeds.error();
+
+  TrajectoryParams p;
+  const double smoothing = std::round(c.smoothing_s / Ts);
+  if (smoothing > static_cast<double>(kMaxSmoothingSamples))
+    return field_error("smoothing_s", c.smoothing_s,
+                       "at most " + std::to_string(kMaxSmoothingSamples) + " samples (" + core::format_number(kMaxSmoothingSamples * Ts) + " s)");
+  p.limits.smoothing_samples = std::max<std::size_t>(1, static_cast<std::size_t>(smoothing));
+  p.limits.Ts = Ts;
+  p.limits.speed_pos_v_s = c.speed_fraction * speeds->pos_v_s;
+  p.limits.speed_neg_v_s = c.speed_fraction * speeds->neg_v_s;
+  const double slow = std::min(p.limits.speed_pos_v_s, p.limits.speed_neg_v_s);
+  p.limits.accel_v_s2 = c.accel_v_s2 > 0.0 ? c.accel_v_s2 : slow / 0.03;  // top speed within 30 ms
+  p.limits.accel_per_distance = c.accel_per_distance;
+  const double b1 = sum_of(B);
+  for (std::size_t i = 0; i < A.size(); ++i) p.A[i] = A[i] / b1;
+  for (std::size_t i = 0; i < B.size(); ++i) p.B[i] = B[i] / b1;
+  p.nA = A.size() - 1;
+  p.nB = B.size() - 1;
+  const double per_u = speeds->pos_v_s / std::max(1e-12, dz.m_r * (valve_limit_v - dz.b_r));  // V/s per unit u
+  p.proportional_gain = c.feedback_bandwidth_rad_s / per_u;
+  p.feedback_filter_alpha = 1.0 - std::exp(-c.filter_ratio * c.feedback_bandwidth_rad_s * Ts);
+  p.integral_gain = c.integral_gain_per_s > 0.0 ? c.integral_gain_per_s : 0.75 * p.proportional_gain * c.feedback_bandwidth_rad_s;
+  p.integrator_band_v = c.integrator_band_v;
+  p.hold_band_v = c.hold_band_v;
+  p.filter_alpha = c.error_filter_s > 0.0 ? 1.0 - std::exp(-Ts / c.error_filter_s) : 1.0;
+  p.idz_ramp = c.idz_ramp;
+  p.creep_margin_v = c.creep_margin_v;
+  p.integrator_limit = std::max(dz.m_r * (valve_limit_v - dz.b_r), dz.m_l * (valve_limit_v + dz.b_l));
+  return p;
+}
+
+void trajectory_reset(const TrajectoryParams& p, TrajectoryState& s, double y_v) noexcept {
+  s = {};
+  motion_profile_reset(p.limits, s.profile, y_v);
+  s.w.fill(y_v);
+}
+
+TrajectoryOutput trajectory_step(const TrajectoryParams& p, TrajectoryState& s, double r_v, double y_v,
+                                 int saturated_sign_last) noexcept {
+  if (!s.profile.started) trajectory_reset(p, s, y_v);
+  for (std::size_t i = kMaxLawOrder; i > 0; --i) s.w[i] = s.w[i - 1];
+  s.w[0] = motion_profile_step(p.limits, s.profile, r_v);
+  double y_d = 0.0, u_ff = 0.0;
+  for (std::size_t i = 0; i <= p.nB; ++i) y_d += p.B[i] * s.w[i];
+  for (std::size_t i = 0; i <= p.nA; ++i) u_ff += p.A[i] * s.w[i];
+
+  // The tracking error against what the model's output does, not against r: y_d reaches r a few
+  // samples after the profile (B's delay), and an integrator fed r - y meanwhile would wind up.
+  const double e = y_d - y_v;
+  s.filtered_error_v += p.filter_alpha * (e - s.filtered_error_v);
+  bool arrived = motion_profile_arrived(p.limits, s.profile, r_v);
+  for (std::size_t i = 0; arrived && i <= std::max(p.nA, p.nB); ++i) arrived = s.w[i] == r_v;
+  const double ef = s.filtered_error_v;
+  if (!arrived) {
+    s.holding = false;
+  } else if (s.holding) {
+    s.holding = std::abs(ef) <= p.hold_band_v;
+  } else {
+    s.holding = std::abs(ef) <= 0.5 * p.hold_band_v;  // enter at half the band: hysteresis
+  }
+  if (arrived && !s.holding && std::abs(ef) > p.integrator_band_v) {
+    const int direction = (ef > 0.0) - (ef < 0.0);
+    if (direction != saturated_sign_last)  // anti-windup: no integrating further into the limit
+      s.integral = std::clamp(s.integral + p.integral_gain * p.limits.Ts * ef, -p.integrator_limit, p.integrator_limit);
+  }
+  s.feedback_stage1_v += p.feedback_filter_alpha * (e - s.feedback_stage1_v);
+  s.feedback_stage2_v += p.feedback_filter_alpha * (s.feedback_stage1_v - s.feedback_stage2_v);
+  const double u_fb = p.proportional_gain * s.feedback_stage2_v;
+  TrajectoryOutput out;
+  out.u = u_ff + u_fb + s.integral;
+  out.holding = s.holding;
+  out.arrived = arrived;
+  return out;
+}
+
+}  // namespace epa::control

@@ -1,0 +1,103 @@
+#pragma once
+// pp-traj: this project's law beyond the paper (README "pp-traj"): a model-based reference
+// trajectory with an exact feed-forward, and a low-bandwidth feedback that only corrects what the
+// model does not know. Per sample, in sensor volts:
+//
+//   w(k)   jerk-limited motion profile towards r (motion_profile.hpp)
+//   y_d    = B(q) w / B(1)     what the model's output does under the feed-forward below
+//   u_ff   = A(q) w / B(1)     so that A y_d = B u_ff: the model tracks y_d exactly, its lead
+//                              and lag included (the paper's B responds to the input's rate)
+//   u_fb   = K_p LP2(y_d - y)  a proportional feedback through a 2nd-order low-pass, K_p set for a
+//                              crossover of feedback_bandwidth_rad_s on the model's integrator. Not
+//                              the paper's F, G: their loop gain at the Nyquist rate (|B(-1)| = 4.1
+//                              against B(1) = 0.007) leaves no margin for a sample of delay or a
+//                              slow valve; this one keeps its crossover far below the model's
+//                              near-unit-circle zeros (16.7 rad/s)
+//   u_i    integrator on the filtered tracking error, only after the profile has arrived (and y_d
+//          with it) and only outside integrator_band_v: it removes what the model does not know
+//          (a wrong gain, a wrong break point, a load) without winding up during the move
+//   valve  while moving: u_d through the inverse dead zone (idz_ramp 0: NG-IDZ, exact on the
+//          model); once arrived: creeping_idz_command, which cannot bang-bang between the break
+//          points when they lie nearer than the model's.
+// Once arrived and within half of hold_band_v the valve is held at 0 V (inside the dead band: the
+// piston stays), so sensor noise cannot make it chatter; it corrects again when the filtered error
+// exceeds hold_band_v.
+#include <array>
+
+#include "control/motion_profile.hpp"
+#include "control/rst_law.hpp"  // kMaxLawOrder
+#include "core/dead_zone.hpp"
+#include "core/polynomial.hpp"
+#include "core/result.hpp"
+
+namespace epa::control {
+
+// The law's own parameters. Speeds are a fraction of the model's top speed at the valve limit in
+// each direction, so one value suits any identified model.
+struct TrajectoryConfig {
+  double speed_fraction = 0.8;        // of the model's top speed at the valve limit, per direction, (0, 1]
+  double accel_v_s2 = 0.0;            // profile acceleration, V/s^2; 0: derived from the model (derive_accel)
+  double accel_per_distance = 200.0;  // short moves: accel <= this x |move|, 1/s^2 (motion_profile.hpp); 0: off
+  double smoothing_s = 0.05;          // moving-average length of the profile (jerk limit), s
+  double feedback_bandwidth_rad_s = 4.0;  // crossover of the feedback loop on the model's integrator
+  double filter_ratio = 4.0;          // the feedback's 2nd-order low-pass sits this far above the crossover
+  double integral_gain_per_s = 0.0;   // u per (V s) of error; 0: derived (PI zero at 3/4 of the crossover)
+  double integrator_band_v = 0.0005;  // no integration within this error, V (0.05 mm at 50 mm/V)
+  double hold_band_v = 0.0015;        // hold the valve once arrived within this filtered error, V
+  double error_filter_s = 0.05;       // time constant of the error filter the integrator and hold read, s
+  double idz_ramp = 0.0;              // u over which the inverse dead zone's break-point jump is spread while moving
+  double creep_margin_v = 0.2;        // once arrived, the jump stops this short of each break point (creeping_idz_command)
+};
+
+// Validated parameters with everything precomputed for the loop.
+struct TrajectoryParams {
+  MotionLimits limits;
+  std::array<double, kMaxLawOrder + 1> A{}, B{};  // the model's A, B divided by B(1)
+  std::size_t nA = 0, nB = 0;
+  double proportional_gain = 0.0;  // u per V of tracking error
+  double feedback_filter_alpha = 1.0;  // per-sample weight of each of the two low-pass stages
+  double integral_gain = 0.0, integrator_band_v = 0.0, hold_band_v = 0.0;
+  double filter_alpha = 1.0;  // per-sample weight of the error filter
+  double idz_ramp = 0.0;
+  double creep_margin_v = 0.2;
+  double integrator_limit = 0.0;  // |u_i| bound: what the valve limit can deliver
+};
+
+struct TrajectoryState {
+  MotionProfileState profile;
+  std::array<double, kMaxLawOrder + 1> w{};  // w(k), w(k-1), ...
+  double filtered_error_v = 0.0;
+  double feedback_stage1_v = 0.0, feedback_stage2_v = 0.0;  // the feedback's low-pass
+  double integral = 0.0;
+  bool holding = false;
+};
+
+// The model's top speed in each direction at the valve limit, V/s, from A = (1 - q) A1 (the plant
+// integrates): speed = u_d,max B(1) / (A1(1) Ts). Fails for a model that does not integrate or
+// whose B(1) is not positive.
+struct ModelSpeeds {
+  double pos_v_s = 0.0, neg_v_s = 0.0;
+};
+core::Result<ModelSpeeds> model_top_speeds(const core::Polynomial& A, const core::Polynomial& B, const core::DeadZone& dz,
+                                           double valve_limit_v, double Ts);
+
+// Errors name the field: a fraction outside (0, 1], a negative gain or band, a smoothing longer
+// than kMaxSmoothingSamples samples, a model that does not integrate.
+core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& config, const core::Polynomial& A,
+                                                      const core::Polynomial& B, const core::DeadZone& dz,
+                                                      double valve_limit_v, double Ts);
+
+// Starts the law at rest at y_v: profile and model history there, nothing filtered or integrated.
+void trajectory_reset(const TrajectoryParams& p, TrajectoryState& s, double y_v) noexcept;
+
+struct TrajectoryOutput {
+  double u = 0.0;         // u_d before the inverse dead zone
+  bool holding = false;   // valve to be held at 0 V
+  bool arrived = false;   // the profile is at the target: correct gently (creeping_idz_command)
+};
+
+// One sample; `saturated_last` is whether the previous valve command hit its limit (anti-windup).
+TrajectoryOutput trajectory_step(const TrajectoryParams& p, TrajectoryState& s, double r_v, double y_v,
+                                 int saturated_sign_last) noexcept;
+
+}  // namespace epa::control
