@@ -42,7 +42,7 @@ std::vector<PointDef> build() {
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.fault)); }},
       {P::kFaultActive, "fault_active", "", "1 while a fault is latched", A::kRead, 0, 0, true, true,
        [](const Ctx& c, int) { return b(c.snapshot.mode == runtime::Mode::kFault); }},
-      {P::kController, "controller", "", "0 pp, 1 pp-ngidz, 2 pp-ffidz", A::kWrite, 0, 2, true, true,
+      {P::kController, "controller", "", "0 pp, 1 pp-ngidz, 2 pp-ffidz, 3 pp-traj", A::kWrite, 0, 3, true, true,
        [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.controller)); }},
       {P::kSetpoint, "setpoint_mm", "mm", "position setpoint", A::kWrite, 0, 500, false, true, [](const Ctx& c, int) { return c.snapshot.setpoint_mm; }},
       {P::kPosition, "position_mm", "mm", "measured piston position", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.position_mm; }},

@@ -26,6 +26,7 @@ enum class CommandRefusal : std::uint8_t {
   kNotStopped = 8,             // EXCITE is entered from STOP only
   kOutsideExcitationGuard = 9, // EXCITE with the piston outside the excitation's guard lines
   kExcitationInvalid = 10,     // excitation settings that do not validate together (excitation_problem)
+  kControllerUnavailable = 11, // pp-traj on a tuning set whose model it cannot use (the loop's own check)
 };
 
 // The state-dependent and range rules for one command in mode `mode` with the piston at

@@ -72,7 +72,21 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
         }
         break;
       case CommandKind::kManualValve: manual_valve_v_ = c.value; break;
-      case CommandKind::kController: controller_ = c.controller; break;  // bumpless: the RST history carries over
+      case CommandKind::kController:
+        if (c.controller == control::ControllerKind::kPpTraj && !tuning_.traj_unavailable.empty()) {
+          refusal = CommandRefusal::kControllerUnavailable;
+          break;
+        }
+        // The RST laws share their history (bumpless between them); pp-traj keeps its own, so a
+        // switch to or from it starts the new law at rest where the piston is.
+        if ((c.controller == control::ControllerKind::kPpTraj) != (controller_ == control::ControllerKind::kPpTraj)) {
+          const double y_v = (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain;  // the last reading
+          state_ = {};
+          state_.rst.y_past.fill(y_v);
+          state_.rst.r_past.fill(y_v);
+        }
+        controller_ = c.controller;
+        break;
       case CommandKind::kTuning: tuning_ = c.tuning; break;              // takes effect in this cycle's step, whole
       case CommandKind::kReset:
         if (mode_ == Mode::kFault) {

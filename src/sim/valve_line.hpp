@@ -27,6 +27,7 @@ class ValveLine {
       ring_[next_] = command_v;
       next_ = (next_ + 1) % delay_;
     }
+    if (alpha_ >= 1.0) return out;  // no lag: the command itself, bit for bit
     lagged_ += alpha_ * (out - lagged_);
     return lagged_;
   }

@@ -11,7 +11,7 @@ struct RunRecord {
   std::int64_t id = 0;
   std::string path;
   std::int64_t recorded_ms = 0;
-  std::string controller;                    // pp, pp-ngidz, pp-ffidz, open-loop
+  std::string controller;                    // pp, pp-ngidz, pp-ffidz, pp-traj, open-loop
   std::optional<std::int64_t> tuning_set_id;
   std::int64_t samples = 0;
   double Ts = 0.005;

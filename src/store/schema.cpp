@@ -67,6 +67,33 @@ CREATE TABLE runs (
 );
 CREATE TABLE retained_points (point TEXT PRIMARY KEY, value REAL NOT NULL, changed_ms INTEGER NOT NULL);
 )sql",
+    // 3: the fourth controller, pp-traj, and its parameters. SQLite cannot change a CHECK in place:
+    // the table is rebuilt (its rows, ids and the runs that name them kept; the references are
+    // checked at COMMIT, when tuning_sets exists again under its name).
+    R"sql(
+PRAGMA defer_foreign_keys = ON;
+CREATE TABLE tuning_sets_v3 (
+  id INTEGER PRIMARY KEY,
+  name TEXT NOT NULL UNIQUE,
+  created_ms INTEGER NOT NULL,
+  modified_ms INTEGER NOT NULL,
+  source TEXT NOT NULL,
+  model_id INTEGER NOT NULL REFERENCES models(id),
+  controller TEXT NOT NULL CHECK (controller IN ('pp', 'pp-ngidz', 'pp-ffidz', 'pp-traj')),
+  f_json TEXT NOT NULL, g_json TEXT NOT NULL, h_json TEXT NOT NULL,  -- RST polynomials in q^-1
+  design_json TEXT NOT NULL DEFAULT '{}',  -- the design spec that produced F, G, H
+  m_r REAL NOT NULL, m_l REAL NOT NULL, b_r REAL NOT NULL, b_l REAL NOT NULL,  -- compensation, V
+  lc_mm REAL NOT NULL,
+  valve_limit_v REAL NOT NULL,
+  trajectory_json TEXT NOT NULL DEFAULT '{}'  -- pp-traj's parameters (store/trajectory_settings.hpp)
+);
+INSERT INTO tuning_sets_v3 (id, name, created_ms, modified_ms, source, model_id, controller, f_json, g_json, h_json,
+                            design_json, m_r, m_l, b_r, b_l, lc_mm, valve_limit_v)
+  SELECT id, name, created_ms, modified_ms, source, model_id, controller, f_json, g_json, h_json,
+         design_json, m_r, m_l, b_r, b_l, lc_mm, valve_limit_v FROM tuning_sets;
+DROP TABLE tuning_sets;
+ALTER TABLE tuning_sets_v3 RENAME TO tuning_sets;
+)sql",
 };
 
 }  // namespace

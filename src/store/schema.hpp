@@ -7,7 +7,7 @@
 
 namespace epa::store {
 
-inline constexpr int kSchemaVersion = 2;
+inline constexpr int kSchemaVersion = 3;
 
 core::Result<int> schema_version(Database& db);
 

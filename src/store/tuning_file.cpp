@@ -71,6 +71,8 @@ std::string format_tuning_toml(const TuningSet& t, const ModelRecord& m) {
   const auto& dz = t.dead_zone;
   s += "\n[dead_zone]\nm_r = " + toml_float(dz.m_r) + "\nm_l = " + toml_float(dz.m_l) + "\nb_r = " + toml_float(dz.b_r) +
        "\nb_l = " + toml_float(dz.b_l) + "\n";
+  s += "\n[trajectory]  # pp-traj's parameters (README \"pp-traj\")\n";
+  for (const auto& [key, value] : trajectory_setting_values(t.trajectory)) s += key + " = " + toml_float(value) + "\n";
   // The model section is the model file's own text, moved under [model].
   std::string model_text = core::format_model_toml({m.model, m.source});
   model_text = model_text.substr(model_text.find('\n') + 1);  // drop its schema line
@@ -92,7 +94,7 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
   const auto schema = root["schema"].value<std::string>();
   if (!schema) return core::parse_error(src + ": schema is missing (expected \"" + kSchema + "\")");
   if (*schema != kSchema) return core::parse_error(src + ": schema \"" + *schema + "\" is not supported (expected \"" + kSchema + "\")");
-  if (auto s = only_keys(root, {"schema", "name", "source", "controller", "lc_mm", "valve_limit_v", "design", "rst", "dead_zone", "model"}, src); !s)
+  if (auto s = only_keys(root, {"schema", "name", "source", "controller", "lc_mm", "valve_limit_v", "design", "rst", "dead_zone", "trajectory", "model"}, src); !s)
     return s.error();
 
   TuningFile f;
@@ -130,6 +132,16 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
     auto v = number(*dz, dz_names[i], src + ": [dead_zone]");
     if (!v) return v.error();
     *fields[i] = *v;
+  }
+
+  if (const auto* trajectory = root["trajectory"].as_table()) {  // optional: files from before pp-traj have none
+    for (const auto& [key, node] : *trajectory) {
+      const std::string name(key.str());
+      auto v = number(*trajectory, name.c_str(), src + ": [trajectory]");
+      if (!v) return v.error();
+      if (!set_trajectory_setting(t.trajectory, name, *v))
+        return core::parse_error(src + ": [trajectory]: unknown key '" + name + "'");
+    }
   }
 
   const auto* model = root["model"].as_table();

@@ -9,7 +9,8 @@ namespace epa::store {
 control::ControllerConfig controller_config(const TuningSet& set, const core::HammersteinModel& model, double safe_valve_v) {
   return {.kind = set.controller, .F = set.F, .G = set.G, .H = set.H, .dead_zone = set.dead_zone,
           .lc_v = set.lc_mm / model.mm_per_volt, .valve_limit_v = set.valve_limit_v, .safe_valve_v = safe_valve_v,
-          .A = model.A, .B = model.B, .Ts = model.Ts, .trajectory = {}};
+          .A = model.A, .B = model.B, .Ts = model.Ts,
+          .trajectory = to_trajectory_config(set.trajectory, model.mm_per_volt)};
 }
 
 core::Status validate(const TuningSet& set, const core::HammersteinModel& model) {

@@ -7,6 +7,7 @@
 
 #include "control/controller.hpp"
 #include "core/hammerstein_model.hpp"
+#include "store/trajectory_settings.hpp"
 
 namespace epa::store {
 
@@ -22,6 +23,7 @@ struct TuningSet {
   core::DeadZone dead_zone;        // what NG-IDZ and FF-IDZ invert, V
   double lc_mm = 5.0;              // FF-IDZ switch-off band l_c
   double valve_limit_v = 5.0;
+  TrajectorySettings trajectory;   // pp-traj's own parameters
 };
 
 // The control law's configuration for `set` designed on `model` (l_c through its sensor scale).

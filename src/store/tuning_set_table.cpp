@@ -11,7 +11,7 @@ namespace {
 
 constexpr const char* kColumns =
     "id, name, created_ms, modified_ms, source, model_id, controller, f_json, g_json, h_json, design_json, "
-    "m_r, m_l, b_r, b_l, lc_mm, valve_limit_v";
+    "m_r, m_l, b_r, b_l, lc_mm, valve_limit_v, trajectory_json";
 
 core::Result<TuningSet> read_row(const Statement& s) {
   TuningSet t;
@@ -36,6 +36,9 @@ core::Result<TuningSet> read_row(const Statement& s) {
   t.dead_zone = {s.column_double(11), s.column_double(12), s.column_double(13), s.column_double(14)};
   t.lc_mm = s.column_double(15);
   t.valve_limit_v = s.column_double(16);
+  auto trajectory = trajectory_settings_from_json_text(s.column_text(17), what + " trajectory_json");
+  if (!trajectory) return trajectory.error();
+  t.trajectory = *trajectory;
   return t;
 }
 
@@ -44,7 +47,7 @@ void bind_values(Statement& s, const TuningSet& t) {
   s.bind(5, std::string(control::to_string(t.controller)));
   s.bind(6, to_json_text(t.F)).bind(7, to_json_text(t.G)).bind(8, to_json_text(t.H)).bind(9, t.design_json.empty() ? "{}" : t.design_json);
   s.bind(10, t.dead_zone.m_r).bind(11, t.dead_zone.m_l).bind(12, t.dead_zone.b_r).bind(13, t.dead_zone.b_l);
-  s.bind(14, t.lc_mm).bind(15, t.valve_limit_v);
+  s.bind(14, t.lc_mm).bind(15, t.valve_limit_v).bind(16, to_json_text(t.trajectory));
 }
 
 core::Result<std::vector<TuningSet>> read_all(Statement& stmt) {
@@ -65,10 +68,10 @@ core::Result<std::int64_t> TuningSetTable::insert(const TuningSet& t) {
   if (t.name.empty()) return core::invalid_argument("a tuning set needs a name");
   auto stmt = db_.prepare(
       "INSERT INTO tuning_sets (name, modified_ms, source, model_id, controller, f_json, g_json, h_json, design_json, "
-      "m_r, m_l, b_r, b_l, lc_mm, valve_limit_v, created_ms) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+      "m_r, m_l, b_r, b_l, lc_mm, valve_limit_v, trajectory_json, created_ms) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   if (!stmt) return stmt.error();
   bind_values(*stmt, t);
-  stmt->bind(16, t.created_ms);
+  stmt->bind(17, t.created_ms);
   if (auto s = stmt->run(); !s) {
     const int code = db_.last_error_code();
     if (code == SQLITE_CONSTRAINT_UNIQUE) return core::invalid_argument("a tuning set named '" + t.name + "' exists already");
@@ -111,10 +114,10 @@ core::Result<std::vector<TuningSet>> TuningSetTable::all() {
 core::Status TuningSetTable::update(const TuningSet& t) {
   auto stmt = db_.prepare(
       "UPDATE tuning_sets SET name = ?, modified_ms = ?, source = ?, model_id = ?, controller = ?, f_json = ?, g_json = ?, "
-      "h_json = ?, design_json = ?, m_r = ?, m_l = ?, b_r = ?, b_l = ?, lc_mm = ?, valve_limit_v = ? WHERE id = ?");
+      "h_json = ?, design_json = ?, m_r = ?, m_l = ?, b_r = ?, b_l = ?, lc_mm = ?, valve_limit_v = ?, trajectory_json = ? WHERE id = ?");
   if (!stmt) return stmt.error();
   bind_values(*stmt, t);
-  stmt->bind(16, t.id);
+  stmt->bind(17, t.id);
   if (auto s = stmt->run(); !s) return s;
   if (db_.changes() != 1) return core::invalid_argument("no tuning set with id " + std::to_string(t.id));
   return core::ok();

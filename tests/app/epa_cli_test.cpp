@@ -29,7 +29,7 @@ TEST_F(EpaCli, SimulateWritesTableRunsJsonAndPicture) {
   const auto j = read_json(path("sim.json"));
   EXPECT_EQ(j["schema"], "epa-sim/1");
   EXPECT_EQ(j["Ts"], 0.005);
-  ASSERT_EQ(j["results"].size(), 6u);
+  ASSERT_EQ(j["results"].size(), 8u);  // four controllers, two steps
   for (const auto& r : j["results"]) {
     if (r["controller"] == "pp" && r["step_mm"] == 25) {
       EXPECT_TRUE(r["rise_s"].is_null());  // never moved
