@@ -24,7 +24,7 @@ void BM_ControllerStep(benchmark::State& state) {
   }
   state.SetLabel(std::string(epa::control::to_string(kind)));
 }
-BENCHMARK(BM_ControllerStep)->Arg(0)->Arg(1)->Arg(2);
+BENCHMARK(BM_ControllerStep)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
 
 void BM_PlantStep(benchmark::State& state) {
   auto plant = *epa::plant::HammersteinPlant::make(epa::core::paper::model(), {.initial_position_mm = 250.0, .noise_std_mm = 0.1});
@@ -47,7 +47,7 @@ void BM_ClosedLoop20s(benchmark::State& state) {
   }
   state.SetLabel(std::string(epa::control::to_string(kind)) + ", 4000 samples incl. recording and metrics");
 }
-BENCHMARK(BM_ClosedLoop20s)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ClosedLoop20s)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

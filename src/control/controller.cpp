@@ -47,12 +47,20 @@ core::Result<ControllerParams> ControllerParams::make(const ControllerConfig& c)
   p.lc_v_ = c.lc_v;
   p.valve_limit_v_ = c.valve_limit_v;
   p.safe_valve_v_ = c.safe_valve_v;
+  p.trajectory_config_ = c.trajectory;
   if (c.kind == ControllerKind::kPpTraj) {
     auto t = make_trajectory_params(c.trajectory, c.A, c.B, c.dead_zone, c.valve_limit_v, c.Ts);
     if (!t) return core::invalid_argument("controller: " + t.error().message);
     p.trajectory_ = *t;
   }
   return p;
+}
+
+void controller_start(const ControllerParams& p, ControllerState& state, double y_v, double speed_v_s) noexcept {
+  state = {};
+  state.rst.y_past.fill(y_v);
+  state.rst.r_past.fill(y_v);
+  if (p.kind() == ControllerKind::kPpTraj) trajectory_reset(p.trajectory(), state.trajectory, y_v, speed_v_s);
 }
 
 ControllerOutput controller_step(const ControllerParams& p, ControllerState& state, double r_v, double y_v) noexcept {

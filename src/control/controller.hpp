@@ -42,6 +42,7 @@ class ControllerParams {
   double valve_limit_v() const { return valve_limit_v_; }
   double safe_valve_v() const { return safe_valve_v_; }
   const TrajectoryParams& trajectory() const { return trajectory_; }
+  const TrajectoryConfig& trajectory_config() const { return trajectory_config_; }  // what pp-traj was made from
 
  private:
   ControllerKind kind_ = ControllerKind::kPp;
@@ -49,6 +50,7 @@ class ControllerParams {
   core::DeadZone dead_zone_;
   double lc_v_ = 0.0, valve_limit_v_ = 5.0, safe_valve_v_ = 0.0;
   TrajectoryParams trajectory_;
+  TrajectoryConfig trajectory_config_;
 };
 
 // A default-constructed state is "not started": pp-traj starts its profile at the first y it reads.
@@ -64,6 +66,10 @@ struct ControllerOutput {
   bool saturated = false;     // the valve command hit its limit
   bool fault = false;         // non-finite input or output: valve_v is the safe command, state kept
 };
+
+// Starts a law on a piston at y_v moving at speed_v_s (V/s), as when RUN begins or another law
+// hands over: the RST laws with no error or output history, pp-traj with its profile there.
+void controller_start(const ControllerParams& params, ControllerState& state, double y_v, double speed_v_s) noexcept;
 
 // One sample: reads r(k), y(k) (sensor volts), returns the valve command to hold until k+1.
 // No anti-windup: the paper's law runs on the unsaturated u (its F has no pole at 1).

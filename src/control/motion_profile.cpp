@@ -5,13 +5,18 @@
 
 namespace epa::control {
 
-void motion_profile_reset(const MotionLimits& l, MotionProfileState& s, double position_v) noexcept {
+void motion_profile_reset(const MotionLimits& l, MotionProfileState& s, double position_v, double speed_v_s) noexcept {
   s.started = true;
   s.position_v = position_v;
-  s.speed_v_s = 0.0;
+  s.speed_v_s = std::isfinite(speed_v_s) ? std::clamp(speed_v_s, -l.speed_neg_v_s, l.speed_pos_v_s) : 0.0;
   s.target_v = position_v;
   s.accel_v_s2 = l.accel_v_s2;
-  std::fill(s.window.begin(), s.window.begin() + static_cast<std::ptrdiff_t>(l.smoothing_samples), position_v);
+  // The window's oldest first: what the path was at the same speed, centred on position_v so the
+  // smoothed output starts where the piston is.
+  const auto n = l.smoothing_samples;
+  for (std::size_t i = 0; i < n; ++i)
+    s.window[i] = position_v + s.speed_v_s * l.Ts * (static_cast<double>(i) - 0.5 * static_cast<double>(n - 1));
+  s.position_v = s.window[n - 1];
   s.next = 0;
 }
 

@@ -35,8 +35,9 @@ struct MotionProfileState {
   std::size_t next = 0;                                // ring index of the oldest
 };
 
-// Starts the profile at rest at `position_v` (the path and its smoothing window all there).
-void motion_profile_reset(const MotionLimits& limits, MotionProfileState& state, double position_v) noexcept;
+// Starts the profile at `position_v` moving at `speed_v_s` (clamped to the limits; 0: at rest),
+// the smoothing window filled as if it had been moving so for a while.
+void motion_profile_reset(const MotionLimits& limits, MotionProfileState& state, double position_v, double speed_v_s = 0.0) noexcept;
 
 // Advances one sample towards `target_v` and returns the smoothed position w(k).
 double motion_profile_step(const MotionLimits& limits, MotionProfileState& state, double target_v) noexcept;

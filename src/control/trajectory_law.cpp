@@ -107,10 +107,10 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   return p;
 }
 
-void trajectory_reset(const TrajectoryParams& p, TrajectoryState& s, double y_v) noexcept {
+void trajectory_reset(const TrajectoryParams& p, TrajectoryState& s, double y_v, double speed_v_s) noexcept {
   s = {};
-  motion_profile_reset(p.limits, s.profile, y_v);
-  s.w.fill(y_v);
+  motion_profile_reset(p.limits, s.profile, y_v, speed_v_s);
+  for (std::size_t i = 0; i < s.w.size(); ++i) s.w[i] = y_v - s.profile.speed_v_s * p.limits.Ts * static_cast<double>(i);
 }
 
 TrajectoryOutput trajectory_step(const TrajectoryParams& p, TrajectoryState& s, double r_v, double y_v,

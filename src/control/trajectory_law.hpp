@@ -87,8 +87,9 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& co
                                                       const core::Polynomial& B, const core::DeadZone& dz,
                                                       double valve_limit_v, double Ts);
 
-// Starts the law at rest at y_v: profile and model history there, nothing filtered or integrated.
-void trajectory_reset(const TrajectoryParams& p, TrajectoryState& s, double y_v) noexcept;
+// Starts the law at y_v, the piston moving at speed_v_s (0: at rest): profile and model history
+// there, nothing filtered or integrated.
+void trajectory_reset(const TrajectoryParams& p, TrajectoryState& s, double y_v, double speed_v_s = 0.0) noexcept;
 
 struct TrajectoryOutput {
   double u = 0.0;         // u_d before the inverse dead zone

@@ -82,6 +82,12 @@ std::vector<PointDef> build() {
       {P::kBr, "b_r", "V", "dead zone right break point", A::kTuning, -10, 10, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.b_r; }},
       {P::kBl, "b_l", "V", "dead zone left break point", A::kTuning, -10, 10, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.b_l; }},
       {P::kLc, "lc_mm", "mm", "FF-IDZ switch-off band l_c", A::kTuning, 0, 100, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.lc_mm; }},
+      {P::kTrajSpeedFraction, "traj_speed_fraction", "", "pp-traj: top speed of its profile, as a fraction of the model's at the valve limit",
+       A::kTuning, 0.05, 1, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.traj_speed_fraction; }},
+      {P::kTrajBandwidth, "traj_bandwidth_rad_s", "rad/s", "pp-traj: crossover of its feedback (what corrects the model's errors)",
+       A::kTuning, 0.5, 30, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.traj_bandwidth_rad_s; }},
+      {P::kTrajHoldBand, "traj_hold_band_mm", "mm", "pp-traj: once arrived, the valve is held at 0 V within this error",
+       A::kTuning, 0, 5, false, true, [](const Ctx& c, int) { return c.snapshot.tuning.traj_hold_band_mm; }},
       // the excitation experiment: settings for the next EXCITE (a running one keeps its own)
       {P::kExciteSeed, "excite_seed", "", "excitation: seed of the pseudo-random pulses (the same seed, the same signal)", A::kTuning, 0,
        4294967295.0, true, true, [](const Ctx& c, int) { return double(c.snapshot.excitation.seed); }},

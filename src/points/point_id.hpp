@@ -20,7 +20,7 @@ enum class PointId : std::uint16_t {
   // the interfaces and the store
   kLocked, kStoreOk, kChangeCounter, kSavedCounter, kModbusRequests, kModbusClients, kUnlockFailures,
   // tuning
-  kTs, kMr, kMl, kBr, kBl, kLc,
+  kTs, kMr, kMl, kBr, kBl, kLc, kTrajSpeedFraction, kTrajBandwidth, kTrajHoldBand,
   // the excitation experiment (mode EXCITE)
   kExciteSeed, kExciteAmplitudeMin, kExciteAmplitudeMax, kExciteDuration, kExciteLeft,
   // the commissioning service: its command (start, abort) and state

@@ -106,6 +106,9 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
       case PointId::kBr: out.tuning.dead_zone.b_r = w.value; break;
       case PointId::kBl: out.tuning.dead_zone.b_l = w.value; break;
       case PointId::kLc: out.tuning.lc_v = w.value / loop_rules_.mm_per_volt; break;
+      case PointId::kTrajSpeedFraction: out.tuning.trajectory.speed_fraction = w.value; break;
+      case PointId::kTrajBandwidth: out.tuning.trajectory.feedback_bandwidth_rad_s = w.value; break;
+      case PointId::kTrajHoldBand: out.tuning.trajectory.hold_band_v = w.value / loop_rules_.mm_per_volt; break;
       case PointId::kExciteSeed: out.excitation.seed = static_cast<std::uint32_t>(w.value); break;
       case PointId::kExciteAmplitudeMin: out.excitation.amplitude_min_v = w.value; break;
       case PointId::kExciteAmplitudeMax: out.excitation.amplitude_max_v = w.value; break;

@@ -19,6 +19,7 @@ ScanCycle::ScanCycle(const RuntimeConfig& config, const Tuning& tuning, hal::Daq
       ch_(ch),
       period_ns_(static_cast<std::int64_t>(std::llround(config.period_s * 1e9))),
       controller_(config.controller),
+      transfer_(0.05, config.period_s),
       setpoint_mm_(config.start_setpoint_mm),
       manual_valve_v_(config.safe_valve_v),
       valve_v_(config.safe_valve_v),
@@ -77,17 +78,21 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
           refusal = CommandRefusal::kControllerUnavailable;
           break;
         }
-        // The RST laws share their history (bumpless between them); pp-traj keeps its own, so a
-        // switch to or from it starts the new law at rest where the piston is.
+        // The RST laws share their history; pp-traj keeps its own, so a switch to or from it
+        // starts the new law where the piston is, at its speed. Either way the valve command
+        // does not step: the new law takes over from it (bumpless transfer).
         if ((c.controller == control::ControllerKind::kPpTraj) != (controller_ == control::ControllerKind::kPpTraj)) {
           const double y_v = (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain;  // the last reading
-          state_ = {};
-          state_.rst.y_past.fill(y_v);
-          state_.rst.r_past.fill(y_v);
+          const double speed_v_s = (sensor_v_ - previous_sensor_v_) * config_.sensor_gain / config_.period_s;
+          control::controller_start(tuning_.for_kind(c.controller), state_, y_v, speed_v_s);
         }
+        if (c.controller != controller_) transfer_pending_ = mode_ == Mode::kRun;
         controller_ = c.controller;
         break;
-      case CommandKind::kTuning: tuning_ = c.tuning; break;              // takes effect in this cycle's step, whole
+      case CommandKind::kTuning:  // takes effect in this cycle's step, whole, taking over from the valve's command
+        tuning_ = c.tuning;
+        transfer_pending_ = mode_ == Mode::kRun;
+        break;
       case CommandKind::kReset:
         if (mode_ == Mode::kFault) {
           mode_ = Mode::kStop;
@@ -233,10 +238,9 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
       if (!read_ok) break;  // hold the last command for a missed sample (counted below)
       if (init_state_on_next_read_) {
         // At rest at the current position: no error history, no controller output history.
-        state_ = {};
-        state_.rst.y_past.fill(y_v);
-        state_.rst.r_past.fill(y_v);
+        control::controller_start(tuning_.for_kind(controller_), state_, y_v, 0.0);
         init_state_on_next_read_ = false;
+        transfer_pending_ = false;  // RUN starts from the safe valve command, not from another law
         if (setpoint_mm_ != position_mm_) start_move();
       }
       {
@@ -245,7 +249,10 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
           enter_fault(FaultCode::kControllerFault);
           valve_v_ = config_.safe_valve_v;
         } else {
-          valve_v_ = out.valve_v;
+          if (transfer_pending_) transfer_.start(valve_v_, out.valve_v);
+          transfer_pending_ = false;
+          const double limit_v = tuning_.for_kind(controller_).valve_limit_v();
+          valve_v_ = std::clamp(transfer_.apply(out.valve_v), -limit_v, limit_v);
           controller_v_ = out.controller_v;
           saturated_ = out.saturated;
         }
@@ -319,6 +326,10 @@ void ScanCycle::publish(bool full_stats) noexcept {
   s.tuning = {rst.F, rst.G, rst.H, static_cast<std::uint8_t>(rst.nF), static_cast<std::uint8_t>(rst.nG),
               static_cast<std::uint8_t>(rst.nH), p.dead_zone().m_r, p.dead_zone().m_l, p.dead_zone().b_r,
               p.dead_zone().b_l, p.lc_v() * config_.mm_per_volt, p.valve_limit_v()};
+  const auto& traj = tuning_.traj.trajectory_config();  // pp-traj's, whichever law runs
+  s.tuning.traj_speed_fraction = traj.speed_fraction;
+  s.tuning.traj_bandwidth_rad_s = traj.feedback_bandwidth_rad_s;
+  s.tuning.traj_hold_band_mm = traj.hold_band_v * config_.mm_per_volt;
   ch_.snapshot.publish(s);
 }
 

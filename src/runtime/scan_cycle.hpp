@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cstdint>
 
+#include "control/bumpless_transfer.hpp"
 #include "control/controller.hpp"
 #include "hal/daq.hpp"
 #include "runtime/clock.hpp"
@@ -92,6 +93,8 @@ class ScanCycle {
   control::ControllerKind controller_;
   control::ControllerState state_;
   bool init_state_on_next_read_ = false;
+  control::BumplessTransfer transfer_;  // a law or tuning switched in RUN takes over from the valve's command
+  bool transfer_pending_ = false;       // start it at the next controller step
   double setpoint_mm_ = 0.0, manual_valve_v_ = 0.0;
   double sensor_v_ = 0.0, position_mm_ = 0.0, valve_v_ = 0.0, controller_v_ = 0.0;
   bool saturated_ = false, io_ok_ = true;

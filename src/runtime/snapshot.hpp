@@ -23,6 +23,7 @@ struct TuningView {
   std::array<double, control::kMaxLawOrder + 1> F{}, G{}, H{};
   std::uint8_t nF = 0, nG = 0, nH = 0;
   double m_r = 0, m_l = 0, b_r = 0, b_l = 0, lc_mm = 0, valve_limit_v = 0;
+  double traj_speed_fraction = 0, traj_bandwidth_rad_s = 0, traj_hold_band_mm = 0;  // pp-traj's settings
 };
 
 struct Snapshot {

@@ -114,6 +114,8 @@ std::string tuning_json(const runtime::Snapshot& s) {
             {"Ts", num(s.Ts)},
             {k(P::kMr), num(t.m_r)}, {k(P::kMl), num(t.m_l)}, {k(P::kBr), num(t.b_r)}, {k(P::kBl), num(t.b_l)},
             {k(P::kLc), num(t.lc_mm)}, {"valve_limit_v", num(t.valve_limit_v)},
+            {k(P::kTrajSpeedFraction), num(t.traj_speed_fraction)}, {k(P::kTrajBandwidth), num(t.traj_bandwidth_rad_s)},
+            {k(P::kTrajHoldBand), num(t.traj_hold_band_mm)},
             {"F", poly(t.F, t.nF)}, {"G", poly(t.G, t.nG)}, {"H", poly(t.H, t.nH)}};
   return j.dump();
 }

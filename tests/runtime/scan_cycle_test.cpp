@@ -11,6 +11,7 @@
 #include "core/run_file.hpp"
 #include "fake_daq.hpp"
 #include "hal/sim_daq.hpp"
+#include "plant/plant_adapter.hpp"
 #include "runtime/recorder.hpp"
 #include "sim/closed_loop.hpp"
 
@@ -161,10 +162,12 @@ TEST(ScanCycle, TuningSwappedMidRunTakesEffectAtTheNextCycleWithTheStateCarriedO
   for (int k = 0; k < 10; ++k) control::controller_step(old_params, state, 3.0, 2.0);
   const auto expected = control::controller_step(swapped.ffidz, state, 3.0, 2.0);
 
+  const double held_v = rig.daq.last_written_v;
   rig.push(tuning_command(swapped));
   rig.cycles(1);
   EXPECT_DOUBLE_EQ(rig.snap().controller_v, expected.controller_v);
-  EXPECT_DOUBLE_EQ(rig.daq.last_written_v, expected.valve_v);
+  EXPECT_NE(expected.valve_v, held_v);             // the new tuning asks for another command...
+  EXPECT_DOUBLE_EQ(rig.daq.last_written_v, held_v);  // ...which it takes over from the held one (bumpless)
   EXPECT_EQ(rig.snap().tuning.G[0], -0.2);
 }
 
@@ -180,10 +183,73 @@ TEST(ScanCycle, ControllerSwitchIsBumplessTheHistoryCarriesOver) {
   const auto t = paper_tuning();
   for (int k = 0; k < 20; ++k) control::controller_step(t.ffidz, state, 3.0, 2.0);
   const auto expected = control::controller_step(t.ngidz, state, 3.0, 2.0);
+  const double held_v = rig.daq.last_written_v;
   rig.push(controller_command(ControllerKind::kPpNgidz));
   rig.cycles(1);
   EXPECT_EQ(rig.snap().controller, ControllerKind::kPpNgidz);
   EXPECT_DOUBLE_EQ(rig.snap().controller_v, expected.controller_v);  // not restarted from zero
+  EXPECT_DOUBLE_EQ(rig.daq.last_written_v, held_v);                  // and the valve does not step
+}
+
+// Issue 17: switching between any two laws while moving makes no step in the valve command; the
+// new law takes over within a few time constants and brings the piston to the target. On the
+// paper's plant, every ordered pair, switched 80 ms into a 100 mm move.
+TEST(ScanCycle, EverySwitchBetweenTwoLawsWhileMovingIsBumpless) {
+  for (ControllerKind from : control::kAllControllerKinds) {
+    for (ControllerKind to : control::kAllControllerKinds) {
+      if (from == to || from == ControllerKind::kPp) continue;  // plain PP stalls in the dead band
+      SCOPED_TRACE(std::string(control::to_string(from)) + " -> " + std::string(control::to_string(to)));
+      auto daq = *hal::SimDaq::make(core::paper::model(), {.initial_position_mm = 100.0});
+      VirtualClock clock;
+      RuntimeConfig config;
+      config.controller = from;
+      config.start_mode = Mode::kRun;
+      config.start_setpoint_mm = 200.0;
+      LoopChannels ch(8000);
+      ScanCycle loop(config, paper_tuning(), daq, clock, ch);
+      run_cycles(loop, clock, 16);
+      const double held_v = loop.last_snapshot().valve_v;
+      ASSERT_TRUE(ch.commands.try_push(controller_command(to)));
+      run_cycles(loop, clock, 1);
+      EXPECT_DOUBLE_EQ(loop.last_snapshot().valve_v, held_v);
+      EXPECT_EQ(loop.last_snapshot().controller, to);
+      run_cycles(loop, clock, 2000);
+      if (to != ControllerKind::kPp) {
+        EXPECT_NEAR(loop.last_snapshot().position_mm, 200.0, 1.5);
+      }
+    }
+  }
+}
+
+// The same on the physics plant (cylinder, valve, stiction): at the switch the valve does not step,
+// whichever law hands over to which, moving or holding.
+TEST(ScanCycle, SwitchingLawsOnThePhysicsPlantDoesNotStepTheValve) {
+  for (int switch_at : {16, 600}) {  // 80 ms into the move, and 3 s later, holding
+    for (ControllerKind from : control::kAllControllerKinds) {
+      for (ControllerKind to : control::kAllControllerKinds) {
+        if (from == to) continue;
+        SCOPED_TRACE(std::string(control::to_string(from)) + " -> " + std::string(control::to_string(to)) + " at sample " +
+                     std::to_string(switch_at));
+        auto plant = plant::make_pneumatic_simulator({}, {.initial_position_mm = 100.0});
+        ASSERT_TRUE(plant);
+        auto daq = *hal::SimDaq::make(std::move(*plant));
+        VirtualClock clock;
+        RuntimeConfig config;
+        config.controller = from;
+        config.start_mode = Mode::kRun;
+        config.start_setpoint_mm = 200.0;
+        LoopChannels ch(8000);
+        ScanCycle loop(config, paper_tuning(), daq, clock, ch);
+        run_cycles(loop, clock, switch_at);
+        const double held_v = loop.last_snapshot().valve_v;
+        ASSERT_TRUE(ch.commands.try_push(controller_command(to)));
+        run_cycles(loop, clock, 1);
+        EXPECT_DOUBLE_EQ(loop.last_snapshot().valve_v, held_v);
+        run_cycles(loop, clock, 400);
+        EXPECT_EQ(loop.last_snapshot().mode, Mode::kRun);  // no fault from the switch
+      }
+    }
+  }
 }
 
 TEST(ScanCycle, ShutDownPutsTheValveSafe) {
