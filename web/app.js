@@ -125,6 +125,7 @@ function showTuning(t) {
   setText("t-f", poly(t.F));
   setText("t-g", poly(t.G));
   setText("t-h", poly(t.H));
+  setText("t-traj", `${num(t.traj_speed_fraction * 100, 0)} % / ${num(t.traj_bandwidth_rad_s, 1)} rad/s / ${num(t.traj_hold_band_mm, 3)} mm`);
 }
 
 const escapeHtml = (s) => String(s).replace(/[&<>"']/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;", "'": "&#39;" }[c]));

@@ -19,7 +19,15 @@ TuningFile example() {
   f.set.dead_zone.m_r = 1.0 / 3.0;  // not representable in few digits: must still round-trip exactly
   f.model.fit_json = R"({"fit_pct":88.5})";
   f.model.model.B = core::Polynomial({0.0, 1.0 / 7.0, -2.046, 1.029});
+  f.set.trajectory.speed_fraction = 0.55;
+  f.set.trajectory.hold_band_mm = 1.0 / 30.0;
   return f;
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return text.replace(at, from.size(), to);
 }
 
 TEST(TuningFile, ExportThenImportGivesTheSameSetAndModel) {
@@ -38,6 +46,7 @@ TEST(TuningFile, ExportThenImportGivesTheSameSetAndModel) {
   EXPECT_EQ(back->set.dead_zone.b_l, f.set.dead_zone.b_l);
   EXPECT_EQ(back->set.lc_mm, f.set.lc_mm);
   EXPECT_EQ(back->set.valve_limit_v, f.set.valve_limit_v);
+  EXPECT_EQ(back->set.trajectory, f.set.trajectory);
   EXPECT_EQ(back->model.name, f.model.name);
   EXPECT_EQ(back->model.source, f.model.source);
   EXPECT_EQ(back->model.fit_json, f.model.fit_json);
@@ -47,17 +56,38 @@ TEST(TuningFile, ExportThenImportGivesTheSameSetAndModel) {
   EXPECT_EQ(format_tuning_toml(back->set, back->model), text);  // and the text is stable
 }
 
+TEST(TuningFile, PpTrajSettingsAreOptionalAndAnUnknownOneIsRefusedByName) {
+  const TuningFile f = example();
+  const std::string text = format_tuning_toml(f.set, f.model);
+  // A file from before pp-traj (no [trajectory]) imports with the defaults.
+  const auto start = text.find("[trajectory]");
+  const auto end = text.find("\n[", start + 1);
+  ASSERT_NE(start, std::string::npos);
+  auto old = parse_tuning_toml(text.substr(0, start) + text.substr(end + 1), "old.toml");
+  ASSERT_TRUE(old) << old.error().message;
+  EXPECT_EQ(old->set.trajectory, TrajectorySettings{});
+  auto bad = parse_tuning_toml(replaced(text, "speed_fraction = ", "top_speed = "), "bad.toml");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("top_speed"), std::string::npos) << bad.error().message;
+  // pp-traj on this example's model (B(1) < 0: more valve, less speed) is refused with why...
+  auto pp_traj = parse_tuning_toml(replaced(text, "controller = \"pp-ngidz\"", "controller = \"pp-traj\""), "t.toml");
+  ASSERT_FALSE(pp_traj);
+  EXPECT_NE(pp_traj.error().message.find("speed gain"), std::string::npos) << pp_traj.error().message;
+  // ...and accepted on the paper's model.
+  const StoreSeed seed = paper_seed();
+  TuningSet set = f.set;
+  set.controller = control::ControllerKind::kPpTraj;
+  auto paper = parse_tuning_toml(format_tuning_toml(set, seed.model), "p.toml");
+  ASSERT_TRUE(paper) << paper.error().message;
+  EXPECT_EQ(paper->set.controller, control::ControllerKind::kPpTraj);
+}
+
 TEST(TuningFile, ThePaperValuesAreWrittenAsPrinted) {
   const std::string text = format_tuning_toml(paper_seed().tuning, paper_seed().model);
   EXPECT_NE(text.find("F = [1.0, -1.778, 0.7828]"), std::string::npos) << text;
   EXPECT_NE(text.find("[model.arx]"), std::string::npos) << text;
 }
 
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  return text.replace(at, from.size(), to);
-}
 
 TEST(TuningFile, BadFilesAreRefusedNamingWhatIsWrong) {
   const TuningFile f = example();
