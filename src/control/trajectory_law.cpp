@@ -40,6 +40,7 @@ core::Result<ModelSpeeds> model_top_speeds(const core::Polynomial& A, const core
                                   core::format_number(b1) + ", A1(1) = " + core::format_number(a_slope));
   const double per_u = b1 / (a_slope * Ts);  // V/s of speed per unit of u_d
   ModelSpeeds s;
+  s.per_u_v_s = per_u;
   s.pos_v_s = std::max(0.0, dz.m_r * (valve_limit_v - dz.b_r)) * per_u;
   s.neg_v_s = std::max(0.0, dz.m_l * (valve_limit_v + dz.b_l)) * per_u;
   if (!(s.pos_v_s > 0.0) || !(s.neg_v_s > 0.0))
@@ -94,8 +95,7 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   for (std::size_t i = 0; i < B.size(); ++i) p.B[i] = B[i] / b1;
   p.nA = A.size() - 1;
   p.nB = B.size() - 1;
-  const double per_u = speeds->pos_v_s / std::max(1e-12, dz.m_r * (valve_limit_v - dz.b_r));  // V/s per unit u
-  p.proportional_gain = c.feedback_bandwidth_rad_s / per_u;
+  p.proportional_gain = c.feedback_bandwidth_rad_s / speeds->per_u_v_s;  // crossover on the model's integrator
   p.feedback_filter_alpha = 1.0 - std::exp(-c.filter_ratio * c.feedback_bandwidth_rad_s * Ts);
   p.integral_gain = c.integral_gain_per_s > 0.0 ? c.integral_gain_per_s : 0.75 * p.proportional_gain * c.feedback_bandwidth_rad_s;
   p.integrator_band_v = c.integrator_band_v;

@@ -36,7 +36,7 @@ namespace epa::control {
 // each direction, so one value suits any identified model.
 struct TrajectoryConfig {
   double speed_fraction = 0.8;        // of the model's top speed at the valve limit, per direction, (0, 1]
-  double accel_v_s2 = 0.0;            // profile acceleration, V/s^2; 0: derived from the model (derive_accel)
+  double accel_v_s2 = 0.0;            // profile acceleration, V/s^2; 0: the slower top speed reached in 30 ms
   double accel_per_distance = 200.0;  // short moves: accel <= this x |move|, 1/s^2 (motion_profile.hpp); 0: off
   double smoothing_s = 0.05;          // moving-average length of the profile (jerk limit), s
   double feedback_bandwidth_rad_s = 4.0;  // crossover of the feedback loop on the model's integrator
@@ -77,6 +77,7 @@ struct TrajectoryState {
 // whose B(1) is not positive.
 struct ModelSpeeds {
   double pos_v_s = 0.0, neg_v_s = 0.0;
+  double per_u_v_s = 0.0;  // speed per unit of u_d, V/s: the model's integrator gain
 };
 core::Result<ModelSpeeds> model_top_speeds(const core::Polynomial& A, const core::Polynomial& B, const core::DeadZone& dz,
                                            double valve_limit_v, double Ts);

@@ -96,7 +96,13 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
     switch (w.id) {
       case PointId::kSetpoint: c = runtime::setpoint_command(w.value); break;
       case PointId::kMode: c = runtime::mode_command(static_cast<runtime::Mode>(static_cast<int>(w.value))); break;
-      case PointId::kController: c = runtime::controller_command(static_cast<control::ControllerKind>(static_cast<int>(w.value))); break;
+      case PointId::kController:
+        c = runtime::controller_command(static_cast<control::ControllerKind>(static_cast<int>(w.value)));
+        if (c.controller == control::ControllerKind::kPpTraj) {  // said here, not only by the loop after the answer
+          auto t = runtime::make_tuning(tuning);
+          if (t && !t->traj_unavailable.empty()) return refuse(Refusal::kInvalidValue, quoted(w.id) + ": " + t->traj_unavailable);
+        }
+        break;
       case PointId::kManualValve: c = runtime::manual_valve_command(w.value); break;
       case PointId::kReset: c = runtime::reset_command(); break;
       case PointId::kHeartbeat: c = runtime::heartbeat_command(static_cast<std::uint32_t>(w.value)); break;

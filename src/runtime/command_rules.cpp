@@ -50,7 +50,7 @@ std::string_view describe(CommandRefusal r) {
       return "EXCITE starts only with the piston between the excitation's guard lines (guard_mm inside the soft limits): move it there first";
     case CommandRefusal::kExcitationInvalid: return "the excitation settings do not validate together";
     case CommandRefusal::kControllerUnavailable:
-      return "pp-traj needs a model that integrates (valve opening -> speed) with a positive gain: the active tuning set's model is not one";
+      return "pp-traj needs a model that integrates (valve opening -> speed) with a positive gain: the tuning set's model is not one";
   }
   return "unknown";
 }

@@ -90,7 +90,16 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
         controller_ = c.controller;
         break;
       case CommandKind::kTuning:  // takes effect in this cycle's step, whole, taking over from the valve's command
+        if (controller_ == control::ControllerKind::kPpTraj && !c.tuning.traj_unavailable.empty()) {
+          refusal = CommandRefusal::kControllerUnavailable;  // pp-traj runs: a set it cannot use is not taken
+          break;
+        }
         tuning_ = c.tuning;
+        if (controller_ == control::ControllerKind::kPpTraj) {  // its profile restarts under the new limits
+          const double y_v = (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain;
+          const double speed_v_s = (sensor_v_ - previous_sensor_v_) * config_.sensor_gain / config_.period_s;
+          control::controller_start(tuning_.traj, state_, y_v, speed_v_s);
+        }
         transfer_pending_ = mode_ == Mode::kRun;
         break;
       case CommandKind::kReset:

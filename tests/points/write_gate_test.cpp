@@ -193,6 +193,34 @@ TEST(WriteGate, AGroupIsTakenWholeOrNotAtAll) {
   EXPECT_EQ(sink.entries.size(), 4u);
 }
 
+TEST(WriteGate, PpTrajIsRefusedOnAModelItCannotUseAndTakenOnOneItCan) {
+  const runtime::RuntimeConfig config;
+  runtime::LoopChannels channels(16);
+  RecordingSink sink;
+  auto not_integrating = paper();
+  not_integrating.A = core::Polynomial({1.0, -0.5});
+  WriteGate refusing(limits_of(config), config, not_integrating, channels, &sink);
+  const PointWrite traj[] = {{PointId::kController, 3.0}};
+  const auto r = refusing.submit(traj, kOperator);
+  EXPECT_EQ(r.refusal, Refusal::kInvalidValue);
+  EXPECT_NE(r.reason.find("integrates"), std::string::npos) << r.reason;
+  runtime::Command c;
+  EXPECT_FALSE(channels.commands.try_pop(c));
+  EXPECT_TRUE(sink.entries.empty());
+
+  WriteGate taking(limits_of(config), config, paper(), channels, &sink);
+  ASSERT_TRUE(taking.submit(traj, kOperator).accepted());
+  ASSERT_TRUE(channels.commands.try_pop(c));
+  EXPECT_EQ(c.controller, control::ControllerKind::kPpTraj);
+  // Its settings are tuning points: checked whole (a speed fraction of 0 would not validate).
+  const PointWrite band[] = {{PointId::kTrajHoldBand, 0.2}, {PointId::kTrajBandwidth, 6.0}};
+  ASSERT_TRUE(taking.submit(band, kOperator).accepted());
+  ASSERT_TRUE(channels.commands.try_pop(c));
+  ASSERT_EQ(c.kind, runtime::CommandKind::kTuning);
+  EXPECT_DOUBLE_EQ(c.tuning.traj.trajectory_config().hold_band_v * 50.0, 0.2);
+  EXPECT_DOUBLE_EQ(c.tuning.traj.trajectory_config().feedback_bandwidth_rad_s, 6.0);
+}
+
 TEST(WriteGate, ExcitationSettingsAreUnlockProtectedCheckedWholeAndQueuedBeforeTheModeChange) {
   const runtime::RuntimeConfig config;
   runtime::LoopChannels channels(16);
