@@ -39,8 +39,8 @@ struct TrajectoryConfig {
   double accel_v_s2 = 0.0;            // profile acceleration, V/s^2; 0: the slower top speed reached in 30 ms
   double accel_per_distance = 200.0;  // short moves: accel <= this x |move|, 1/s^2 (motion_profile.hpp); 0: off
   double smoothing_s = 0.05;          // moving-average length of the profile (jerk limit), s
-  double feedback_bandwidth_rad_s = 4.0;  // crossover of the feedback loop on the model's integrator
-  double filter_ratio = 4.0;          // the feedback's 2nd-order low-pass sits this far above the crossover
+  double feedback_bandwidth_rad_s = 6.0;  // crossover of the feedback loop on the model's integrator
+  double filter_ratio = 8.0;          // the feedback's 2nd-order low-pass sits this far above the crossover
   double integral_gain_per_s = 0.0;   // u per (V s) of error; 0: derived (PI zero at 3/4 of the crossover)
   double integrator_band_v = 0.0005;  // no integration within this error, V (0.05 mm at 50 mm/V)
   double hold_band_v = 0.0015;        // hold the valve once arrived within this filtered error, V

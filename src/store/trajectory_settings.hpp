@@ -9,22 +9,26 @@
 
 #include "control/trajectory_law.hpp"
 #include "core/result.hpp"
+#include "core/units.hpp"
 
 namespace epa::store {
 
+// The law's own defaults, in these units (at the rig's 50 mm per sensor volt): one set of values.
+inline constexpr control::TrajectoryConfig kTrajectoryDefaults{};
+
 struct TrajectorySettings {
-  double speed_fraction = 0.8;
-  double accel_mm_s2 = 0.0;
-  double accel_per_distance_per_s2 = 200.0;
-  double smoothing_s = 0.05;
-  double feedback_bandwidth_rad_s = 4.0;
-  double filter_ratio = 4.0;
-  double integral_gain_per_mm_s = 0.0;
-  double integrator_band_mm = 0.025;
-  double hold_band_mm = 0.075;
-  double error_filter_s = 0.05;
-  double idz_ramp_v = 0.0;
-  double creep_margin_v = 0.2;
+  double speed_fraction = kTrajectoryDefaults.speed_fraction;
+  double accel_mm_s2 = core::sensor_v_to_mm(kTrajectoryDefaults.accel_v_s2);
+  double accel_per_distance_per_s2 = kTrajectoryDefaults.accel_per_distance;
+  double smoothing_s = kTrajectoryDefaults.smoothing_s;
+  double feedback_bandwidth_rad_s = kTrajectoryDefaults.feedback_bandwidth_rad_s;
+  double filter_ratio = kTrajectoryDefaults.filter_ratio;
+  double integral_gain_per_mm_s = kTrajectoryDefaults.integral_gain_per_s / core::kMmPerSensorVolt;
+  double integrator_band_mm = core::sensor_v_to_mm(kTrajectoryDefaults.integrator_band_v);
+  double hold_band_mm = core::sensor_v_to_mm(kTrajectoryDefaults.hold_band_v);
+  double error_filter_s = kTrajectoryDefaults.error_filter_s;
+  double idz_ramp_v = kTrajectoryDefaults.idz_ramp;
+  double creep_margin_v = kTrajectoryDefaults.creep_margin_v;
 
   bool operator==(const TrajectorySettings&) const = default;
 };

@@ -65,10 +65,10 @@ TEST(PpTraj, WithSensorNoiseItStaysWithinTheNoiseAndHoldsTheValve) {
   }
 }
 
-// Issue 17's robustness cases. What this law guarantees in all of them is asserted here: no
-// divergence, no chatter, the target held within 0.2 mm. Its overshoot and settling limits
-// (30 %, 3 s) are not met by every case: the README's robustness table gives the figures.
-TEST(PpTraj, OnPlantsItsModelGetsWrongItNeitherDivergesNorChatters) {
+// Issue 17's robustness cases. Asserted in all of them: no divergence, no chatter, e_ss within
+// 0.15 mm, settled within 3 s (10 s with the delay). The overshoot limit (30 %) is not met by every
+// short move: the README's robustness table gives the figures.
+TEST(PpTraj, OnPlantsItsModelGetsWrongItHoldsTheTargetWithoutChatterAndSettlesInTime) {
   struct Case {
     const char* name;
     ModelPerturbation plant;
@@ -84,9 +84,11 @@ TEST(PpTraj, OnPlantsItsModelGetsWrongItNeitherDivergesNorChatters) {
     for (double step : kSteps) {
       SCOPED_TRACE(std::string(c.name) + ", step " + std::to_string(step) + " mm");
       const StepRun traj = run(ControllerKind::kPpTraj, step, c.plant, c.line);
-      EXPECT_NEAR(traj.metrics.final_mm, step, 0.2);
-      EXPECT_LE(traj.metrics.ess_mm, 0.2);
+      EXPECT_NEAR(traj.metrics.final_mm, step, 0.15);
+      EXPECT_LE(traj.metrics.ess_mm, 0.15);
       EXPECT_LE(sign_changes_in_last_10s(traj), 2u);
+      ASSERT_TRUE(traj.metrics.settling_s.has_value());
+      EXPECT_LE(*traj.metrics.settling_s, c.line.delay_samples > 0 ? 10.0 : 3.0);
     }
   }
 }
