@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <span>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -54,12 +53,6 @@ void add_simulate_command(CLI::App& app, SimulateOptions& o) {
 namespace {
 
 nlohmann::json optional_json(std::optional<double> v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
-
-// The last `seconds` of a column (all of it when the run is shorter): where chatter is judged.
-std::span<const double> last_seconds(const std::vector<double>& column, double seconds, double Ts) {
-  const auto n = std::min(column.size(), static_cast<std::size_t>(std::llround(seconds / Ts)));
-  return std::span<const double>(column).subspan(column.size() - n);
-}
 
 }  // namespace
 
@@ -155,7 +148,7 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
                               {"ess_mm", m.ess_mm}, {"overshoot_pct", optional_json(m.overshoot_pct)},
                               {"overshoot_mm", optional_json(m.overshoot_pct ? std::optional<double>(*m.overshoot_pct / 100.0 * std::abs(c.step_mm)) : std::nullopt)},
                               {"valve_sign_changes", c.result.valve_sign_changes},
-                              {"valve_sign_changes_last_10s", sim::count_sign_changes(last_seconds(c.result.run.u_V, 10.0, model.Ts))},
+                              {"valve_sign_changes_last_10s", sim::valve_sign_changes_in_last(c.result, 10.0)},
                               {"faults", c.result.faults}});
     }
     if (auto s = write_output(o.json_path, j.dump(1) + "\n", out); !s) return err << "epa simulate: " << s.error().message << "\n", 1;

@@ -70,38 +70,33 @@ ControllerOutput controller_step(const ControllerParams& p, ControllerState& sta
     out.fault = true;
     return out;
   }
+  double u = 0.0, valve = 0.0;
+  bool finite = true;
   if (p.kind() == ControllerKind::kPpTraj) {
-    const ControllerState before = state;
+    const TrajectoryState before = state.trajectory;
     const TrajectoryOutput t = trajectory_step(p.trajectory(), state.trajectory, r_v, y_v, state.saturated_sign);
-    if (!std::isfinite(t.u)) {  // overflow of a diverging loop: do not poison the state
-      state = before;
-      out.valve_v = p.safe_valve_v();
-      out.fault = true;
-      return out;
+    u = t.u;
+    finite = std::isfinite(u);
+    if (!finite) state.trajectory = before;  // overflow of a diverging loop: do not poison the state
+    valve = t.holding   ? 0.0
+            : t.arrived ? creeping_idz_command(p.dead_zone(), u, p.trajectory().creep_margin_v)
+                        : smooth_idz_command(p.dead_zone(), u, p.trajectory().idz_ramp);
+  } else {
+    const RstState before = state.rst;
+    u = rst_step(p.rst(), state.rst, r_v, y_v);
+    finite = std::isfinite(u);
+    if (!finite) state.rst = before;  // overflow of a diverging loop: do not poison the state
+    switch (p.kind()) {
+      case ControllerKind::kPp: valve = u; break;
+      case ControllerKind::kPpNgidz: valve = ngidz_command(p.dead_zone(), u); break;
+      case ControllerKind::kPpFfidz: valve = ffidz_command(p.dead_zone(), u, r_v - y_v, p.lc_v()); break;
+      case ControllerKind::kPpTraj: break;  // the branch above
     }
-    const double valve = t.holding   ? 0.0
-                         : t.arrived ? creeping_idz_command(p.dead_zone(), t.u, p.trajectory().creep_margin_v)
-                                     : smooth_idz_command(p.dead_zone(), t.u, p.trajectory().idz_ramp);
-    out.controller_v = t.u;
-    out.valve_v = std::clamp(valve, -p.valve_limit_v(), p.valve_limit_v());
-    out.saturated = out.valve_v != valve;
-    state.saturated_sign = out.saturated ? (valve > 0.0 ? 1 : -1) : 0;
-    return out;
   }
-  const RstState before = state.rst;
-  const double u = rst_step(p.rst(), state.rst, r_v, y_v);
-  if (!std::isfinite(u)) {  // overflow of a diverging loop: do not poison the state
-    state.rst = before;
+  if (!finite) {
     out.valve_v = p.safe_valve_v();
     out.fault = true;
     return out;
-  }
-  double valve = u;
-  switch (p.kind()) {
-    case ControllerKind::kPp: break;
-    case ControllerKind::kPpNgidz: valve = ngidz_command(p.dead_zone(), u); break;
-    case ControllerKind::kPpFfidz: valve = ffidz_command(p.dead_zone(), u, r_v - y_v, p.lc_v()); break;
-    case ControllerKind::kPpTraj: break;  // handled above
   }
   out.controller_v = u;
   out.valve_v = std::clamp(valve, -p.valve_limit_v(), p.valve_limit_v());

@@ -99,8 +99,9 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
       case PointId::kController:
         c = runtime::controller_command(static_cast<control::ControllerKind>(static_cast<int>(w.value)));
         if (c.controller == control::ControllerKind::kPpTraj) {  // said here, not only by the loop after the answer
-          auto t = runtime::make_tuning(tuning);
-          if (t && !t->traj_unavailable.empty()) return refuse(Refusal::kInvalidValue, quoted(w.id) + ": " + t->traj_unavailable);
+          control::ControllerConfig traj = tuning;
+          traj.kind = control::ControllerKind::kPpTraj;
+          if (auto p = control::ControllerParams::make(traj); !p) return refuse(Refusal::kInvalidValue, quoted(w.id) + ": " + p.error().message);
         }
         break;
       case PointId::kManualValve: c = runtime::manual_valve_command(w.value); break;

@@ -74,32 +74,25 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
         break;
       case CommandKind::kManualValve: manual_valve_v_ = c.value; break;
       case CommandKind::kController:
-        if (c.controller == control::ControllerKind::kPpTraj && !tuning_.traj_unavailable.empty()) {
+        if (c.controller == control::ControllerKind::kPpTraj && !tuning_.traj_available) {
           refusal = CommandRefusal::kControllerUnavailable;
           break;
         }
         // The RST laws share their history; pp-traj keeps its own, so a switch to or from it
         // starts the new law where the piston is, at its speed. Either way the valve command
         // does not step: the new law takes over from it (bumpless transfer).
-        if ((c.controller == control::ControllerKind::kPpTraj) != (controller_ == control::ControllerKind::kPpTraj)) {
-          const double y_v = (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain;  // the last reading
-          const double speed_v_s = (sensor_v_ - previous_sensor_v_) * config_.sensor_gain / config_.period_s;
-          control::controller_start(tuning_.for_kind(c.controller), state_, y_v, speed_v_s);
-        }
+        if ((c.controller == control::ControllerKind::kPpTraj) != (controller_ == control::ControllerKind::kPpTraj))
+          start_law_at_the_piston(tuning_.for_kind(c.controller));
         if (c.controller != controller_) transfer_pending_ = mode_ == Mode::kRun;
         controller_ = c.controller;
         break;
       case CommandKind::kTuning:  // takes effect in this cycle's step, whole, taking over from the valve's command
-        if (controller_ == control::ControllerKind::kPpTraj && !c.tuning.traj_unavailable.empty()) {
+        if (controller_ == control::ControllerKind::kPpTraj && !c.tuning.traj_available) {
           refusal = CommandRefusal::kControllerUnavailable;  // pp-traj runs: a set it cannot use is not taken
           break;
         }
         tuning_ = c.tuning;
-        if (controller_ == control::ControllerKind::kPpTraj) {  // its profile restarts under the new limits
-          const double y_v = (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain;
-          const double speed_v_s = (sensor_v_ - previous_sensor_v_) * config_.sensor_gain / config_.period_s;
-          control::controller_start(tuning_.traj, state_, y_v, speed_v_s);
-        }
+        if (controller_ == control::ControllerKind::kPpTraj) start_law_at_the_piston(tuning_.traj);  // new limits: a new profile
         transfer_pending_ = mode_ == Mode::kRun;
         break;
       case CommandKind::kReset:
@@ -136,6 +129,13 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
   ++rejected_;
   last_refusal_ = refusal;
   ch_.refusals.try_push({c.sequence, refusal});  // full: the count and last_refusal still tell
+}
+
+double ScanCycle::position_v() const noexcept { return (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain; }
+
+void ScanCycle::start_law_at_the_piston(const control::ControllerParams& law) noexcept {
+  const double speed_v_s = (sensor_v_ - previous_sensor_v_) * config_.sensor_gain / config_.period_s;
+  control::controller_start(law, state_, position_v(), speed_v_s);
 }
 
 void ScanCycle::enter_run(std::int64_t now_ns) noexcept {
@@ -239,7 +239,7 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
     if (const FaultCode f = detect_fault(read_ok, now_ns); f != FaultCode::kNone) enter_fault(f);
   }
 
-  const double y_v = (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain;
+  const double y_v = position_v();
   const double r_v = setpoint_mm_ / config_.mm_per_volt;
   saturated_ = false;
   switch (mode_) {

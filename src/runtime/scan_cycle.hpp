@@ -74,6 +74,10 @@ class ScanCycle {
   void apply_commands(std::int64_t now_ns) noexcept;
   void apply(const Command& c, std::int64_t now_ns) noexcept;
   void enter_run(std::int64_t now_ns) noexcept;
+  // The calibrated position in sensor volts from the last reading: what the control laws read.
+  double position_v() const noexcept;
+  // Starts `law` on the piston where the last reading put it, at the speed of the last two readings.
+  void start_law_at_the_piston(const control::ControllerParams& law) noexcept;
   void end_excitation(ExcitationEnd how) noexcept;
   void start_move() noexcept;
   void finish_move() noexcept;

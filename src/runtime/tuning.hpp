@@ -1,17 +1,16 @@
 #pragma once
 // A tuning set ready for the loop: validated parameters of all four laws from one base
 // configuration, so switching the controller is a lookup at a cycle boundary, never a rebuild.
-#include <string>
-
 #include "control/controller.hpp"
 
 namespace epa::runtime {
 
 struct Tuning {
   control::ControllerParams pp, ngidz, ffidz, traj;
-  // Why pp-traj cannot run on this set's model (it needs one that integrates), empty when it can.
-  // The other three laws stay usable; selecting pp-traj is refused with this reason.
-  std::string traj_unavailable;
+  // False when pp-traj cannot run on this set's model (it needs one that integrates); the other
+  // three laws stay usable and selecting pp-traj is refused. A flag, not the reason: the loop
+  // copies a Tuning on every swap and must not allocate (ControllerParams::make says why).
+  bool traj_available = true;
 
   const control::ControllerParams& for_kind(control::ControllerKind kind) const noexcept {
     switch (kind) {
@@ -32,8 +31,8 @@ inline core::Result<Tuning> make_tuning(control::ControllerConfig base) {
     base.kind = control::kAllControllerKinds[i];
     auto p = control::ControllerParams::make(base);
     if (!p && base.kind == control::ControllerKind::kPpTraj) {
-      t.traj_unavailable = p.error().message;
-      t.traj = t.pp;  // never run: selecting pp-traj is refused while traj_unavailable is set
+      t.traj_available = false;
+      t.traj = t.pp;  // never run: selecting pp-traj is refused while it is unavailable
       continue;
     }
     if (!p) return p.error();

@@ -1,5 +1,6 @@
 #include "sim/closed_loop.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -63,6 +64,12 @@ core::Result<StepRun> simulate_step_on(plant::PlantSimulator& plant, double mm_p
   result.metrics = core::step_metrics(run.y_mm, target_mm, {.Ts = Ts});
   result.valve_sign_changes = count_sign_changes(run.u_V);
   return result;
+}
+
+std::size_t valve_sign_changes_in_last(const StepRun& r, double seconds) {
+  const auto& u = r.run.u_V;
+  const auto n = std::min(u.size(), static_cast<std::size_t>(std::llround(seconds / r.run.Ts)));
+  return count_sign_changes(std::span<const double>(u).subspan(u.size() - n));
 }
 
 std::size_t count_sign_changes(std::span<const double> values) {

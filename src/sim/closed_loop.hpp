@@ -48,4 +48,8 @@ core::Result<StepRun> simulate_step_on(plant::PlantSimulator& plant, double mm_p
 // Number of times the sign flips between strictly positive and strictly negative (zeros skipped).
 std::size_t count_sign_changes(std::span<const double> values);
 
+// The same over the valve commands of the run's last `seconds` (all of it when shorter): where
+// chatter is judged once a move has settled (issue 17: the last 10 s of a 20 s run).
+std::size_t valve_sign_changes_in_last(const StepRun& run, double seconds);
+
 }  // namespace epa::sim

@@ -17,7 +17,6 @@ using control::ControllerKind;
 constexpr double kSteps[] = {25, 50, 100, 200};
 constexpr double kFfidzEssMm = 1.1;    // "FF-IDZ steady-state error within about 1 mm"
 constexpr double kReachedMm = 2.0;     // "reaches the target": final value within 2 mm
-constexpr std::size_t kLast10s = 2000; // samples at Ts = 5 ms
 
 StepRun run(ControllerKind kind, double step_mm, double noise_mm = 0.0, double lc_mm = 5.0) {
   auto config = control::paper_controller_config(kind);
@@ -30,10 +29,7 @@ StepRun run(ControllerKind kind, double step_mm, double noise_mm = 0.0, double l
   return *r;
 }
 
-std::size_t sign_changes_in_last_10s(const StepRun& r) {
-  const auto& u = r.run.u_V;
-  return count_sign_changes(std::span<const double>(u).subspan(u.size() - kLast10s));
-}
+std::size_t sign_changes_in_last_10s(const StepRun& r) { return valve_sign_changes_in_last(r, 10.0); }
 
 TEST(PaperClosedLoop, PlainPpStallsInsideTheDeadZoneAndNeverReachesNinetyPercent) {
   for (double step : kSteps) {

@@ -17,7 +17,6 @@ namespace {
 using control::ControllerKind;
 
 constexpr double kSteps[] = {25, 50, 100, 200};
-constexpr std::size_t kLast10s = 2000;  // samples at Ts = 5 ms
 
 control::ControllerParams params_of(ControllerKind kind) {
   auto p = control::ControllerParams::make(control::paper_controller_config(kind));
@@ -35,10 +34,7 @@ StepRun run(ControllerKind kind, double step_mm, const ModelPerturbation& plant 
   return *r;
 }
 
-std::size_t sign_changes_in_last_10s(const StepRun& r) {
-  const auto& u = r.run.u_V;
-  return count_sign_changes(std::span<const double>(u).subspan(u.size() - kLast10s));
-}
+std::size_t sign_changes_in_last_10s(const StepRun& r) { return valve_sign_changes_in_last(r, 10.0); }
 
 TEST(PpTraj, BeatsFfIdzOnThePrintedModelOnEveryCriterionOfIssue17) {
   for (double step : kSteps) {
