@@ -61,7 +61,7 @@ std::string commission_report_html(const commission::CommissionOutcome& o) {
     std::vector<Panel> panels;
     for (std::size_t i = 0; i < o.experiment.size(); ++i) {
       const auto& r = o.experiment[i];
-      const bool held_out = i + 1 == o.experiment.size();
+      const bool held_out = o.identified ? i == o.identified->held_out_run : i + 1 == o.experiment.size();
       Panel p{"run " + std::to_string(i + 1) + (held_out ? " (held out)" : " (estimation)"), "time (s)", "position (mm)", {}, {}, {}, {}, {}, {}};
       p.series.push_back({"measured", "#1f77b4", times(r.y_mm.size(), r.Ts), r.y_mm, false});
       if (held_out && o.identified && !o.identified->validation_simulated_mm.empty())

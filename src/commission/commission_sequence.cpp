@@ -141,12 +141,31 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
     done_s += spec.excitation_s;
   }
 
-  // 2. Identification: all runs but the last estimate, the last validates.
+  // 2. Identification, cross-validated: each run is held out once while the others estimate, and
+  // the model that predicts its held-out run best is kept. One short run can leave the search in
+  // a model that fits it and nothing else (held-out fits of 24 % and 88 % were seen on the same
+  // rig); trying each split costs seconds of computation, not another experiment.
   step(Stage::kIdentifying, pct(), "identifying the Hammerstein model", out);
-  std::vector<core::Run> estimation(out.experiment.begin(), out.experiment.end() - 1);
-  auto identified = identify_(estimation, out.experiment.back());
-  if (aborted(out)) return out;
-  if (!identified) return finish(Verdict::kRolledBack, "identification: " + identified.error().message, out);
+  std::optional<IdentifiedModel> identified;
+  std::string first_error;
+  for (std::size_t held = out.experiment.size(); held-- > 0;) {
+    std::vector<core::Run> estimation;
+    for (std::size_t i = 0; i < out.experiment.size(); ++i)
+      if (i != held) estimation.push_back(out.experiment[i]);
+    auto candidate = identify_(estimation, out.experiment[held]);
+    if (aborted(out)) return out;
+    const std::string which = "run " + std::to_string(held + 1) + " held out: ";
+    if (!candidate) {
+      out.log.push_back("identification, " + which + candidate.error().message);
+      if (first_error.empty()) first_error = which + candidate.error().message;
+      continue;
+    }
+    candidate->held_out_run = held;
+    out.log.push_back("identified, " + which + candidate->summary);
+    if (log_) log_("commission: identified, " + which + candidate->summary);
+    if (!identified || candidate->validation_fit_pct > identified->validation_fit_pct) identified = std::move(*candidate);
+  }
+  if (!identified) return finish(Verdict::kRolledBack, "identification: " + first_error, out);
   identified->model.Ts = old_model.Ts;  // the runs were recorded by this loop, at its period
   out.identified = *identified;
   out.log.push_back("identified: " + identified->summary);

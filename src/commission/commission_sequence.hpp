@@ -37,6 +37,7 @@ struct IdentifiedModel {
   double validation_fit_pct = 0.0;  // on the held-out run
   std::vector<double> validation_simulated_mm;  // the model's free run on the held-out run's commands
   std::string summary;              // one line for the log and the report
+  std::size_t held_out_run = 0;     // which of the experiment's runs validated it (the others estimated)
 };
 using Identify = std::function<core::Result<IdentifiedModel>(const std::vector<core::Run>& estimation,
                                                              const core::Run& validation)>;
@@ -55,7 +56,7 @@ struct CommissionOutcome {
   CommissionSpec spec;
   std::string previous_set, new_set;  // names; new_set empty when none was stored
   std::int64_t previous_set_id = 0, new_set_id = 0;
-  std::vector<core::Run> experiment;  // the excitation runs, the last held out
+  std::vector<core::Run> experiment;  // the excitation runs (identified->held_out_run validated the model)
   std::optional<IdentifiedModel> identified;
   std::optional<control::RstDesign> design;
   std::optional<SimulatedVerification> simulation;

@@ -27,8 +27,8 @@ struct MoveLimits {
 };
 
 struct CommissionSpec {
-  // The experiment: runs of the excitation (ramps through the dead band, then pulses), the last
-  // one held out to validate the identified model.
+  // The experiment: runs of the excitation (ramps through the dead band, then pulses); each is
+  // held out once to validate the model the others identify (the best held-out fit is kept).
   int excitation_runs = 2;
   double excitation_s = 60.0;
   std::uint64_t seed = 1;           // of the first run's pulses; run i uses seed + i

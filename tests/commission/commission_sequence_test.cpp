@@ -75,6 +75,50 @@ TEST(CommissionSequence, DeploysASetThatPassesEveryCheck) {
   EXPECT_EQ(seq.progress().percent, 100.0);
 }
 
+// Estimated on the run of `bad_seed`, the stand-in returns a model whose gain is a tenth of the
+// plant's (its design cannot pass the simulated moves on the plant's behalf); on any other run,
+// the plant. Held-out fits as a real fit would rank them.
+Identify bad_when_estimated_on(std::uint64_t bad_seed, std::vector<std::string>& held_out_seeds) {
+  return [bad_seed, &held_out_seeds](const std::vector<core::Run>& estimation, const core::Run& validation) -> core::Result<IdentifiedModel> {
+    if (estimation.size() != 1) return core::invalid_argument("expected one estimation run");
+    held_out_seeds.push_back(validation.meta("excitation_seed"));
+    auto plant = core::paper::model();
+    if (estimation.front().meta("excitation_seed") != std::to_string(bad_seed))
+      return IdentifiedModel{plant, 90.0, 88.0, {}, "from a good run"};
+    plant.B = plant.B * 0.1;
+    return IdentifiedModel{plant, 60.0, 24.0, {}, "from a bad run"};
+  };
+}
+
+TEST(CommissionSequence, EachRunIsHeldOutOnceAndTheBestHeldOutFitIsKept) {
+  for (const std::uint64_t bad_seed : {1u, 2u}) {  // spec seed 1: runs of seeds 1 and 2
+    const auto plant = core::paper::model();
+    testing::SimulatedAxis axis(plant, paper_tuning());
+    std::vector<std::string> held_out;
+    CommissionSequence seq(axis, bad_when_estimated_on(bad_seed, held_out));
+    const auto out = seq.run(short_spec());
+    EXPECT_EQ(held_out, (std::vector<std::string>{"2", "1"})) << "each run held out once";
+    ASSERT_EQ(out.verdict, Verdict::kDeployed) << "bad run seed " << bad_seed << ": " << out.reason;
+    ASSERT_TRUE(out.identified);
+    EXPECT_EQ(out.identified->validation_fit_pct, 88.0);
+    EXPECT_EQ(out.experiment[out.identified->held_out_run].meta("excitation_seed"), std::to_string(bad_seed))
+        << "the model kept was estimated on the other run";
+    EXPECT_EQ(axis.excitations, 2) << "no extra experiment";
+  }
+}
+
+TEST(CommissionSequence, AnIdentificationThatFailsOnEverySplitRollsBackWithTheReason) {
+  testing::SimulatedAxis axis(core::paper::model(), paper_tuning());
+  Identify failing = [](const std::vector<core::Run>&, const core::Run&) -> core::Result<IdentifiedModel> {
+    return core::numerical_error("the excitation never left the dead band");
+  };
+  CommissionSequence seq(axis, failing);
+  const auto out = seq.run(short_spec());
+  EXPECT_EQ(out.verdict, Verdict::kRolledBack);
+  EXPECT_NE(out.reason.find("identification: run 2 held out: the excitation never left the dead band"), std::string::npos) << out.reason;
+  EXPECT_EQ(axis.stored_active, 1);
+}
+
 TEST(CommissionSequence, AVerificationLimitTheAxisCannotMeetRollsBackAtOnce) {
   // The axis's valve has a dead band 0.6 V wider than the model identification returned: the
   // simulation on the model passes, the axis stops short.

@@ -34,6 +34,7 @@ class SimulatedAxis final : public commission::Axis {
     core::Run run;
     run.Ts = 0.005;
     run.set_meta("controller", "open-loop");
+    run.set_meta("excitation_seed", std::to_string(r.seed));
     for (std::size_t k = 0; !gen->done() && !abort; ++k) {
       const double y = plant_.measured_mm(), u = gen->next(y);
       run.t_s.push_back(static_cast<double>(k) * run.Ts), run.r_mm.push_back(0.0), run.y_mm.push_back(y);
