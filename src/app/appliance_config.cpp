@@ -253,6 +253,16 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   rec.number("move_window_s", r.move_window_s, above(0, 600, "s"));
   rec.refuse_unknown_keys();
 
+  TableReader mo(top.subtable("motion"), "motion", file, error);
+  mo.number("in_position_window_mm", r.in_position_window_mm, above(0, 100, "mm"));
+  mo.number("in_position_time_s", r.in_position_time_s, closed(0, 60, "s"));
+  mo.number("halt_decel_mm_s2", r.halt_decel_mm_s2, above(0, 1e6, "mm/s^2"));
+  mo.number("jog_speed_mm_s", r.jog_speed_mm_s, above(0, 10000, "mm/s"));
+  mo.number("jog_accel_mm_s2", r.jog_accel_mm_s2, above(0, 1e6, "mm/s^2"));
+  mo.number("jog_keepalive_s", r.jog_keepalive_s, closed(0, 3600, "s (0: off)"));
+  mo.boolean("enable_holds_position", r.enable_holds_position);
+  mo.refuse_unknown_keys();
+
   TableReader ex(top.subtable("excite"), "excite", file, error);
   ex.integer("seed", r.excitation.seed, 0, 4294967295);
   ex.number("amplitude_min_v", r.excitation.amplitude_min_v, above(0, 10, "V"));

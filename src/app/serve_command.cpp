@@ -64,7 +64,7 @@ core::Status apply_overrides(const ServeOptions& o, ApplianceConfig& c) {
     if (!m) return core::invalid_argument("--mode: " + m.error().message);
     c.runtime.start_mode = *m;
   }
-  if (o.setpoint_mm >= 0.0) c.runtime.start_setpoint_mm = o.setpoint_mm;
+  if (o.setpoint_mm >= 0.0) c.runtime.start_setpoint_mm = o.setpoint_mm, c.runtime.start_moves_to_setpoint = true;
   if (!o.record_dir.empty()) c.record_directory = o.record_dir;
   if (!o.db_path.empty()) c.store_path = o.db_path;
   if (auto s = runtime::validate(c.runtime); !s) return s;
@@ -91,13 +91,14 @@ struct ControlSetup {
   runtime::Tuning tuning;
 };
 
-// The points whose accepted values the store keeps: the register map's persisted column; without
-// Modbus, the setpoint (the only persisted point the web page can change).
+// The points whose accepted values the store keeps: the register map's persisted column (without
+// Modbus, the setpoint), and always the position-record table, whichever interface edits it.
 std::set<points::PointId> persisted_points(const std::optional<modbus::RegisterMap>& map) {
-  if (!map) return {points::PointId::kSetpoint};
   std::set<points::PointId> out;
-  for (const auto& e : map->entries())
+  if (!map) out.insert(points::PointId::kSetpoint);
+  for (const auto& e : map ? map->entries() : std::vector<modbus::RegisterEntry>{})
     if (e.persisted) out.insert(e.point->id);
+  for (std::size_t k = 0; k < 4 * points::kPositionRecords; ++k) out.insert(points::indexed_id(points::PointId::kRecordTarget0, k));
   return out;
 }
 
@@ -302,7 +303,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   for (int i = 0; i < 200 && channels.snapshot.read().cycle == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   LogAuditSink log_audit(&store_writer);
   web::RecentAudit audit(&log_audit);  // the last entries for the status page, the log, the store
-  points::WriteGate gate(std::move(*limits), c.runtime, control->tuning_base, channels, &audit);  // every interface's writes
+  points::WriteGate gate(std::move(*limits), c.runtime, control->tuning_base, channels, &audit, control->store.records);  // every interface's writes
   // Commissioning (issue 19): its axis is this loop, through the gate, the recorder and the store.
   // Declared before the interfaces, so it outlives them on every way out (they reach it through
   // the gate), and after the loop, which takes its last commands when it is aborted.

@@ -4,6 +4,7 @@
 // aside and replaced when damaged; refused when newer), the active tuning set loaded and
 // validated (a refused set falls back to the last good one), the retained setpoint, and the
 // store thread that keeps every accepted change from then on.
+#include "points/position_records.hpp"
 #include <memory>
 #include <optional>
 #include <set>
@@ -25,6 +26,7 @@ struct StoreStartup {
   store::TuningSet set;
   store::ModelRecord model;
   std::optional<double> retained_setpoint_mm;
+  points::PositionRecords records;  // the position-record table as retained (defaults where none was)
   runtime::FaultCode start_fault = runtime::FaultCode::kNone;  // kStoreDamaged when moved aside
   std::vector<std::string> notes;     // for the log: what happened at start
   std::vector<std::string> warnings;  // ... and what an operator must look at

@@ -33,8 +33,11 @@ RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, int u
 
 points::InterfaceStatus RequestHandler::status(const Session& session, std::int64_t now_ns) const {
   const core::ChangeCounters changes = gate_.counters();
-  return {static_cast<std::uint32_t>(changes.accepted), static_cast<std::uint32_t>(changes.saved), changes.saving, requests_,
-          clients_, now_ns >= session.unlocked_until_ns, unlock_.failures(), gate_.commission_view()};
+  points::InterfaceStatus s{static_cast<std::uint32_t>(changes.accepted), static_cast<std::uint32_t>(changes.saved), changes.saving,
+                            requests_, clients_, now_ns >= session.unlocked_until_ns, unlock_.failures(), gate_.commission_view()};
+  s.records = gate_.records();
+  s.record_select = gate_.record_select();
+  return s;
 }
 
 std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, Session& session, std::int64_t now_ns,
@@ -46,7 +49,7 @@ std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, Session
   const int fc = req[kHeader];
   const std::uint8_t* d = req + kHeader + 1;
   const int data_length = length - kHeader - 1;
-  const runtime::Snapshot snap = channels_.snapshot.read();
+  const runtime::Snapshot snap = gate_.snapshot();  // with this client's (and others') accepted writes
   std::vector<Write> writes;
 
   switch (fc) {
@@ -99,7 +102,7 @@ std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, Session
         if (!map_.find(Table::kHoldingRegister, a).entry) return kIllegalAddress;
       if (auto e = apply_writes(writes, session, now_ns)) return e;
       // modbus_reply writes first, then reads: the answer shows the written values.
-      return read_into(Table::kHoldingRegister, be16(d), read_quantity, snap, session, now_ns, image);
+      return read_into(Table::kHoldingRegister, be16(d), read_quantity, gate_.snapshot(), session, now_ns, image);
     }
     default: return kIllegalFunction;
   }

@@ -1,5 +1,6 @@
 #include "points/point_catalog.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdlib>
 #include <string>
@@ -16,6 +17,41 @@ double b(bool v) { return v ? 1.0 : 0.0; }
 double coefficient(const std::array<double, kCoefficients>& c, std::uint8_t degree, int i) {
   return i <= degree ? c[static_cast<std::size_t>(i)] : 0.0;
 }
+
+// Names of the indexed points, kept alive for the string_views in the catalog.
+const std::vector<std::string>& record_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const char* field : {"target_mm", "speed_mm_s", "window_mm", "controller"})
+      for (std::size_t i = 1; i <= kPositionRecords; ++i) n.push_back("record" + std::to_string(i) + "_" + field);
+    return n;
+  }();
+  return names;
+}
+
+constexpr std::string_view kControlBitNames[runtime::kControlBits] = {"start", "halt", "jog_plus", "jog_minus", "control_reset"};
+constexpr std::string_view kControlBitText[runtime::kControlBits] = {
+    "control word bit 0: rising edge starts the selected record (record_select; 0: the setpoint); needs RUN",
+    "control word bit 1: rising edge brakes (halt_decel_mm_s2) and holds where the piston stops",
+    "control word bit 2: held, jogs towards larger positions (MANUAL, jog_speed_mm_s); released, brakes",
+    "control word bit 3: held, jogs towards smaller positions (MANUAL)",
+    "control word bit 4: rising edge clears a latched fault"};
+constexpr std::string_view kStatusBitNames[runtime::kStatusBits] = {"ready", "run_enabled", "moving", "in_position", "target_reached",
+                                                                    "following_error", "warning", "fault_latched", "ack", "halted",
+                                                                    "jogging", "manual_mode"};
+constexpr std::string_view kStatusBitText[runtime::kStatusBits] = {
+    "status bit 0: no fault latched and the I/O works",
+    "status bit 1: mode RUN (the law holds or moves the axis)",
+    "status bit 2: a move, halt or jog is under way",
+    "status bit 3: |target - position| within the window for in_position_time_s (RUN)",
+    "status bit 4: the last started move came into position (cleared by the next start)",
+    "status bit 5: |reference - position| beyond following_error_mm now (the fault follows after following_error_time_s)",
+    "status bit 6: following error, I/O errors or the store not saving",
+    "status bit 7: a fault is latched (fault_code)",
+    "status bit 8: acknowledge: mirrors the control word's start bit once the loop applied it",
+    "status bit 9: the last task was a halt",
+    "status bit 10: a jog (or its braking) is under way",
+    "status bit 11: mode MANUAL"};
 
 // Names of the coefficient points (F0..H6), kept alive for the string_views in the catalog.
 const std::vector<std::string>& coefficient_names() {
@@ -63,6 +99,12 @@ std::vector<PointDef> build() {
                                  "writable for this connection until the unlock timeout or until it closes; after 5 wrong keys the "
                                  "address is refused for a back-off that doubles up to 5 minutes", A::kKey, 0, 0, true, false,
        [](const Ctx&, int) { return 0.0; }},
+      // the positioning interface
+      {P::kControlWord, "control_word", "", "bits: 0 start (edge), 1 halt (edge), 2 jog_plus, 3 jog_minus (held, MANUAL), "
+                                            "4 reset (edge); docs/registers.md", A::kWrite, 0, runtime::kControlWordMask, true, true,
+       [](const Ctx& c, int) { return double(c.snapshot.axis.control_word); }},
+      {P::kRecordSelect, "record_select", "", "the record a start moves to: 1..32, or 0 for setpoint_mm", A::kWrite, 0,
+       double(kPositionRecords), true, true, [](const Ctx& c, int) { return double(c.status.record_select); }},
       {P::kLocked, "locked", "", "1 while tuning registers refuse this connection's writes", A::kRead, 0, 0, true, true,
        [](const Ctx& c, int) { return b(c.status.locked); }},
       {P::kStoreOk, "store_ok", "", "1 while the tuning store saves changes; 0 while its writes fail (disk full, read-only): saved_counter stands still until they succeed",
@@ -117,6 +159,9 @@ std::vector<PointDef> build() {
       {P::kMoveSettling, "move_settling_s", "s", "last move: 2 % settling time", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.settling_s; }},
       {P::kMoveEss, "move_ess_mm", "mm", "last move: steady-state error", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.ess_mm; }},
       {P::kMoveOvershoot, "move_overshoot_pct", "%", "last move: overshoot", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.overshoot_pct; }},
+      {P::kMoveEnd, "move_end", "", "last move: how it ended: 0 complete (its whole window), 1 cut short by a new target, 2 halted, "
+                                    "3 stopped (mode change), 4 fault; its metrics are over the samples it had",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.last_move.end); }},
       // loop statistics and counters
       {P::kLoopWakeP50, "loop_wake_p50_us", "us", "scan cycle wake-up latency, median", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.loop.wake_p50_us; }},
       {P::kLoopWakeP99, "loop_wake_p99_us", "us", "scan cycle wake-up latency, 99th percentile", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.loop.wake_p99_us; }},
@@ -137,6 +182,45 @@ std::vector<PointDef> build() {
                                                             "8 EXCITE not from STOP, 9 piston outside the excitation's guard lines, 10 excitation settings invalid",
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.last_refusal)); }},
   };
+  // Positioning: the control bits as coils, the status word and its bits, reference and speed.
+  // (Inserted at their ids' places: the catalog is in PointId order.)
+  std::vector<PointDef> positioning;
+  for (int i = 0; i < runtime::kControlBits; ++i)
+    positioning.push_back({indexed_id(P::kControlBit0, static_cast<std::size_t>(i)), kControlBitNames[i], "", kControlBitText[i], A::kWrite,
+                           0, 1, true, true, [](const Ctx& c, int bit) { return b(c.snapshot.axis.control_word & (1u << bit)); }, i});
+  positioning.push_back({P::kStatusWord, "status_word", "", "bits 0 ready, 1 enabled, 2 moving, 3 in_position, 4 target_reached, "
+                                                              "5 following_error, 6 warning, 7 fault, 8 ack, 9 halted, 10 jogging, 11 manual",
+                         A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(status_word(c.snapshot, c.status.saving)); }});
+  for (int i = 0; i < runtime::kStatusBits; ++i)
+    positioning.push_back({indexed_id(P::kStatusBit0, static_cast<std::size_t>(i)), kStatusBitNames[i], "", kStatusBitText[i], A::kRead, 0, 0,
+                           true, true, [](const Ctx& c, int bit) { return b(status_word(c.snapshot, c.status.saving) & (1u << bit)); }, i});
+  positioning.push_back({P::kReference, "reference_mm", "mm", "what the control law follows: the target, or a halt's or jog's braking path",
+                         A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.axis.reference_mm; }});
+  positioning.push_back({P::kSpeed, "speed_mm_s", "mm/s", "measured piston speed (low-pass 20 ms)", A::kRead, 0, 0, false, true,
+                         [](const Ctx& c, int) { return c.snapshot.axis.speed_mm_s; }});
+  const auto after_select = std::find_if(p.begin(), p.end(), [](const PointDef& d) { return d.id == P::kRecordSelect; }) + 1;
+  p.insert(after_select, positioning.begin(), positioning.end());
+
+  // The position-record table.
+  static constexpr std::string_view kRecordText[] = {
+      "position record: target", "position record: speed limit (0: none, the law's own step response)",
+      "position record: in-position window (0: [motion] in_position_window_mm)",
+      "position record: law (0 pp, 1 pp-ngidz, 2 pp-ffidz, 3 pp-traj; 255 the running one)"};
+  static constexpr double kRecordMax[] = {10000.0, 10000.0, 100.0, double(kKeepController)};
+  static constexpr std::string_view kRecordUnit[] = {"mm", "mm/s", "mm", ""};
+  const auto& records = record_names();
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    const std::size_t field = k / kPositionRecords;
+    PointDef d{indexed_id(P::kRecordTarget0, k), records[k], kRecordUnit[field], kRecordText[field], A::kTuning,
+               field == 0 ? -10000.0 : 0.0, kRecordMax[field], field == 3, true, nullptr, static_cast<int>(k)};
+    d.read = [](const Ctx& c, int j) {
+      RecordField f;
+      record_field(indexed_id(P::kRecordTarget0, static_cast<std::size_t>(j)), f);
+      return record_value(c.status.records[f.record], f.kind);
+    };
+    p.push_back(d);
+  }
+
   const auto& names = coefficient_names();
   static constexpr std::string_view kWhat[] = {"controller F coefficient of q^-i (F u = H r - G y)", "controller G coefficient of q^-i",
                                                "controller H coefficient of q^-i"};
@@ -166,6 +250,18 @@ const std::vector<PointDef>& catalog() {
 }
 
 }  // namespace
+
+std::uint16_t status_word(const runtime::Snapshot& s, bool store_saving) {
+  using namespace runtime;
+  const bool fault = s.mode == Mode::kFault;
+  const bool warning = s.axis.following_error || !s.io_ok || !store_saving;
+  const bool bits[kStatusBits] = {!fault && s.io_ok, s.mode == Mode::kRun, s.axis.moving, s.axis.in_position, s.axis.target_reached,
+                                  s.axis.following_error, warning, fault, s.axis.ack, s.axis.halted, s.axis.jogging, s.mode == Mode::kManual};
+  std::uint16_t w = 0;
+  for (int i = 0; i < kStatusBits; ++i)
+    if (bits[i]) w = static_cast<std::uint16_t>(w | (1u << i));
+  return w;
+}
 
 std::span<const PointDef> point_catalog() { return catalog(); }
 const PointDef& point(PointId id) { return catalog()[index(id)]; }

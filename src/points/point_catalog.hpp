@@ -12,6 +12,7 @@
 
 #include "points/commission_control.hpp"
 #include "points/point_id.hpp"
+#include "points/position_records.hpp"
 #include "runtime/snapshot.hpp"
 
 namespace epa::points {
@@ -26,7 +27,13 @@ struct InterfaceStatus {
   bool locked = true;                // tuning points refuse this client's writes
   std::uint64_t unlock_failures = 0; // refused unlock attempts since start (wrong key, back-off)
   CommissionView commission;         // the commissioning service's state (WriteGate::commission_view)
+  PositionRecords records{};         // the position-record table (WriteGate::records)
+  int record_select = 0;             // the record a start takes (0: the setpoint)
 };
+
+// The status word (runtime/axis_words.hpp) of the loop's state and the interfaces' (warning
+// includes a store that does not save).
+std::uint16_t status_word(const runtime::Snapshot& s, bool store_saving);
 
 struct PointContext {
   const runtime::Snapshot& snapshot;

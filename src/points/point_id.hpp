@@ -6,10 +6,12 @@
 #include <cstdint>
 
 #include "control/rst_law.hpp"
+#include "runtime/axis_words.hpp"
 
 namespace epa::points {
 
 inline constexpr std::size_t kCoefficients = control::kMaxLawOrder + 1;  // F0..F6, G0..G6, H0..H6
+inline constexpr std::size_t kPositionRecords = 32;  // record 1..32 of the position-record table
 
 enum class PointId : std::uint16_t {
   // identity and status
@@ -17,6 +19,11 @@ enum class PointId : std::uint16_t {
   kSetpoint, kPosition, kError, kSensor, kValve, kControllerOutput, kManualValve, kSaturated, kIoOk,
   // commands
   kReset, kHeartbeat, kRecord, kUnlock,
+  // the positioning interface: control word (and its bits as coils), the record a start takes,
+  // status word (and its bits as discrete inputs), the law's reference, the measured speed
+  kControlWord, kRecordSelect, kControlBit0,
+  kStatusWord = kControlBit0 + runtime::kControlBits, kStatusBit0,
+  kReference = kStatusBit0 + runtime::kStatusBits, kSpeed,
   // the interfaces and the store
   kLocked, kStoreOk, kChangeCounter, kSavedCounter, kModbusRequests, kModbusClients, kUnlockFailures,
   // tuning
@@ -26,12 +33,17 @@ enum class PointId : std::uint16_t {
   // the commissioning service: its command (start, abort) and state
   kCommissionCommand, kCommissionStage, kCommissionVerdict, kCommissionProgress,
   // the last move
-  kMoveNumber, kMoveFrom, kMoveTo, kMoveRise, kMoveSettling, kMoveEss, kMoveOvershoot,
+  kMoveNumber, kMoveFrom, kMoveTo, kMoveRise, kMoveSettling, kMoveEss, kMoveOvershoot, kMoveEnd,
   // loop statistics and counters
   kLoopWakeP50, kLoopWakeP99, kLoopWakeMax, kLoopJitterP99, kLoopComputeP99, kLoopOverruns, kCycles, kUptime,
   kMoves, kFaults, kIoErrors, kCommandsApplied, kCommandsRejected, kLastCommandRefusal,
+  // the position-record table: kRecordTarget0 + i ... for record i + 1, i < kPositionRecords
+  kRecordTarget0,
+  kRecordSpeed0 = kRecordTarget0 + kPositionRecords,
+  kRecordWindow0 = kRecordSpeed0 + kPositionRecords,
+  kRecordController0 = kRecordWindow0 + kPositionRecords,
   // controller coefficients: kF0 + i, kG0 + i, kH0 + i for i < kCoefficients
-  kF0,
+  kF0 = kRecordController0 + kPositionRecords,
   kG0 = kF0 + kCoefficients,
   kH0 = kG0 + kCoefficients,
   kCount = kH0 + kCoefficients,
@@ -39,7 +51,7 @@ enum class PointId : std::uint16_t {
 
 inline constexpr std::size_t kPointCount = static_cast<std::size_t>(PointId::kCount);
 inline constexpr std::size_t index(PointId id) { return static_cast<std::size_t>(id); }
-inline constexpr PointId coefficient_id(PointId first, std::size_t i) {
+inline constexpr PointId indexed_id(PointId first, std::size_t i) {
   return static_cast<PointId>(static_cast<std::size_t>(first) + i);
 }
 

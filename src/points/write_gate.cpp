@@ -1,5 +1,6 @@
 #include "points/write_gate.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/format.hpp"
@@ -15,6 +16,9 @@ struct WriteGate::Decision {
   bool tuning_changed = false;
   runtime::ExcitationSettings excitation;
   bool excitation_changed = false;  // then the excitation command is the group's first
+  std::uint16_t control_word = 0;
+  int record_select = 0;
+  PositionRecords records;
 };
 
 namespace {
@@ -33,6 +37,8 @@ bool excitation_point(PointId id) {
 Refusal gate_refusal(runtime::CommandRefusal r) {
   switch (r) {
     case runtime::CommandRefusal::kNotManual:
+    case runtime::CommandRefusal::kStartNotRunning:
+    case runtime::CommandRefusal::kJogNotManual:
     case runtime::CommandRefusal::kFaultLatched:
     case runtime::CommandRefusal::kRecordQueueFull:
     case runtime::CommandRefusal::kNotStopped:
@@ -44,13 +50,57 @@ Refusal gate_refusal(runtime::CommandRefusal r) {
 }  // namespace
 
 WriteGate::WriteGate(WriteLimits limits, const runtime::RuntimeConfig& loop_rules, control::ControllerConfig tuning,
-                     runtime::LoopChannels& channels, core::AuditSink* audit)
+                     runtime::LoopChannels& channels, core::AuditSink* audit, const PositionRecords& records)
     : limits_(std::move(limits)),
       loop_rules_(loop_rules),
       channels_(channels),
       audit_(audit),
       tuning_(std::move(tuning)),
-      excitation_(loop_rules.excitation) {}
+      excitation_(loop_rules.excitation),
+      records_(records) {}
+
+PositionRecords WriteGate::records() const {
+  std::lock_guard lock(mutex_);
+  return records_;
+}
+
+int WriteGate::record_select() const {
+  std::lock_guard lock(mutex_);
+  return record_select_;
+}
+
+runtime::Snapshot WriteGate::snapshot() const {
+  runtime::Snapshot s = channels_.snapshot.read();
+  std::lock_guard lock(mutex_);
+  while (!unapplied_.empty() && unapplied_.front().sequence <= s.last_sequence) unapplied_.pop_front();
+  for (const runtime::Command& c : unapplied_) {
+    switch (c.kind) {
+      case runtime::CommandKind::kSetpoint: s.setpoint_mm = c.value; break;
+      case runtime::CommandKind::kMode: s.mode = c.mode; break;
+      case runtime::CommandKind::kManualValve: s.manual_valve_v = c.value; break;
+      case runtime::CommandKind::kController: s.controller = c.controller; break;
+      case runtime::CommandKind::kHeartbeat: s.heartbeat = c.heartbeat; break;
+      case runtime::CommandKind::kExcitation: s.excitation = c.excitation; break;
+      case runtime::CommandKind::kControl:
+        if (c.control_word & ~s.axis.control_word & runtime::kControlStart) s.setpoint_mm = c.value;
+        s.axis.control_word = c.control_word;
+        break;
+      case runtime::CommandKind::kTuning: {
+        const auto& t = tuning_;  // the gate's copy is what the loop takes
+        s.tuning.m_r = t.dead_zone.m_r, s.tuning.m_l = t.dead_zone.m_l, s.tuning.b_r = t.dead_zone.b_r, s.tuning.b_l = t.dead_zone.b_l;
+        s.tuning.lc_mm = t.lc_v * loop_rules_.mm_per_volt;
+        s.tuning.traj_speed_fraction = t.trajectory.speed_fraction;
+        s.tuning.traj_bandwidth_rad_s = t.trajectory.feedback_bandwidth_rad_s;
+        s.tuning.traj_hold_band_mm = t.trajectory.hold_band_v * loop_rules_.mm_per_volt;
+        break;
+      }
+      case runtime::CommandKind::kReset:
+      case runtime::CommandKind::kRecord: break;
+    }
+  }
+  s.error_mm = s.setpoint_mm - s.position_mm;
+  return s;
+}
 
 control::ControllerConfig WriteGate::running_tuning() const {
   std::lock_guard lock(mutex_);
@@ -90,6 +140,44 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
   // 3. The commands, all of them or none.
   out.tuning = tuning;
   out.excitation = excitation;
+  out.control_word = control_word_;
+  out.record_select = record_select_;
+  out.records = records_;
+  // The record a start takes may come in the same group: selections and record edits first.
+  for (const PointWrite& w : writes) {
+    if (w.id == PointId::kRecordSelect) out.record_select = static_cast<int>(w.value);
+    if (RecordField f; record_field(w.id, f)) {
+      if (f.kind == RecordField::kTarget && !(w.value >= loop_rules_.setpoint_min_mm && w.value <= loop_rules_.setpoint_max_mm))
+        return refuse(Refusal::kInvalidValue, quoted(w.id) + " " + core::format_number(w.value) + " mm is outside the setpoint range [" +
+                                                  core::format_number(loop_rules_.setpoint_min_mm) + ", " +
+                                                  core::format_number(loop_rules_.setpoint_max_mm) + "] mm");
+      if (f.kind == RecordField::kController && w.value != kKeepController && !(w.value >= 0 && w.value <= 3))
+        return refuse(Refusal::kInvalidValue, quoted(w.id) + " takes 0 pp, 1 pp-ngidz, 2 pp-ffidz, 3 pp-traj or 255 (the running law), not " +
+                                                  core::format_number(w.value));
+      set_record_value(out.records[f.record], f.kind, w.value);
+    }
+  }
+  // A start resolves the selected record (or the setpoint) into the move it commands.
+  auto control = [&](std::uint16_t word, runtime::Command& c) {
+    c = runtime::control_command(word);
+    const std::uint16_t rising = word & static_cast<std::uint16_t>(~out.control_word);
+    out.control_word = word;
+    if (!(rising & runtime::kControlStart)) return;
+    if (out.record_select == 0) {
+      c.value = snap.setpoint_mm;
+      for (const PointWrite& w : writes)
+        if (w.id == PointId::kSetpoint) c.value = w.value;
+      return;
+    }
+    const PositionRecord& r = out.records[static_cast<std::size_t>(out.record_select - 1)];
+    c.value = r.target_mm;
+    c.speed_limit_mm_s = r.speed_mm_s;
+    c.window_mm = r.window_mm;
+    if (r.controller != kKeepController) {
+      c.start_controller = true;
+      c.controller = static_cast<control::ControllerKind>(r.controller);
+    }
+  };
   PointId first_tuning_point = PointId::kCount, first_excitation_point = PointId::kCount;
   for (const PointWrite& w : writes) {
     runtime::Command c;
@@ -108,6 +196,8 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
       case PointId::kReset: c = runtime::reset_command(); break;
       case PointId::kHeartbeat: c = runtime::heartbeat_command(static_cast<std::uint32_t>(w.value)); break;
       case PointId::kRecord: c = runtime::record_command(w.value); break;
+      case PointId::kControlWord: control(static_cast<std::uint16_t>(w.value), c); break;
+      case PointId::kRecordSelect: continue;  // the gate's own: taken above
       case PointId::kMr: out.tuning.dead_zone.m_r = w.value; break;
       case PointId::kMl: out.tuning.dead_zone.m_l = w.value; break;
       case PointId::kBr: out.tuning.dead_zone.b_r = w.value; break;
@@ -120,7 +210,15 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
       case PointId::kExciteAmplitudeMin: out.excitation.amplitude_min_v = w.value; break;
       case PointId::kExciteAmplitudeMax: out.excitation.amplitude_max_v = w.value; break;
       case PointId::kExciteDuration: out.excitation.duration_s = w.value; break;
-      default: return refuse(Refusal::kNotWritable, quoted(w.id) + " has no command behind it");
+      default: {
+        if (RecordField f; record_field(w.id, f)) continue;  // the gate's own: taken above
+        const std::size_t bit = index(w.id) - index(PointId::kControlBit0);
+        if (bit >= static_cast<std::size_t>(runtime::kControlBits))
+          return refuse(Refusal::kNotWritable, quoted(w.id) + " has no command behind it");
+        const auto mask = static_cast<std::uint16_t>(1u << bit);
+        control(static_cast<std::uint16_t>(w.value != 0.0 ? out.control_word | mask : out.control_word & ~mask), c);
+        break;
+      }
     }
     if (excitation_point(w.id)) {
       if (first_excitation_point == PointId::kCount) first_excitation_point = w.id;
@@ -133,6 +231,14 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
     out.commands.push_back(c);
     out.command_point.push_back(w.id);
   }
+  // A mode change goes first, so "enable and start" (or enable and a setpoint) in one write moves
+  // the axis: RUN entered holds, and the move comes after.
+  for (std::size_t i = 1; i < out.commands.size(); ++i)
+    if (out.commands[i].kind == runtime::CommandKind::kMode) {
+      std::rotate(out.commands.begin(), out.commands.begin() + static_cast<std::ptrdiff_t>(i), out.commands.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+      std::rotate(out.command_point.begin(), out.command_point.begin() + static_cast<std::ptrdiff_t>(i),
+                  out.command_point.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+    }
   if (first_tuning_point != PointId::kCount) {
     // Every tuning point of the group becomes one tuning command, validated whole (e.g. b_l > b_r
     // after this write is refused), last in the group.
@@ -156,10 +262,12 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
   // the order the loop applies it (mode MANUAL then a manual valve command is one valid group).
   runtime::Mode mode = snap.mode;
   runtime::ExcitationSettings next_excitation = excitation;
+  std::uint16_t word = control_word_;
   for (std::size_t i = 0; i < out.commands.size(); ++i) {
     const runtime::Command& c = out.commands[i];
-    if (const auto r = runtime::check_command(c, mode, snap.position_mm, next_excitation, loop_rules_); r != runtime::CommandRefusal::kNone)
+    if (const auto r = runtime::check_command(c, mode, snap.position_mm, next_excitation, word, loop_rules_); r != runtime::CommandRefusal::kNone)
       return refuse(gate_refusal(r), quoted(out.command_point[i]) + ": " + std::string(runtime::describe(r)));
+    if (c.kind == runtime::CommandKind::kControl) word = c.control_word;
     if (c.kind == runtime::CommandKind::kMode) mode = c.mode;
     if (c.kind == runtime::CommandKind::kExcitation) next_excitation = c.excitation;
     if (c.kind == runtime::CommandKind::kReset && mode == runtime::Mode::kFault) mode = runtime::Mode::kStop;
@@ -182,6 +290,8 @@ GateResult WriteGate::submit(std::span<const PointWrite> writes, const Requester
   const runtime::Snapshot snap = channels_.snapshot.read();
   Decision d;
   if (GateResult r = build(writes, who, snap, tuning_, excitation_, d); !r.accepted()) return r;
+  const PositionRecords records_before = records_;  // the audit trail's old values
+  const int record_select_before = record_select_;
   const std::uint64_t first = next_sequence_;
   for (std::size_t i = 0; i < d.commands.size(); ++i) d.commands[i].sequence = first + i;
   if (!d.commands.empty() && !channels_.commands.try_push_all(d.commands.data(), d.commands.size()))
@@ -189,10 +299,17 @@ GateResult WriteGate::submit(std::span<const PointWrite> writes, const Requester
   next_sequence_ += d.commands.size();
   if (d.tuning_changed) tuning_ = d.tuning;
   if (d.excitation_changed) excitation_ = d.excitation;
+  control_word_ = d.control_word;
+  record_select_ = d.record_select;
+  records_ = d.records;
+  for (const auto& c : d.commands) unapplied_.push_back(c);
+  while (unapplied_.size() > kUnapplied) unapplied_.pop_front();
 
   // Accepted: the audit trail (and so the store) gets the group. Each entry keeps its command's
   // sequence number while it is in flight, so a late refusal can be audited against it.
-  const InterfaceStatus status;
+  InterfaceStatus status;
+  status.records = records_before;
+  status.record_select = record_select_before;
   const PointContext ctx{snap, status};
   const std::int64_t time_ms = core::unix_time_ms();
   std::vector<core::AuditEntry> change;

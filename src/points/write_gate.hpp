@@ -14,6 +14,12 @@
 // A command the gate accepted is refused by the loop only when the state changed in between (a
 // fault latched, the recorder busy). take_refusals() collects those off the loop: each is logged
 // and audited as refused, with the value the point kept, and counted in the snapshot.
+//
+// The positioning interface lives here too: the gate keeps the control word (so a single coil
+// changes one bit of it), the selected record and the position-record table, and turns a start
+// edge into one move command with the record's target, speed limit, window and law. Reads go
+// through snapshot(): the loop's last snapshot with the writes it has not applied yet, so a read
+// right after an acknowledged write returns the written value.
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -26,6 +32,7 @@
 #include "core/audit.hpp"
 #include "points/commission_control.hpp"
 #include "points/point_id.hpp"
+#include "points/position_records.hpp"
 #include "points/write_limits.hpp"
 #include "runtime/scan_cycle.hpp"
 
@@ -64,7 +71,12 @@ class WriteGate {
   // `loop_rules` is the scan cycle's configuration (its command rules and mm_per_volt); `tuning`
   // the running tuning's configuration; `audit` may be null.
   WriteGate(WriteLimits limits, const runtime::RuntimeConfig& loop_rules, control::ControllerConfig tuning,
-            runtime::LoopChannels& channels, core::AuditSink* audit);
+            runtime::LoopChannels& channels, core::AuditSink* audit, const PositionRecords& records = {});
+
+  // The loop's last snapshot with the accepted writes it has not taken yet applied on top.
+  runtime::Snapshot snapshot() const;
+  PositionRecords records() const;
+  int record_select() const;
 
   // Checks `writes` whole against the loop's current snapshot; queues and audits them, or refuses.
   GateResult submit(std::span<const PointWrite> writes, const Requester& who);
@@ -123,6 +135,13 @@ class WriteGate {
   std::uint64_t next_sequence_ = 1;
   std::deque<InFlight> in_flight_;  // the last kInFlight accepted writes, for late refusals
   static constexpr std::size_t kInFlight = 1024;
+  std::uint16_t control_word_ = 0;  // as accepted (the loop's follows within a cycle)
+  int record_select_ = 0;
+  PositionRecords records_;
+  // Accepted commands the loop may not have taken yet (snapshot() applies them); pruned by the
+  // snapshot's last_sequence.
+  mutable std::deque<runtime::Command> unapplied_;
+  static constexpr std::size_t kUnapplied = 256;
 };
 
 // The interfaces' codes for a refusal.

@@ -22,6 +22,8 @@ enum class CommandKind : std::uint8_t {
   kHeartbeat,    // heartbeat = the supervising client's counter
   kRecord,       // value = seconds of history to write as a run file
   kExcitation,   // excitation = the settings of the next EXCITE, whole
+  kControl,      // control_word = the client's new control word (axis_words.hpp); on a start edge,
+                 // value = the target, mm, with speed_limit_mm_s, window_mm and (start_controller) controller
 };
 
 struct Command {
@@ -30,6 +32,9 @@ struct Command {
   Mode mode = Mode::kStop;
   control::ControllerKind controller = control::ControllerKind::kPpFfidz;
   std::uint32_t heartbeat = 0;
+  std::uint16_t control_word = 0;
+  double speed_limit_mm_s = 0.0, window_mm = 0.0;  // a start's: 0 none / the configured window
+  bool start_controller = false;                    // a start switches to `controller` first
   std::uint64_t sequence = 0;  // the producer's number for it: a refusal is reported with it
   Tuning tuning;
   ExcitationSettings excitation;
@@ -43,6 +48,7 @@ inline Command tuning_command(const Tuning& t) { Command c; c.kind = CommandKind
 inline Command reset_command() { Command c; c.kind = CommandKind::kReset; return c; }
 inline Command heartbeat_command(std::uint32_t n) { Command c; c.kind = CommandKind::kHeartbeat; c.heartbeat = n; return c; }
 inline Command record_command(double seconds) { Command c; c.kind = CommandKind::kRecord; c.value = seconds; return c; }
+inline Command control_command(std::uint16_t word) { Command c; c.kind = CommandKind::kControl; c.control_word = word; return c; }
 inline Command excitation_command(const ExcitationSettings& s) { Command c; c.kind = CommandKind::kExcitation; c.excitation = s; return c; }
 
 }  // namespace epa::runtime

@@ -2,10 +2,12 @@
 
 #include <cmath>
 
+#include "runtime/axis_words.hpp"
+
 namespace epa::runtime {
 
 CommandRefusal check_command(const Command& c, Mode mode, double position_mm, const ExcitationSettings& excitation,
-                             const RuntimeConfig& config) noexcept {
+                             std::uint16_t control_word, const RuntimeConfig& config) noexcept {
   switch (c.kind) {
     case CommandKind::kSetpoint:
       return c.value >= config.setpoint_min_mm && c.value <= config.setpoint_max_mm ? CommandRefusal::kNone
@@ -26,6 +28,14 @@ CommandRefusal check_command(const Command& c, Mode mode, double position_mm, co
       return c.value > 0.0 && std::isfinite(c.value) ? CommandRefusal::kNone : CommandRefusal::kRecordOutOfRange;
     case CommandKind::kExcitation:  // taken in any mode: a running experiment keeps its own settings
       return excitation_problem(c.excitation, config) ? CommandRefusal::kExcitationInvalid : CommandRefusal::kNone;
+    case CommandKind::kControl: {
+      const std::uint16_t rising = c.control_word & static_cast<std::uint16_t>(~control_word);
+      if ((rising & kControlStart) && mode != Mode::kRun) return CommandRefusal::kStartNotRunning;
+      if ((rising & kControlStart) && !(c.value >= config.setpoint_min_mm && c.value <= config.setpoint_max_mm))
+        return CommandRefusal::kSetpointOutOfRange;
+      if ((rising & (kControlJogPlus | kControlJogMinus)) && mode != Mode::kManual) return CommandRefusal::kJogNotManual;
+      return CommandRefusal::kNone;  // halt, reset, releases: any time
+    }
     case CommandKind::kController:
     case CommandKind::kTuning:  // validated whole by runtime::make_tuning before it is queued
     case CommandKind::kReset:   // a reset without a latched fault does nothing, and that is fine
@@ -51,6 +61,8 @@ std::string_view describe(CommandRefusal r) {
     case CommandRefusal::kExcitationInvalid: return "the excitation settings do not validate together";
     case CommandRefusal::kControllerUnavailable:
       return "pp-traj needs a model that integrates (valve opening -> speed) with a positive gain: the tuning set's model is not one";
+    case CommandRefusal::kStartNotRunning: return "a start needs mode RUN: enable the axis first";
+    case CommandRefusal::kJogNotManual: return "jogging is only possible in MANUAL";
   }
   return "unknown";
 }

@@ -27,14 +27,17 @@ enum class CommandRefusal : std::uint8_t {
   kOutsideExcitationGuard = 9, // EXCITE with the piston outside the excitation's guard lines
   kExcitationInvalid = 10,     // excitation settings that do not validate together (excitation_problem)
   kControllerUnavailable = 11, // pp-traj on a tuning set whose model it cannot use (the loop's own check)
+  kStartNotRunning = 12,       // a start (control word) outside RUN: enable the axis first
+  kJogNotManual = 13,          // a jog (control word) outside MANUAL
 };
 
 // The state-dependent and range rules for one command in mode `mode` with the piston at
-// `position_mm` (the last reading). `excitation` holds the settings EXCITE would start with.
+// `position_mm` (the last reading). `excitation` holds the settings EXCITE would start with;
+// `control_word` the control word before `c` (a control command's rules are for its rising edges).
 // kRecordQueueFull is the loop's own (only it sees the recorder's queue). noexcept and
 // allocation-free: the loop calls it.
 CommandRefusal check_command(const Command& c, Mode mode, double position_mm, const ExcitationSettings& excitation,
-                             const RuntimeConfig& config) noexcept;
+                             std::uint16_t control_word, const RuntimeConfig& config) noexcept;
 
 std::string_view describe(CommandRefusal r);  // for logs, the audit trail and HTTP answers
 

@@ -10,10 +10,20 @@
 
 namespace epa::runtime {
 
+// How a move ended. Numeric values are part of the Modbus interface (move_end): append only.
+enum class MoveEnd : std::uint8_t {
+  kComplete = 0,  // measured over its whole window
+  kCutShort = 1,  // a new target (setpoint or start) came first
+  kHalted = 2,    // a halt
+  kStopped = 3,   // the mode changed (STOP, MANUAL) or the appliance shut down
+  kFault = 4,     // a fault
+};
+
 struct MoveResult {
   std::uint32_t number = 0;  // 1 for the first move since start
   double from_mm = 0.0, to_mm = 0.0;
   core::StepMetrics metrics;
+  MoveEnd end = MoveEnd::kComplete;
   std::uint64_t first_sample = 0, end_sample = 0;  // recorder indices of the move
 };
 
@@ -27,7 +37,7 @@ class MoveTracker {
   void start(double from_mm, double to_mm, std::uint64_t sample_index) noexcept {
     active_ = true;
     count_ = 0;
-    current_ = {next_number_++, from_mm, to_mm, {}, sample_index, sample_index};
+    current_ = {next_number_++, from_mm, to_mm, {}, MoveEnd::kComplete, sample_index, sample_index};
   }
 
   // Adds the position of one cycle; true when the window just became full (call finish()).
@@ -38,10 +48,15 @@ class MoveTracker {
     return count_ == capacity_;
   }
 
-  MoveResult finish() noexcept {
+  // The move's metrics over the samples it had. The steady-state window is the last 2 s of a full
+  // window, and the last 40 % of a move cut short (its whole length would average the transient
+  // in: a move that settled within 1 mm before it was cut reported an 18 mm e_ss).
+  MoveResult finish(MoveEnd end) noexcept {
     active_ = false;
+    const double length_s = static_cast<double>(count_) * Ts_;
+    current_.end = end;
     current_.metrics = core::step_metrics(std::span<const double>(y_.get(), count_), current_.to_mm,
-                                          {.Ts = Ts_, .ess_window_s = std::min(2.0, static_cast<double>(count_) * Ts_)});
+                                          {.Ts = Ts_, .ess_window_s = std::min(2.0, 0.4 * length_s)});
     return current_;
   }
 

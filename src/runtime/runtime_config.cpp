@@ -15,6 +15,9 @@ core::Status validate(const RuntimeConfig& c) {
       {"manual_valve_limit_v", c.manual_valve_limit_v, true},
       {"following_error_mm", c.following_error_mm, true},
       {"move_window_s", c.move_window_s, true}, {"record_buffer_s", c.record_buffer_s, true},
+      {"in_position_window_mm", c.in_position_window_mm, true}, {"in_position_time_s", c.in_position_time_s, false},
+      {"halt_decel_mm_s2", c.halt_decel_mm_s2, true}, {"jog_speed_mm_s", c.jog_speed_mm_s, true},
+      {"jog_accel_mm_s2", c.jog_accel_mm_s2, true}, {"jog_keepalive_s", c.jog_keepalive_s, false},
   };
   for (const auto& ch : checks) {
     if (!std::isfinite(ch.value)) return core::invalid_argument(std::string(ch.name) + " must be a finite number");
@@ -40,6 +43,8 @@ core::Status validate(const RuntimeConfig& c) {
                                   "] mm must lie inside the soft limits [" + core::format_number(c.soft_min_mm) + ", " + core::format_number(c.soft_max_mm) + "] mm");
   if (!std::isfinite(c.safe_valve_v) || std::abs(c.safe_valve_v) > 10.0)  // the valve accepts +-10 V
     return core::invalid_argument("safe_valve_v must be a valve command within +-10 V, got " + core::format_number(c.safe_valve_v));
+  if (c.in_position_time_s < 0.0 || c.jog_keepalive_s < 0.0)
+    return core::invalid_argument("[motion] in_position_time_s and jog_keepalive_s must be >= 0");
   if (!(c.following_error_time_s >= 0.0)) return core::invalid_argument("following_error_time_s must be >= 0 (0: off)");
   if (!(c.heartbeat_timeout_s >= 0.0)) return core::invalid_argument("heartbeat_timeout_s must be >= 0 (0: off)");
   if (!(c.sensor_frozen_time_s >= 0.0)) return core::invalid_argument("sensor_frozen_time_s must be >= 0 (0: off)");

@@ -40,6 +40,21 @@ struct RuntimeConfig {
   double record_buffer_s = 60.0;    // recorder ring: seconds of history kept in memory (see below)
 
   ExcitationSettings excitation;    // the experiment of mode EXCITE, [excite]
+
+  // [motion]: the positioning interface (status and control words, axis_motion.hpp).
+  double in_position_window_mm = 1.0;  // in position: |target - position| <= this ...
+  double in_position_time_s = 0.1;     // ... for this long
+  double halt_decel_mm_s2 = 4000.0;    // a halt brakes the reference at this
+  double jog_speed_mm_s = 20.0;        // jog: top speed, ...
+  double jog_accel_mm_s2 = 500.0;      // ... acceleration and braking
+  double jog_keepalive_s = 1.0;        // a jog brakes unless the heartbeat changes or the control word is written within this (0: off)
+  // RUN entered holds the piston where it is (the setpoint follows it), so a retained or stale
+  // setpoint never moves the axis; a start or a setpoint written in RUN moves it. false: RUN drives
+  // to the setpoint (the behaviour before the positioning interface).
+  bool enable_holds_position = true;
+  // At start-up in RUN: drive to start_setpoint_mm (it was asked for explicitly), even when
+  // enable_holds_position holds otherwise.
+  bool start_moves_to_setpoint = false;
 };
 
 core::Status validate(const RuntimeConfig& config);

@@ -4,11 +4,20 @@
 #include <cmath>
 #include <limits>
 
+#include "runtime/axis_words.hpp"
+
 namespace epa::runtime {
 
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kSpeedFilterS = 0.02;  // the measured speed's low-pass (a halt brakes from it)
 double or_nan(const std::optional<double>& v) { return v ? *v : kNaN; }
+
+MotionConfig motion_config(const RuntimeConfig& c) {
+  return {.in_position_window_mm = c.in_position_window_mm, .in_position_time_s = c.in_position_time_s,
+          .halt_decel_mm_s2 = c.halt_decel_mm_s2, .jog_speed_mm_s = c.jog_speed_mm_s, .jog_accel_mm_s2 = c.jog_accel_mm_s2,
+          .min_mm = c.setpoint_min_mm, .max_mm = c.setpoint_max_mm, .Ts = c.period_s};
+}
 }  // namespace
 
 ScanCycle::ScanCycle(const RuntimeConfig& config, const Tuning& tuning, hal::Daq& daq, Clock& clock, LoopChannels& ch)
@@ -24,7 +33,8 @@ ScanCycle::ScanCycle(const RuntimeConfig& config, const Tuning& tuning, hal::Daq
       manual_valve_v_(config.safe_valve_v),
       valve_v_(config.safe_valve_v),
       excitation_settings_(config.excitation),
-      moves_(config.move_window_s, config.period_s) {
+      moves_(config.move_window_s, config.period_s),
+      motion_(motion_config(config)) {
   if (config.start_fault != FaultCode::kNone) {
     mode_ = Mode::kFault;  // before any start mode: a fault found before the start is latched
     fault_ = config.start_fault;
@@ -32,6 +42,7 @@ ScanCycle::ScanCycle(const RuntimeConfig& config, const Tuning& tuning, hal::Daq
   } else if (config.start_mode == Mode::kRun) {
     mode_ = Mode::kRun;
     init_state_on_next_read_ = true;  // the position is known only after the first read
+    hold_on_enable_ = config.enable_holds_position && !config.start_moves_to_setpoint;
   }
   heartbeat_changed_ns_ = clock_.now_ns();
   publish();
@@ -45,13 +56,14 @@ void ScanCycle::apply_commands(std::int64_t now_ns) noexcept {
 }
 
 void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
-  CommandRefusal refusal = check_command(c, mode_, position_mm_, excitation_settings_, config_);
+  last_sequence_ = c.sequence;
+  CommandRefusal refusal = check_command(c, mode_, position_mm_, excitation_settings_, control_word_, config_);
   if (refusal == CommandRefusal::kNone) {
     switch (c.kind) {
       case CommandKind::kSetpoint:
         if (c.value != setpoint_mm_) {
           setpoint_mm_ = c.value;
-          if (mode_ == Mode::kRun) start_move();
+          if (mode_ == Mode::kRun) start_move(c.value, 0.0, 0.0);
         }
         break;
       case CommandKind::kMode:
@@ -61,12 +73,14 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
             refusal = CommandRefusal::kExcitationInvalid;  // cannot happen: the settings were checked when taken
             break;
           }
-          if (moves_.active()) finish_move();
+          if (moves_.active()) finish_move(MoveEnd::kStopped);
           if (mode_ == Mode::kExcite) end_excitation(ExcitationEnd::kStopped);
+          jog_law_ = false;
           if (c.mode == Mode::kRun) enter_run(now_ns);
           if (c.mode == Mode::kManual) {
             manual_valve_v_ = config_.safe_valve_v;  // never resume a stale manual command
             heartbeat_changed_ns_ = now_ns;
+            motion_.hold(position_mm_);
           }
           if (c.mode == Mode::kExcite) heartbeat_changed_ns_ = now_ns;  // the client gets a full timeout from here
           mode_ = c.mode;
@@ -95,20 +109,15 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
         if (controller_ == control::ControllerKind::kPpTraj) start_law_at_the_piston(tuning_.traj);  // new limits: a new profile
         transfer_pending_ = mode_ == Mode::kRun;
         break;
-      case CommandKind::kReset:
-        if (mode_ == Mode::kFault) {
-          mode_ = Mode::kStop;
-          fault_ = FaultCode::kNone;
-          consecutive_read_errors_ = consecutive_write_errors_ = consecutive_overruns_ = 0;
-          following_error_since_ns_ = -1;
-        }
-        break;
+      case CommandKind::kReset: reset_fault(); break;
       case CommandKind::kHeartbeat:
         if (c.heartbeat != heartbeat_) {
           heartbeat_ = c.heartbeat;
           heartbeat_changed_ns_ = now_ns;
+          jog_keepalive_ns_ = now_ns;
         }
         break;
+      case CommandKind::kControl: apply_control(c, now_ns); break;
       case CommandKind::kRecord: {
         RecordRequest r;
         r.end = ch_.samples.written();
@@ -140,8 +149,60 @@ void ScanCycle::start_law_at_the_piston(const control::ControllerParams& law) no
 
 void ScanCycle::enter_run(std::int64_t now_ns) noexcept {
   init_state_on_next_read_ = true;
+  hold_on_enable_ = config_.enable_holds_position;  // until a move is started before the first reading
   heartbeat_changed_ns_ = now_ns;  // the client gets a full timeout from here
   following_error_since_ns_ = -1;
+  motion_.hold(position_mm_);
+}
+
+void ScanCycle::reset_fault() noexcept {
+  if (mode_ != Mode::kFault) return;  // nothing latched: nothing to do, and that is fine
+  mode_ = Mode::kStop;
+  fault_ = FaultCode::kNone;
+  consecutive_read_errors_ = consecutive_write_errors_ = consecutive_overruns_ = 0;
+  following_error_since_ns_ = -1;
+}
+
+void ScanCycle::apply_control(const Command& c, std::int64_t now_ns) noexcept {
+  const std::uint16_t word = c.control_word & kControlWordMask;
+  const std::uint16_t rising = word & static_cast<std::uint16_t>(~control_word_);
+  control_word_ = word;
+  jog_keepalive_ns_ = now_ns;  // any control word written keeps a jog alive
+  if (rising & kControlReset) reset_fault();
+  if (rising & kControlHalt) {
+    if (mode_ == Mode::kRun) {
+      if (moves_.active()) finish_move(MoveEnd::kHalted);
+      motion_.halt(position_mm_, speed_mm_s_);
+      setpoint_mm_ = motion_.target_mm();  // the setpoint tells where the axis now stops
+      hold_on_enable_ = false;
+    } else if (jog_law_) {
+      motion_.jog(0, position_mm_, speed_mm_s_);
+    }
+  }
+  if (rising & kControlStart) {  // checked: RUN, a target within the setpoint range
+    if (c.start_controller && c.controller != controller_) {
+      Command switch_law = controller_command(c.controller);
+      switch_law.sequence = c.sequence;
+      apply(switch_law, now_ns);  // refused (pp-traj unavailable): the move runs with the law it has
+    }
+    setpoint_mm_ = c.value;
+    start_move(c.value, c.speed_limit_mm_s, c.window_mm);
+  }
+  if (mode_ == Mode::kManual) {
+    const bool plus = word & kControlJogPlus, minus = word & kControlJogMinus;
+    const int direction = plus == minus ? 0 : plus ? 1 : -1;  // both held: neither
+    if (direction != 0 && (rising & (kControlJogPlus | kControlJogMinus))) {
+      if (!jog_law_) {  // the law takes over from the manual valve command where the piston is
+        start_law_at_the_piston(tuning_.for_kind(controller_));
+        transfer_pending_ = true;
+        jog_law_ = true;
+      }
+      manual_valve_v_ = config_.safe_valve_v;  // after the jog: the valve rests
+      motion_.jog(direction, position_mm_, speed_mm_s_);
+    } else if (direction == 0 && jog_law_) {
+      motion_.jog(0, position_mm_, speed_mm_s_);
+    }
+  }
 }
 
 void ScanCycle::end_excitation(ExcitationEnd how) noexcept {
@@ -159,13 +220,15 @@ void ScanCycle::end_excitation(ExcitationEnd how) noexcept {
   if (r.end > r.first) ch_.record_requests.try_push(r);  // a full queue drops the file, never the loop
 }
 
-void ScanCycle::start_move() noexcept {
-  if (moves_.active()) finish_move();
-  moves_.start(position_mm_, setpoint_mm_, ch_.samples.written());
+void ScanCycle::start_move(double target_mm, double speed_limit_mm_s, double window_mm) noexcept {
+  if (moves_.active()) finish_move(MoveEnd::kCutShort);
+  hold_on_enable_ = false;  // RUN entered with a move: the move, not a hold
+  moves_.start(position_mm_, target_mm, ch_.samples.written());
+  motion_.move(target_mm, speed_limit_mm_s, window_mm, position_mm_, speed_mm_s_);
 }
 
-void ScanCycle::finish_move() noexcept {
-  last_move_ = moves_.finish();
+void ScanCycle::finish_move(MoveEnd end) noexcept {
+  last_move_ = moves_.finish(end);
   RecordRequest r;
   r.reason = RecordRequest::Reason::kMove;
   r.first = last_move_.first_sample;
@@ -202,7 +265,7 @@ FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
     }
   }
   if (mode_ == Mode::kRun && read_ok && config_.following_error_time_s > 0.0) {
-    if (std::abs(setpoint_mm_ - position_mm_) > config_.following_error_mm) {
+    if (std::abs(motion_.reference_mm() - position_mm_) > config_.following_error_mm) {
       if (following_error_since_ns_ < 0) following_error_since_ns_ = now_ns;
       if (static_cast<double>(now_ns - following_error_since_ns_) > config_.following_error_time_s * 1e9)
         return FaultCode::kFollowingError;
@@ -214,7 +277,8 @@ FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
 }
 
 void ScanCycle::enter_fault(FaultCode code) noexcept {
-  if (moves_.active()) finish_move();
+  if (moves_.active()) finish_move(MoveEnd::kFault);
+  jog_law_ = false;
   if (mode_ == Mode::kExcite) end_excitation(ExcitationEnd::kFault);
   mode_ = Mode::kFault;
   fault_ = code;
@@ -229,8 +293,12 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
   if (read_ok) {
     previous_sensor_v_ = sensor_v_;
     sensor_v_ = reading.sensor_v;
+    const double previous_mm = position_mm_;
     position_mm_ = (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain * config_.mm_per_volt;
+    const double raw_speed = (position_mm_ - previous_mm) / config_.period_s;
+    if (have_reading_ && std::isfinite(raw_speed)) speed_mm_s_ += (raw_speed - speed_mm_s_) * (config_.period_s / (kSpeedFilterS + config_.period_s));
     consecutive_read_errors_ = 0;
+    have_reading_ = true;
   } else {
     ++consecutive_read_errors_;  // counted before the fault check: the N-th failure faults this cycle
     ++io_errors_;
@@ -240,7 +308,6 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
   }
 
   const double y_v = position_v();
-  const double r_v = setpoint_mm_ / config_.mm_per_volt;
   saturated_ = false;
   switch (mode_) {
     case Mode::kRun:
@@ -250,24 +317,29 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
         control::controller_start(tuning_.for_kind(controller_), state_, y_v, 0.0);
         init_state_on_next_read_ = false;
         transfer_pending_ = false;  // RUN starts from the safe valve command, not from another law
-        if (setpoint_mm_ != position_mm_) start_move();
-      }
-      {
-        const auto out = control::controller_step(tuning_.for_kind(controller_), state_, r_v, y_v);
-        if (out.fault) {
-          enter_fault(FaultCode::kControllerFault);
-          valve_v_ = config_.safe_valve_v;
-        } else {
-          if (transfer_pending_) transfer_.start(valve_v_, out.valve_v);
-          transfer_pending_ = false;
-          const double limit_v = tuning_.for_kind(controller_).valve_limit_v();
-          valve_v_ = std::clamp(transfer_.apply(out.valve_v), -limit_v, limit_v);
-          controller_v_ = out.controller_v;
-          saturated_ = out.saturated;
+        if (hold_on_enable_) {      // enable holds: the setpoint follows the piston, nothing moves
+          setpoint_mm_ = position_mm_;
+          motion_.hold(position_mm_);
+          hold_on_enable_ = false;
+        } else if (!moves_.active()) {  // RUN drives to the setpoint (enable_holds_position off, or asked at start)
+          if (setpoint_mm_ != position_mm_) start_move(setpoint_mm_, 0.0, 0.0);
+          else motion_.hold(setpoint_mm_);
         }
       }
+      step_law(motion_.step(position_mm_), y_v);
       break;
-    case Mode::kManual: valve_v_ = manual_valve_v_; controller_v_ = 0.0; break;
+    case Mode::kManual:
+      if (jog_law_) {  // the law drives the jog (holding the last command for a missed sample)
+        if (!read_ok) break;
+        if (config_.jog_keepalive_s > 0.0 && static_cast<double>(now_ns - jog_keepalive_ns_) > config_.jog_keepalive_s * 1e9)
+          motion_.jog(0, position_mm_, speed_mm_s_);  // no keep-alive: brake as if released
+        step_law(motion_.step(position_mm_), y_v);
+        if (mode_ == Mode::kManual && motion_.task() != MotionTask::kJog) jog_law_ = false;  // braked: the manual command next
+        break;
+      }
+      valve_v_ = manual_valve_v_;
+      controller_v_ = 0.0;
+      break;
     case Mode::kExcite:
       controller_v_ = 0.0;
       if (excitation_.done()) {  // every command given: STOP by itself, the valve safe in this cycle
@@ -294,9 +366,24 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
 
   ch_.samples.push({static_cast<double>(cycle_) * config_.period_s, setpoint_mm_, position_mm_, valve_v_, controller_v_});
   if (mode_ == Mode::kRun) run_samples_end_ = ch_.samples.written();
-  if (mode_ == Mode::kRun && moves_.active() && moves_.add(position_mm_)) finish_move();
+  if (mode_ == Mode::kRun && moves_.active() && moves_.add(position_mm_)) finish_move(MoveEnd::kComplete);
   ++cycle_;
   publish();
+}
+
+void ScanCycle::step_law(double reference_mm, double y_v) noexcept {
+  const auto out = control::controller_step(tuning_.for_kind(controller_), state_, reference_mm / config_.mm_per_volt, y_v);
+  if (out.fault) {
+    enter_fault(FaultCode::kControllerFault);
+    valve_v_ = config_.safe_valve_v;
+    return;
+  }
+  if (transfer_pending_) transfer_.start(valve_v_, out.valve_v);
+  transfer_pending_ = false;
+  const double limit_v = tuning_.for_kind(controller_).valve_limit_v();
+  valve_v_ = std::clamp(transfer_.apply(out.valve_v), -limit_v, limit_v);
+  controller_v_ = out.controller_v;
+  saturated_ = out.saturated;
 }
 
 void ScanCycle::publish(bool full_stats) noexcept {
@@ -327,7 +414,13 @@ void ScanCycle::publish(bool full_stats) noexcept {
   s.excitation_left_s = excitation_.left_s();
   const auto& m = last_move_.metrics;
   s.last_move = {last_move_.number, last_move_.from_mm, last_move_.to_mm, or_nan(m.rise_s), or_nan(m.settling_s),
-                 last_move_.number ? m.ess_mm : kNaN, or_nan(m.overshoot_pct)};
+                 last_move_.number ? m.ess_mm : kNaN, or_nan(m.overshoot_pct), static_cast<std::uint8_t>(last_move_.end)};
+  const MotionStatus motion = motion_.status();
+  const bool axis_active = mode_ == Mode::kRun || (mode_ == Mode::kManual && jog_law_);
+  s.axis = {axis_active && motion.moving, mode_ == Mode::kRun && motion.in_position, motion.target_reached,
+            following_error_since_ns_ >= 0, (control_word_ & kControlStart) != 0, motion.halted, axis_active && motion.jogging,
+            control_word_, axis_active ? motion_.reference_mm() : position_mm_, speed_mm_s_};
+  s.last_sequence = last_sequence_;
   if (cycle_ % 200 == 0 || full_stats) s.loop = stats_.view();  // percentiles scan the bins: a few times a second
   s.loop.overruns = stats_.overruns;
   const auto& p = tuning_.for_kind(controller_);
@@ -367,7 +460,7 @@ void ScanCycle::run(const std::atomic<bool>& stop) noexcept {
 }
 
 void ScanCycle::shut_down() noexcept {
-  if (moves_.active()) finish_move();
+  if (moves_.active()) finish_move(MoveEnd::kStopped);
   if (mode_ == Mode::kExcite) end_excitation(ExcitationEnd::kStopped);
   valve_v_ = config_.safe_valve_v;
   daq_.write_valve(valve_v_);

@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "control/bumpless_transfer.hpp"
+#include "runtime/axis_motion.hpp"
 #include "control/controller.hpp"
 #include "hal/daq.hpp"
 #include "runtime/clock.hpp"
@@ -74,13 +75,18 @@ class ScanCycle {
   void apply_commands(std::int64_t now_ns) noexcept;
   void apply(const Command& c, std::int64_t now_ns) noexcept;
   void enter_run(std::int64_t now_ns) noexcept;
+  void apply_control(const Command& c, std::int64_t now_ns) noexcept;
+  void reset_fault() noexcept;  // FAULT -> STOP
+  // Runs the law towards `reference_mm` and sets valve_v_, controller_v_, saturated_ (or faults).
+  void step_law(double reference_mm, double y_v) noexcept;
   // The calibrated position in sensor volts from the last reading: what the control laws read.
   double position_v() const noexcept;
   // Starts `law` on the piston where the last reading put it, at the speed of the last two readings.
   void start_law_at_the_piston(const control::ControllerParams& law) noexcept;
   void end_excitation(ExcitationEnd how) noexcept;
-  void start_move() noexcept;
-  void finish_move() noexcept;
+  // A started move (a setpoint written in RUN, or a start): the one before it ends cut short.
+  void start_move(double target_mm, double speed_limit_mm_s, double window_mm) noexcept;
+  void finish_move(MoveEnd end) noexcept;
   FaultCode detect_fault(bool read_ok, std::int64_t now_ns) noexcept;
   void enter_fault(FaultCode code) noexcept;
   void publish(bool full_stats = false) noexcept;
@@ -117,6 +123,16 @@ class ScanCycle {
 
   MoveTracker moves_;
   MoveResult last_move_;
+
+  // The positioning interface: the task and its reference, the control word and its handshake.
+  AxisMotion motion_;
+  std::uint16_t control_word_ = 0;
+  bool hold_on_enable_ = false;         // RUN entered: hold at the first reading unless a move was started since
+  bool jog_law_ = false;                // MANUAL: the law drives a jog (else the manual valve command)
+  std::int64_t jog_keepalive_ns_ = 0;   // the heartbeat or control word last written while jogging
+  double speed_mm_s_ = 0.0;             // measured, filtered
+  bool have_reading_ = false;           // a reading before this one (the speed needs two)
+  std::uint64_t last_sequence_ = 0;
   LoopStats stats_;
   Snapshot snap_;
 };

@@ -17,6 +17,7 @@ struct MoveMetricsView {
   std::uint32_t number = 0;  // 0: no move finished yet
   double from_mm = 0, to_mm = 0;
   double rise_s = 0, settling_s = 0, ess_mm = 0, overshoot_pct = 0;  // NaN: never reached / never moved
+  std::uint8_t end = 0;      // MoveEnd: 0 complete, 1 cut short, 2 halted, 3 stopped, 4 fault
 };
 
 struct TuningView {
@@ -24,6 +25,15 @@ struct TuningView {
   std::uint8_t nF = 0, nG = 0, nH = 0;
   double m_r = 0, m_l = 0, b_r = 0, b_l = 0, lc_mm = 0, valve_limit_v = 0;
   double traj_speed_fraction = 0, traj_bandwidth_rad_s = 0, traj_hold_band_mm = 0;  // pp-traj's settings
+};
+
+// The positioning interface's state (axis_words.hpp composes the status word from it).
+struct AxisView {
+  bool moving = false, in_position = false, target_reached = false, following_error = false;
+  bool ack = false, halted = false, jogging = false;
+  std::uint16_t control_word = 0;  // as the loop last applied it
+  double reference_mm = 0;         // what the control law follows (a halt's or jog's profile, or the target)
+  double speed_mm_s = 0;           // measured, filtered (20 ms)
 };
 
 struct Snapshot {
@@ -43,6 +53,8 @@ struct Snapshot {
   ExcitationSettings excitation;  // what the next EXCITE starts with
   double excitation_left_s = 0;   // of the running experiment; 0 when none runs
   MoveMetricsView last_move;
+  AxisView axis;
+  std::uint64_t last_sequence = 0;  // the last command the loop took, applied or refused (Command::sequence)
   LoopStatsView loop;
   TuningView tuning;
 };

@@ -77,6 +77,8 @@ bool within(const std::filesystem::path& file, const std::filesystem::path& root
 struct WebServer::Impl {
   WebConfig config;
   runtime::LoopChannels& channels;
+  // The loop's snapshot with the accepted writes it has not taken yet (read after write).
+  runtime::Snapshot snapshot() const { return gate ? gate->snapshot() : channels.snapshot.read(); }
   points::WriteGate* gate;
   RecentAudit* audit;
   ModbusStatsFn modbus_stats;
@@ -254,7 +256,7 @@ struct WebServer::Impl {
       return httplib::Server::HandlerResponse::Unhandled;
     });
     s.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
-      res.set_content(status_json(channels.snapshot.read(), modbus(), commands_enabled(), store()), kJson);
+      res.set_content(status_json(snapshot(), modbus(), commands_enabled(), store()), kJson);
     });
     s.Get("/api/trend", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(trend_json(trend.points(), channels.snapshot.read()), kJson);
@@ -263,7 +265,7 @@ struct WebServer::Impl {
       res.set_content(moves_json(trend.moves()), kJson);
     });
     s.Get("/api/tuning", [this](const httplib::Request&, httplib::Response& res) {
-      res.set_content(tuning_json(channels.snapshot.read()), kJson);
+      res.set_content(tuning_json(snapshot()), kJson);
     });
     s.Get("/api/points", [this](const httplib::Request&, httplib::Response& res) {
       if (!gate) return send_error(res, 404, "no point catalog on this server");

@@ -214,10 +214,10 @@ TEST_F(Handler, ABlockWriteArrivesAsOneGroup) {
   // setpoint (0-1) = 50.0 and mode (2) = 1 in one FC16.
   EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x03, 0x06, 0x42, 0x48, 0x00, 0x00, 0x00, 0x01}), 0);
   const auto c = drain();
-  ASSERT_EQ(c.size(), 2u);
-  EXPECT_EQ(c[0].kind, runtime::CommandKind::kSetpoint);
-  EXPECT_EQ(c[1].kind, runtime::CommandKind::kMode);
-  EXPECT_EQ(c[1].mode, runtime::Mode::kRun);
+  ASSERT_EQ(c.size(), 2u);  // the mode first: RUN entered holds, then the setpoint moves
+  EXPECT_EQ(c[0].kind, runtime::CommandKind::kMode);
+  EXPECT_EQ(c[0].mode, runtime::Mode::kRun);
+  EXPECT_EQ(c[1].kind, runtime::CommandKind::kSetpoint);
   EXPECT_EQ(handler_->status(Session{}, 0).change_counter, 1u);  // one accepted write request
 }
 

@@ -28,7 +28,7 @@ TEST(PointCatalog, OneEntryPerIdInOrderWithUniqueNames) {
   }
   EXPECT_EQ(find_point("no_such_point"), nullptr);
   EXPECT_EQ(name(PointId::kSetpoint), "setpoint_mm");
-  EXPECT_EQ(name(coefficient_id(PointId::kG0, 3)), "G3");
+  EXPECT_EQ(name(indexed_id(PointId::kG0, 3)), "G3");
 }
 
 // Files that spell a point's name as a key of their own documented format (FORMATS.md), not as

@@ -278,8 +278,8 @@ struct FakeRig {
 TEST(ExciteMode, IsEnteredFromStopOnlyWithThePistonBetweenTheGuardLines) {
   {
     FakeRig rig;
+    rig.push(mode_command(Mode::kRun));  // enable (holds), then the setpoint moves
     rig.push(setpoint_command(150.0));
-    rig.push(mode_command(Mode::kRun));
     rig.cycles(2);
     rig.push(mode_command(Mode::kExcite));
     rig.cycles(1);

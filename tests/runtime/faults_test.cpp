@@ -19,6 +19,7 @@ class Faults : public ::testing::Test {
  protected:
   void start(RuntimeConfig c = {}, bool expect_moving = true) {
     c.start_mode = Mode::kRun;
+    c.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
     c.start_setpoint_mm = c.start_setpoint_mm == 0.0 ? 300.0 : c.start_setpoint_mm;
     config_ = c;
     daq_.sensor_v = 2.0;  // 100 mm

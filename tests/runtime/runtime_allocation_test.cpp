@@ -17,6 +17,7 @@ TEST(RuntimeAllocation, TenThousandScanCyclesAllocateNothing) {
   VirtualClock clock;
   RuntimeConfig config;
   config.start_mode = Mode::kRun;
+  config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
   config.start_setpoint_mm = 50.0;
   config.move_window_s = 2.0;
   LoopChannels ch(20000);

@@ -45,6 +45,7 @@ TEST(ScanCycle, ReproducesSimulateExactlyForEachController) {
     RuntimeConfig config;
     config.controller = kind;
     config.start_mode = Mode::kRun;
+    config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
     config.start_setpoint_mm = 50.0;
     LoopChannels ch(8000);
     ScanCycle loop(config, paper_tuning(), daq, clock, ch);
@@ -67,6 +68,7 @@ TEST(ScanCycle, OnlineMoveMetricsAreSimulateMetricsOverTheMoveWindow) {
   VirtualClock clock;
   RuntimeConfig config;
   config.start_mode = Mode::kRun;
+  config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
   config.start_setpoint_mm = 100.0;
   config.move_window_s = 5.0;
   LoopChannels ch(8000);
@@ -106,8 +108,8 @@ TEST(ScanCycle, StopHoldsTheValveSafeAndRunMovesIt) {
   rig.cycles(3);
   EXPECT_EQ(rig.daq.last_written_v, 0.0);
   EXPECT_EQ(rig.snap().mode, Mode::kStop);
+  rig.push(mode_command(Mode::kRun));  // enable (holds), then the setpoint moves
   rig.push(setpoint_command(150.0));  // 2 V sensor = 100 mm now
-  rig.push(mode_command(Mode::kRun));
   rig.cycles(1);
   EXPECT_EQ(rig.snap().mode, Mode::kRun);
   EXPECT_NE(rig.daq.last_written_v, 0.0);
@@ -145,6 +147,7 @@ TEST(ScanCycle, SetpointOutsideTheRangeIsRejectedWhole) {
 TEST(ScanCycle, TuningSwappedMidRunTakesEffectAtTheNextCycleWithTheStateCarriedOver) {
   RuntimeConfig config;
   config.start_mode = Mode::kRun;
+  config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
   config.start_setpoint_mm = 150.0;
   Rig rig(config);
   rig.daq.sensor_v = 2.0;
@@ -174,6 +177,7 @@ TEST(ScanCycle, TuningSwappedMidRunTakesEffectAtTheNextCycleWithTheStateCarriedO
 TEST(ScanCycle, ControllerSwitchIsBumplessTheHistoryCarriesOver) {
   RuntimeConfig config;
   config.start_mode = Mode::kRun;
+  config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
   config.start_setpoint_mm = 150.0;
   Rig rig(config);
   rig.cycles(20);
@@ -204,6 +208,7 @@ TEST(ScanCycle, EverySwitchBetweenTwoLawsWhileMovingIsBumpless) {
       RuntimeConfig config;
       config.controller = from;
       config.start_mode = Mode::kRun;
+      config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
       config.start_setpoint_mm = 200.0;
       LoopChannels ch(8000);
       ScanCycle loop(config, paper_tuning(), daq, clock, ch);
@@ -237,6 +242,7 @@ TEST(ScanCycle, SwitchingLawsOnThePhysicsPlantDoesNotStepTheValve) {
         RuntimeConfig config;
         config.controller = from;
         config.start_mode = Mode::kRun;
+        config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
         config.start_setpoint_mm = 200.0;
         LoopChannels ch(8000);
         ScanCycle loop(config, paper_tuning(), daq, clock, ch);
@@ -255,6 +261,7 @@ TEST(ScanCycle, SwitchingLawsOnThePhysicsPlantDoesNotStepTheValve) {
 TEST(ScanCycle, ShutDownPutsTheValveSafe) {
   RuntimeConfig config;
   config.start_mode = Mode::kRun;
+  config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
   config.start_setpoint_mm = 300.0;
   Rig rig(config);
   rig.cycles(5);
@@ -267,6 +274,7 @@ TEST(ScanCycle, ShutDownPutsTheValveSafe) {
 TEST(ScanCycle, RunStopsWhenAskedAndLeavesTheValveSafe) {
   RuntimeConfig config;
   config.start_mode = Mode::kRun;
+  config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
   config.start_setpoint_mm = 300.0;
   testing::FakeDaq daq;
   VirtualClock clock;
@@ -297,6 +305,7 @@ TEST(Recorder, WritesEachMoveAsAValidRunFile) {
   VirtualClock clock;
   RuntimeConfig config;
   config.start_mode = Mode::kRun;
+  config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
   config.start_setpoint_mm = 50.0;
   config.move_window_s = 2.0;
   LoopChannels ch(4000);
