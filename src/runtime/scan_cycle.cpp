@@ -75,7 +75,7 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
           }
           if (moves_.active()) finish_move(MoveEnd::kStopped);
           if (mode_ == Mode::kExcite) end_excitation(ExcitationEnd::kStopped);
-          jog_law_ = false;
+          jog_law_ = profile_law_ = false;
           if (c.mode == Mode::kRun) enter_run(now_ns);
           if (c.mode == Mode::kManual) {
             manual_valve_v_ = config_.safe_valve_v;  // never resume a stale manual command
@@ -95,10 +95,11 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
         // The RST laws share their history; pp-traj keeps its own, so a switch to or from it
         // starts the new law where the piston is, at its speed. Either way the valve command
         // does not step: the new law takes over from it (bumpless transfer).
-        if ((c.controller == control::ControllerKind::kPpTraj) != (controller_ == control::ControllerKind::kPpTraj))
+        if ((c.controller == control::ControllerKind::kPpTraj) != (law() == control::ControllerKind::kPpTraj))
           start_law_at_the_piston(tuning_.for_kind(c.controller));
-        if (c.controller != controller_) transfer_pending_ = mode_ == Mode::kRun;
+        if (c.controller != law()) transfer_pending_ = mode_ == Mode::kRun;
         controller_ = c.controller;
+        profile_law_ = false;  // the law asked for runs from now on, a halt's hold included
         break;
       case CommandKind::kTuning:  // takes effect in this cycle's step, whole, taking over from the valve's command
         if (controller_ == control::ControllerKind::kPpTraj && !c.tuning.traj_available) {
@@ -106,7 +107,11 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
           break;
         }
         tuning_ = c.tuning;
-        if (controller_ == control::ControllerKind::kPpTraj) start_law_at_the_piston(tuning_.traj);  // new limits: a new profile
+        if (profile_law_ && !tuning_.traj_available) {  // a halt's or jog's pp-traj cannot go on: the selected law takes over
+          profile_law_ = false;
+          start_law_at_the_piston(tuning_.for_kind(controller_));
+        }
+        if (law() == control::ControllerKind::kPpTraj) start_law_at_the_piston(tuning_.traj);  // new limits: a new profile
         transfer_pending_ = mode_ == Mode::kRun;
         break;
       case CommandKind::kReset: reset_fault(); break;
@@ -155,6 +160,26 @@ void ScanCycle::enter_run(std::int64_t now_ns) noexcept {
   motion_.hold(position_mm_);
 }
 
+void ScanCycle::use_profile_law(bool on) noexcept {
+  if (on == profile_law_ || (on && !tuning_.traj_available)) return;
+  const control::ControllerKind before = law();
+  profile_law_ = on;
+  if (law() == before) return;  // pp-traj is the selected law anyway
+  if ((before == control::ControllerKind::kPpTraj) != (law() == control::ControllerKind::kPpTraj))
+    start_law_at_the_piston(tuning_.for_kind(law()));
+  transfer_pending_ = true;
+}
+
+double ScanCycle::plausible_speed_mm_s() const noexcept {
+  if (!tuning_.traj_available) return speed_mm_s_;
+  // No faster than the model at the valve limit: beyond it a reading is a spike, not a speed (the
+  // printed B answers each valve jump with one), and a halt would aim at the end of the stroke.
+  const auto& t = tuning_.traj;
+  const double fraction = t.trajectory_config().speed_fraction;
+  const auto& limits = t.trajectory().limits;
+  return std::clamp(speed_mm_s_, -limits.speed_neg_v_s / fraction * config_.mm_per_volt, limits.speed_pos_v_s / fraction * config_.mm_per_volt);
+}
+
 void ScanCycle::reset_fault() noexcept {
   if (mode_ != Mode::kFault) return;  // nothing latched: nothing to do, and that is fine
   mode_ = Mode::kStop;
@@ -172,7 +197,8 @@ void ScanCycle::apply_control(const Command& c, std::int64_t now_ns) noexcept {
   if (rising & kControlHalt) {
     if (mode_ == Mode::kRun) {
       if (moves_.active()) finish_move(MoveEnd::kHalted);
-      motion_.halt(position_mm_, speed_mm_s_);
+      use_profile_law(true);
+      motion_.halt(position_mm_, plausible_speed_mm_s());
       setpoint_mm_ = motion_.target_mm();  // the setpoint tells where the axis now stops
       hold_on_enable_ = false;
     } else if (jog_law_) {
@@ -193,7 +219,8 @@ void ScanCycle::apply_control(const Command& c, std::int64_t now_ns) noexcept {
     const int direction = plus == minus ? 0 : plus ? 1 : -1;  // both held: neither
     if (direction != 0 && (rising & (kControlJogPlus | kControlJogMinus))) {
       if (!jog_law_) {  // the law takes over from the manual valve command where the piston is
-        start_law_at_the_piston(tuning_.for_kind(controller_));
+        profile_law_ = tuning_.traj_available;
+        start_law_at_the_piston(tuning_.for_kind(law()));
         transfer_pending_ = true;
         jog_law_ = true;
       }
@@ -223,6 +250,7 @@ void ScanCycle::end_excitation(ExcitationEnd how) noexcept {
 void ScanCycle::start_move(double target_mm, double speed_limit_mm_s, double window_mm) noexcept {
   if (moves_.active()) finish_move(MoveEnd::kCutShort);
   hold_on_enable_ = false;  // RUN entered with a move: the move, not a hold
+  use_profile_law(false);   // after a halt: the selected law again, taking over bumplessly
   moves_.start(position_mm_, target_mm, ch_.samples.written());
   motion_.move(target_mm, speed_limit_mm_s, window_mm, position_mm_, speed_mm_s_);
 }
@@ -278,7 +306,7 @@ FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
 
 void ScanCycle::enter_fault(FaultCode code) noexcept {
   if (moves_.active()) finish_move(MoveEnd::kFault);
-  jog_law_ = false;
+  jog_law_ = profile_law_ = false;
   if (mode_ == Mode::kExcite) end_excitation(ExcitationEnd::kFault);
   mode_ = Mode::kFault;
   fault_ = code;
@@ -293,12 +321,15 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
   if (read_ok) {
     previous_sensor_v_ = sensor_v_;
     sensor_v_ = reading.sensor_v;
-    const double previous_mm = position_mm_;
+    const double two_back_mm = previous_position_mm_;
+    previous_position_mm_ = position_mm_;
     position_mm_ = (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain * config_.mm_per_volt;
-    const double raw_speed = (position_mm_ - previous_mm) / config_.period_s;
-    if (have_reading_ && std::isfinite(raw_speed)) speed_mm_s_ += (raw_speed - speed_mm_s_) * (config_.period_s / (kSpeedFilterS + config_.period_s));
+    // Over two samples: a plant ringing at the Nyquist rate (the paper's B under FF-IDZ) alternates
+    // its readings, which this difference cancels, so a halt brakes from the piston's real speed.
+    const double raw_speed = (position_mm_ - two_back_mm) / (2.0 * config_.period_s);
+    if (readings_ >= 2 && std::isfinite(raw_speed)) speed_mm_s_ += (raw_speed - speed_mm_s_) * (config_.period_s / (kSpeedFilterS + config_.period_s));
     consecutive_read_errors_ = 0;
-    have_reading_ = true;
+    if (readings_ < 2) ++readings_;
   } else {
     ++consecutive_read_errors_;  // counted before the fault check: the N-th failure faults this cycle
     ++io_errors_;
@@ -314,6 +345,7 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
       if (!read_ok) break;  // hold the last command for a missed sample (counted below)
       if (init_state_on_next_read_) {
         // At rest at the current position: no error history, no controller output history.
+        profile_law_ = false;
         control::controller_start(tuning_.for_kind(controller_), state_, y_v, 0.0);
         init_state_on_next_read_ = false;
         transfer_pending_ = false;  // RUN starts from the safe valve command, not from another law
@@ -334,7 +366,7 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
         if (config_.jog_keepalive_s > 0.0 && static_cast<double>(now_ns - jog_keepalive_ns_) > config_.jog_keepalive_s * 1e9)
           motion_.jog(0, position_mm_, speed_mm_s_);  // no keep-alive: brake as if released
         step_law(motion_.step(position_mm_), y_v);
-        if (mode_ == Mode::kManual && motion_.task() != MotionTask::kJog) jog_law_ = false;  // braked: the manual command next
+        if (mode_ == Mode::kManual && motion_.task() != MotionTask::kJog) jog_law_ = profile_law_ = false;  // braked: the manual command next
         break;
       }
       valve_v_ = manual_valve_v_;
@@ -372,7 +404,7 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
 }
 
 void ScanCycle::step_law(double reference_mm, double y_v) noexcept {
-  const auto out = control::controller_step(tuning_.for_kind(controller_), state_, reference_mm / config_.mm_per_volt, y_v);
+  const auto out = control::controller_step(tuning_.for_kind(law()), state_, reference_mm / config_.mm_per_volt, y_v);
   if (out.fault) {
     enter_fault(FaultCode::kControllerFault);
     valve_v_ = config_.safe_valve_v;
@@ -380,7 +412,7 @@ void ScanCycle::step_law(double reference_mm, double y_v) noexcept {
   }
   if (transfer_pending_) transfer_.start(valve_v_, out.valve_v);
   transfer_pending_ = false;
-  const double limit_v = tuning_.for_kind(controller_).valve_limit_v();
+  const double limit_v = tuning_.for_kind(law()).valve_limit_v();
   valve_v_ = std::clamp(transfer_.apply(out.valve_v), -limit_v, limit_v);
   controller_v_ = out.controller_v;
   saturated_ = out.saturated;

@@ -77,6 +77,12 @@ class ScanCycle {
   void enter_run(std::int64_t now_ns) noexcept;
   void apply_control(const Command& c, std::int64_t now_ns) noexcept;
   void reset_fault() noexcept;  // FAULT -> STOP
+  // A halt or a jog brakes along a profile, which pp-traj is made for: it runs them whenever the
+  // tuning set's model allows it, whatever law is selected, and the selected law takes over again
+  // (bumplessly) at the next start. law() is the one stepping.
+  void use_profile_law(bool on) noexcept;
+  double plausible_speed_mm_s() const noexcept;  // the measured speed, within the model's top speeds
+  control::ControllerKind law() const noexcept { return profile_law_ ? control::ControllerKind::kPpTraj : controller_; }
   // Runs the law towards `reference_mm` and sets valve_v_, controller_v_, saturated_ (or faults).
   void step_law(double reference_mm, double y_v) noexcept;
   // The calibrated position in sensor volts from the last reading: what the control laws read.
@@ -129,9 +135,11 @@ class ScanCycle {
   std::uint16_t control_word_ = 0;
   bool hold_on_enable_ = false;         // RUN entered: hold at the first reading unless a move was started since
   bool jog_law_ = false;                // MANUAL: the law drives a jog (else the manual valve command)
+  bool profile_law_ = false;            // pp-traj runs a halt or a jog in place of the selected law
   std::int64_t jog_keepalive_ns_ = 0;   // the heartbeat or control word last written while jogging
   double speed_mm_s_ = 0.0;             // measured, filtered
-  bool have_reading_ = false;           // a reading before this one (the speed needs two)
+  double previous_position_mm_ = 0.0;   // the reading before position_mm_ (the speed spans two)
+  int readings_ = 0;                    // up to 2: the speed needs two readings before this one
   std::uint64_t last_sequence_ = 0;
   LoopStats stats_;
   Snapshot snap_;

