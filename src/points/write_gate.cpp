@@ -72,6 +72,10 @@ int WriteGate::record_select() const {
 runtime::Snapshot WriteGate::snapshot() const {
   runtime::Snapshot s = channels_.snapshot.read();
   std::lock_guard lock(mutex_);
+  return with_unapplied(s);
+}
+
+runtime::Snapshot WriteGate::with_unapplied(runtime::Snapshot s) const {
   while (!unapplied_.empty() && unapplied_.front().sequence <= s.last_sequence) unapplied_.pop_front();
   for (const runtime::Command& c : unapplied_) {
     switch (c.kind) {
@@ -287,7 +291,7 @@ GateResult WriteGate::decide(std::span<const PointWrite> writes, const Requester
 GateResult WriteGate::submit(std::span<const PointWrite> writes, const Requester& who) {
   if (!writes.empty() && writes.front().id == PointId::kCommissionCommand) return commission(writes, who);
   std::lock_guard lock(mutex_);
-  const runtime::Snapshot snap = channels_.snapshot.read();
+  const runtime::Snapshot snap = with_unapplied(channels_.snapshot.read());  // decided on what reads show
   Decision d;
   if (GateResult r = build(writes, who, snap, tuning_, excitation_, d); !r.accepted()) return r;
   const PositionRecords records_before = records_;  // the audit trail's old values

@@ -141,6 +141,7 @@ class WriteGate {
   // Accepted commands the loop may not have taken yet (snapshot() applies them); pruned by the
   // snapshot's last_sequence.
   mutable std::deque<runtime::Command> unapplied_;
+  runtime::Snapshot with_unapplied(runtime::Snapshot s) const;  // mutex_ held
   static constexpr std::size_t kUnapplied = 256;
 };
 

@@ -24,6 +24,7 @@ struct Axis {
   explicit Axis(double start_mm, ControllerKind kind = ControllerKind::kPpFfidz, RuntimeConfig c = {})
       : daq(*hal::SimDaq::make(core::paper::model(), {.initial_position_mm = start_mm})), config(c), ch(4000) {
     config.controller = kind;
+    config.enable_holds_position = true;  // the positioning interface's way (the appliance's default is not yet)
     loop = std::make_unique<ScanCycle>(config, *make_tuning(control::paper_controller_config(kind)), daq, clock, ch);
     cycles(2);
   }
@@ -54,6 +55,7 @@ struct Axis {
 
 TEST(Positioning, EnableHoldsThePistonWhereItIsWhateverTheSetpointSays) {
   RuntimeConfig c;
+  c.enable_holds_position = true;
   c.start_setpoint_mm = 250.0;  // retained from before a restart, the piston at 20 mm
   Axis axis(20.0, ControllerKind::kPpFfidz, c);
   const double before = axis.snap().position_mm;
