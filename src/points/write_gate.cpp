@@ -80,7 +80,10 @@ runtime::Snapshot WriteGate::with_unapplied(runtime::Snapshot s) const {
   for (const runtime::Command& c : unapplied_) {
     switch (c.kind) {
       case runtime::CommandKind::kSetpoint: s.setpoint_mm = c.value; break;
-      case runtime::CommandKind::kMode: s.mode = c.mode; break;
+      case runtime::CommandKind::kMode:
+        if (c.mode == runtime::Mode::kExcite && s.mode != runtime::Mode::kExcite) s.excitation_left_s = s.excitation.duration_s;  // all of it is left
+        s.mode = c.mode;
+        break;
       case runtime::CommandKind::kManualValve: s.manual_valve_v = c.value; break;
       case runtime::CommandKind::kController: s.controller = c.controller; break;
       case runtime::CommandKind::kHeartbeat: s.heartbeat = c.heartbeat; break;
