@@ -18,6 +18,7 @@
 #include "app/store_setup.hpp"
 #include "app/tuning_source.hpp"
 #include "core/format.hpp"
+#include "core/version.hpp"
 #include "hal/realtime.hpp"
 #include "runtime/clock.hpp"
 #include "runtime/recorder.hpp"
@@ -270,7 +271,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   store::StoreWriter& store_writer = *control->store.writer;
   auto daq = make_daq(c, control->plant_model.model);
   if (!daq) return fail(daq.error());
-  spdlog::info("epa serve starting: config {}, DAQ {}", o.config_path, (*daq)->describe());
+  spdlog::info("epa {} serve starting: config {}, DAQ {}", core::kVersion, o.config_path, (*daq)->describe());
   if (auto s = (*daq)->open(); !s) {
     spdlog::error("DAQ: {}", s.error().message);
     return 1;

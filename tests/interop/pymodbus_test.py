@@ -18,6 +18,8 @@ Exit 0 when every test passes, 1 otherwise (unittest prints "Ran N tests ... OK/
 """
 import math
 import os
+import re
+import subprocess
 import sys
 import time
 import unittest
@@ -26,7 +28,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from epa_appliance import (UNIT, UNLOCK_ADDRESS, Appliance, unlock, f32_value, f32_words, i16_value, pymodbus,  # noqa: E402
                            u32_value, u32_words)
 
-VERSION = (0, 2, 0)  # src/points/point_catalog.hpp kVersionMajor/Minor/Patch
+VERSION = None  # (major, minor, patch) as `epa --version` prints it: CMakeLists.txt's project(VERSION)
 MM_PER_VOLT = 50.0   # the paper's position sensor scale (config/paper-model.toml)
 HEARTBEAT_TIMEOUT_S = 5.0  # [limits] heartbeat_timeout_s of the epa.csv appliance: generous, so a test
 # process starved for a moment on a loaded CI machine does not lapse it by accident
@@ -380,13 +382,23 @@ class LegacyHmiMapTest(ApplianceTest):
             self.ok(c.write_register(1001, 0, slave=UNIT), "mode 0 (stop)")
 
 
+def epa_version(epa):
+    """The version `epa --version` prints ("epa 0.3.0") as a tuple of three numbers."""
+    out = subprocess.run([epa, "--version"], capture_output=True, text=True, timeout=10).stdout.strip()
+    match = re.fullmatch(r"epa (\d+)\.(\d+)\.(\d+)", out)
+    if not match:
+        sys.exit(f"FAIL: `{epa} --version` printed {out!r}, expected 'epa MAJOR.MINOR.PATCH'")
+    return tuple(int(g) for g in match.groups())
+
+
 def main():
-    global EPA, SRC
+    global EPA, SRC, VERSION
     if len(sys.argv) != 3:
         sys.exit(f"usage: {sys.argv[0]} <epa binary> <source dir>")
     EPA, SRC = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     if not os.access(EPA, os.X_OK):
         sys.exit(f"FAIL: {EPA} is not an executable")
+    VERSION = epa_version(EPA)
     print(f"pymodbus {pymodbus.__version__} ({os.path.dirname(pymodbus.__file__)}), python {sys.version.split()[0]}",
           file=sys.stderr)
     suite = unittest.TestSuite()

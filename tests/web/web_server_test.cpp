@@ -4,6 +4,7 @@
 #include "web/web_server.hpp"
 
 #include "control/paper_controller.hpp"
+#include "core/version.hpp"
 
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
@@ -160,6 +161,7 @@ TEST_F(WebServerTest, StatusShowsThePublishedSnapshotWithNanAsNull) {
   EXPECT_EQ(s["modbus"]["clients"], 2);
   EXPECT_EQ(s["modbus"]["requests"], 77);
   EXPECT_FALSE(s["commands_enabled"].get<bool>());
+  EXPECT_EQ(s["version"], std::string(epa::core::kVersion));  // project(... VERSION) in CMakeLists.txt
 }
 
 TEST_F(WebServerTest, StatusNamesALatchedFaultInWords) {
