@@ -7,6 +7,7 @@
 #include <ctime>
 #include <optional>
 #include <set>
+#include <string>
 #include <thread>
 
 #include "app/daq_factory.hpp"
@@ -152,8 +153,10 @@ core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const Appliance
   auto server = modbus::ModbusServer::start(c.modbus, map, gate, channels, [](const std::string& line) { spdlog::info("{}", line); });
   if (!server) return server.error();
   const auto& p = c.modbus.policy;
-  spdlog::info("modbus: listening on {}:{} (unit {}, map {}, {} points, {})", c.modbus.address, (*server)->port(),
-               c.modbus.unit_id, c.register_map_path, map.entries().size(),
+  std::string aliases;
+  for (const int id : c.modbus.alias_unit_ids) aliases += (aliases.empty() ? ", also " : " and ") + std::to_string(id);
+  spdlog::info("modbus: listening on {}:{} (unit {}{}, map {}, {} points, {})", c.modbus.address, (*server)->port(),
+               c.modbus.unit_id, aliases, c.register_map_path, map.entries().size(),
                p.read_only ? "read-only" : p.unlock_key ? "tuning locked until unlocked" : "tuning locked (no unlock key)");
   return server;
 }
