@@ -243,6 +243,8 @@ TEST_F(Server, DeviceIdentificationIsAnsweredBehindTheRequestsMbapHeader) {
   const std::uint8_t missing[] = {0x12, 0x36, 0x00, 0x00, 0x00, 0x05, 0x01, 0x2B, 0x0E, 0x04, 0x07};
   ASSERT_EQ(send(fd, missing, sizeof missing, 0), static_cast<ssize_t>(sizeof missing));
   EXPECT_EQ(read_adu(fd), (std::vector<std::uint8_t>{0x12, 0x36, 0x00, 0x00, 0x00, 0x03, 0x01, 0xAB, 0x02}));
+  // The server counts after it sent the answer: wait for it, bounded.
+  for (const auto until = Clock::now() + 1s; server_->exceptions() < 1 && Clock::now() < until;) std::this_thread::sleep_for(1ms);
   EXPECT_EQ(server_->requests(), 3u);
   EXPECT_EQ(server_->exceptions(), 1u);
 }
