@@ -1,7 +1,8 @@
 // Modbus TCP requests into the server's request path with the shipped map (registers/epa.csv):
 // the input is a byte stream as a client sends it, cut into ADUs by the MBAP length exactly as
 // ModbusServer does, each one through RequestHandler::handle and then libmodbus' modbus_reply /
-// modbus_reply_exception (which reads the register image the handler filled). Unlocking is
+// modbus_reply_exception (which reads the register image the handler filled), or the handler's
+// own PDU (device identification) behind its MBAP header. Unlocking is
 // configured (key 5e3a9c17d24b086f, in the dictionary and the seeds), so tuning writes are reached.
 // Every input starts from a fresh handler and an empty command queue: a run replays alone.
 #include <modbus.h>
@@ -35,10 +36,7 @@ Fixture& fixture() {
     auto m = modbus::RegisterMap::load(EPA_SOURCE_DIR "/registers/epa.csv");
     if (!m) std::abort();
     auto* fx = new Fixture{std::move(*m)};
-    using modbus::Table;
-    fx->image = modbus_mapping_new_start_address(0, fx->map.end_address(Table::kCoil), 0, fx->map.end_address(Table::kDiscreteInput),
-                                                 0, fx->map.end_address(Table::kHoldingRegister), 0,
-                                                 fx->map.end_address(Table::kInputRegister));
+    fx->image = modbus::new_register_image(fx->map);  // as the server's: bit tables padded to 16
     fx->ctx = modbus_new_tcp("127.0.0.1", 502);
     if (!fx->image || !fx->ctx || socketpair(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK, 0, fx->sink) != 0) std::abort();
     modbus_set_socket(fx->ctx, fx->sink[0]);
@@ -76,7 +74,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   points::WriteGate gate(*points::WriteLimits::from_config(loop, "fuzz.toml"), loop,
                          control::paper_controller_config(control::ControllerKind::kPpFfidz), channels, &audit);
   modbus::RequestHandler handler(fx.map, modbus::WritePolicy{.read_only = false, .unlock_key = 0x5e3a9c17d24b086f, .unlock_timeout_s = 10},
-                                 1, gate, channels);
+                                 {1, 0, 0xFF}, gate, channels);
   modbus::Session session{"127.0.0.1", "127.0.0.1:50000", 0};
   std::int64_t now_ns = 0;
   std::size_t pos = 0;
@@ -91,9 +89,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // ASan see a read past the frame.
     std::unique_ptr<std::uint8_t[]> req(new std::uint8_t[total]);
     std::copy(frame, frame + total, req.get());
-    const std::uint8_t exception = handler.handle(req.get(), static_cast<int>(total), session, now_ns, fx.image);
-    if (exception) modbus_reply_exception(fx.ctx, req.get(), exception);
-    else modbus_reply(fx.ctx, req.get(), static_cast<int>(total), fx.image);
+    const modbus::Reply reply = handler.handle(req.get(), static_cast<int>(total), session, now_ns, fx.image);
+    if (reply.exception) {
+      modbus_reply_exception(fx.ctx, req.get(), reply.exception);
+    } else if (!reply.pdu.empty()) {  // FC43: the handler's own PDU, checked against the limit the server relies on
+      if (reply.pdu.size() > static_cast<std::size_t>(modbus::kMaxPduBytes)) std::abort();
+      const auto adu = modbus::tcp_adu(req.get(), reply.pdu);
+      if (write(fx.sink[0], adu.data(), adu.size()) < 0) std::abort();
+    } else {
+      modbus_reply(fx.ctx, req.get(), static_cast<int>(total), fx.image);
+    }
     runtime::Command c;
     while (channels.commands.try_pop(c)) {}
     std::uint8_t discard[512];

@@ -20,9 +20,11 @@ packages=(
   # sanitizer and fuzz builds (scripts/test-sanitizers.sh, test-tsan.sh, fuzz.sh)
   clang libclang-rt-14-dev
   # programs the tests and scripts call: Modbus clients (mbpoll, Debian's python3 with pymodbus),
-  # the browser, HTTP (curl), taskset/chrt (util-linux), mount (fault injection); sqlite3 is the
+  # the browser, HTTP (curl), taskset/chrt (util-linux), mount (fault injection), promtool
+  # (/metrics checked by Prometheus' own linter; Debian ships it only in prometheus, which also
+  # installs the Prometheus server as a service: the tests use promtool alone); sqlite3 is the
   # database's own shell, for looking into the tuning store (epa.db)
-  python3 python3-pymodbus python3-serial-asyncio mbpoll chromium curl sqlite3 util-linux mount
+  python3 python3-pymodbus python3-serial-asyncio mbpoll chromium curl sqlite3 util-linux mount prometheus
 )
 bench_packages=(
   # bench/jitter_vs_cyclictest.sh: cyclictest is the scan cycle's timing peer

@@ -53,6 +53,7 @@ function showStatus(s) {
   setText("mode", s.mode);
   mode.className = "badge " + s.mode;
   setText("controller", s.controller_name);
+  setText("version", s.version);
   setText("uptime", `up ${num(s.time_s, 0)} s` + (s.mode === "excite" ? ` \u2014 excitation: ${num(s.excite_left_s, 0)} s left` : ""));
   const fault = $("fault");
   fault.hidden = s.mode !== "fault";

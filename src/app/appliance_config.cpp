@@ -92,6 +92,19 @@ class TableReader {
       out.push_back(*item.value<std::string>());
     }
   }
+  void integer_list(const char* key, std::vector<int>& out, int lo, int hi) {
+    const toml::node* n = find(key);
+    if (!n) return;
+    const auto* arr = n->as_array();
+    if (!arr) return fail(*n, key, "must be an array of whole numbers within " + std::to_string(lo) + ".." + std::to_string(hi));
+    out.clear();
+    for (const auto& item : *arr) {
+      const auto v = item.is_integer() ? item.value<std::int64_t>() : std::nullopt;
+      if (!v || *v < lo || *v > hi)
+        return fail(item, key, "must contain whole numbers within " + std::to_string(lo) + ".." + std::to_string(hi) + " only");
+      out.push_back(static_cast<int>(*v));
+    }
+  }
   const toml::table* subtable(const char* key) {
     used_.insert(key);
     return table_ ? (*table_)[key].as_table() : nullptr;
@@ -284,6 +297,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   mbs.text("address", c.modbus.address);
   mbs.integer("port", c.modbus.port, 0, 65535);
   mbs.integer("unit_id", c.modbus.unit_id, 0, 247);
+  mbs.integer_list("alias_unit_ids", c.modbus.alias_unit_ids, 0, 255);
   mbs.integer("max_clients", c.modbus.max_clients, 1, 1000);
   mbs.number("idle_timeout_s", c.modbus.idle_timeout_s, above(0, kDay_s, "s"));
   mbs.number("frame_timeout_s", c.modbus.frame_timeout_s, above(0, 60, "s"));

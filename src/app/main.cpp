@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include "app/commission_command.hpp"
 #include "app/design_command.hpp"
@@ -13,12 +14,13 @@
 #include "app/serve_command.hpp"
 #include "app/simulate_command.hpp"
 #include "app/tuning_command.hpp"
+#include "core/version.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"epa: electro-pneumatic actuator controller appliance (pole placement with feed-forward "
                "inverse dead-zone compensation)"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "epa 0.1.0");
+  app.set_version_flag("--version", "epa " + std::string(epa::core::kVersion));
   epa::app::SimulateOptions simulate;
   epa::app::DesignOptions design;
   epa::app::ExciteOptions excite;

@@ -7,6 +7,7 @@
 #include <ctime>
 #include <optional>
 #include <set>
+#include <string>
 #include <thread>
 
 #include "app/daq_factory.hpp"
@@ -18,6 +19,7 @@
 #include "app/store_setup.hpp"
 #include "app/tuning_source.hpp"
 #include "core/format.hpp"
+#include "core/version.hpp"
 #include "hal/realtime.hpp"
 #include "runtime/clock.hpp"
 #include "runtime/recorder.hpp"
@@ -152,8 +154,10 @@ core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const Appliance
   auto server = modbus::ModbusServer::start(c.modbus, map, gate, channels, [](const std::string& line) { spdlog::info("{}", line); });
   if (!server) return server.error();
   const auto& p = c.modbus.policy;
-  spdlog::info("modbus: listening on {}:{} (unit {}, map {}, {} points, {})", c.modbus.address, (*server)->port(),
-               c.modbus.unit_id, c.register_map_path, map.entries().size(),
+  std::string aliases;
+  for (const int id : c.modbus.alias_unit_ids) aliases += (aliases.empty() ? ", also " : " and ") + std::to_string(id);
+  spdlog::info("modbus: listening on {}:{} (unit {}{}, map {}, {} points, {})", c.modbus.address, (*server)->port(),
+               c.modbus.unit_id, aliases, c.register_map_path, map.entries().size(),
                p.read_only ? "read-only" : p.unlock_key ? "tuning locked until unlocked" : "tuning locked (no unlock key)");
   return server;
 }
@@ -271,7 +275,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   store::StoreWriter& store_writer = *control->store.writer;
   auto daq = make_daq(c, control->plant_model.model);
   if (!daq) return fail(daq.error());
-  spdlog::info("epa serve starting: config {}, DAQ {}", o.config_path, (*daq)->describe());
+  spdlog::info("epa {} serve starting: config {}, DAQ {}", core::kVersion, o.config_path, (*daq)->describe());
   if (auto s = (*daq)->open(); !s) {
     spdlog::error("DAQ: {}", s.error().message);
     return 1;

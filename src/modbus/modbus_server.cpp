@@ -54,7 +54,12 @@ struct ModbusServer::Impl {
   Log log;
 
   Impl(const ServerConfig& c, const RegisterMap& map, points::WriteGate& gate, runtime::LoopChannels& ch, Log l)
-      : config(c), handler(map, c.policy, c.unit_id, gate, ch, l), log(std::move(l)) {}
+      : config(c), handler(map, c.policy, unit_ids(c), gate, ch, l), log(std::move(l)) {}
+  static std::vector<int> unit_ids(const ServerConfig& c) {
+    std::vector<int> ids = {c.unit_id};
+    ids.insert(ids.end(), c.alias_unit_ids.begin(), c.alias_unit_ids.end());
+    return ids;
+  }
   ~Impl() {
     for (auto& cl : clients) ::close(cl.fd);
     if (listener >= 0) ::close(listener);
@@ -69,10 +74,7 @@ core::Result<std::unique_ptr<ModbusServer>> ModbusServer::start(const ServerConf
   auto impl = std::make_unique<Impl>(c, map, gate, ch, std::move(log));
   impl->ctx = modbus_new_tcp(c.address.c_str(), c.port);
   if (!impl->ctx) return core::invalid_argument("modbus: cannot listen on " + where + ": " + modbus_strerror(errno));
-  impl->image = modbus_mapping_new_start_address(0, static_cast<unsigned>(map.end_address(Table::kCoil)), 0,
-                                                 static_cast<unsigned>(map.end_address(Table::kDiscreteInput)), 0,
-                                                 static_cast<unsigned>(map.end_address(Table::kHoldingRegister)), 0,
-                                                 static_cast<unsigned>(map.end_address(Table::kInputRegister)));
+  impl->image = new_register_image(map);  // bit tables padded to 16: the reserved bits read 0
   if (!impl->image) return core::io_error("modbus: cannot allocate the register image");
   impl->listener = modbus_tcp_listen(impl->ctx, 64);
   if (impl->listener < 0) return core::io_error("modbus: cannot listen on " + where + ": " + modbus_strerror(errno));
@@ -159,12 +161,21 @@ void ModbusServer::serve() {
         const auto total = static_cast<std::size_t>(kMbapLength + count);
         if (cl.buffer.size() < total) break;
         m.handler.set_clients(static_cast<int>(m.clients.size()));
-        const std::uint8_t exception = m.handler.handle(cl.buffer.data(), static_cast<int>(total), cl.session, now, m.image);
+        const Reply reply = m.handler.handle(cl.buffer.data(), static_cast<int>(total), cl.session, now, m.image);
         modbus_set_socket(m.ctx, cl.fd);
-        const int rc = exception ? modbus_reply_exception(m.ctx, cl.buffer.data(), exception)
-                                 : modbus_reply(m.ctx, cl.buffer.data(), static_cast<int>(total), m.image);
+        int rc = 0;
+        if (reply.exception) {
+          rc = modbus_reply_exception(m.ctx, cl.buffer.data(), reply.exception);
+        } else if (!reply.pdu.empty()) {
+          // One send, as libmodbus' own replies: an answer of at most 260 bytes that the socket
+          // cannot take whole means a client that does not read, and it is dropped.
+          const auto adu = tcp_adu(cl.buffer.data(), reply.pdu);
+          rc = ::send(cl.fd, adu.data(), adu.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(adu.size()) ? 0 : -1;
+        } else {
+          rc = modbus_reply(m.ctx, cl.buffer.data(), static_cast<int>(total), m.image);
+        }
         requests_++;
-        if (exception) exceptions_++;
+        if (reply.exception) exceptions_++;
         if (rc < 0) { drop(i, "send failed"); dropped = true; break; }
         cl.buffer.erase(cl.buffer.begin(), cl.buffer.begin() + static_cast<std::ptrdiff_t>(total));
         cl.idle_since_ns = now;

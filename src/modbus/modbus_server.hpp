@@ -1,8 +1,9 @@
 #pragma once
 // The Modbus TCP server: one thread, poll() over non-blocking sockets, our own framing per client
 // (so a client that sends one byte a second, or nothing, never blocks the others), libmodbus to
-// build every answer and exception (modbus_reply / modbus_reply_exception), and the
-// RequestHandler for what the answer says. A crowd of dead or slow connections cannot starve it:
+// build the answers and exceptions (modbus_reply / modbus_reply_exception) except the few whose
+// PDU the RequestHandler builds itself (device identification), and the RequestHandler for what
+// the answer says. A crowd of dead or slow connections cannot starve it:
 // a frame must be complete within frame_timeout_s of its first byte, a client without a request
 // for idle_timeout_s is closed, and at max_clients a new client evicts a connection that never
 // completed a request, else the one idle the longest.
@@ -11,6 +12,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "modbus/request_handler.hpp"
 
@@ -20,6 +22,7 @@ struct ServerConfig {
   std::string address = "0.0.0.0";  // IPv4 address to listen on
   int port = 502;                    // 0: any free port (see port())
   int unit_id = 1;
+  std::vector<int> alias_unit_ids = kDefaultAliasUnitIds;  // also answered as this device; others get 0B
   int max_clients = 16;
   double idle_timeout_s = 60.0;      // a client without a complete request this long is disconnected
   double frame_timeout_s = 1.0;      // a frame not complete this long after its first byte: disconnected

@@ -66,6 +66,13 @@ class RegisterMap {
   };
   Hit find(Table table, int address) const noexcept;
   int end_address(Table table) const noexcept { return static_cast<int>(index_[static_cast<int>(table)].size()); }
+  // Where reads of the table end: a bit table's end rounded up to a multiple of 16 (clients read
+  // coils and discrete inputs 8 or 16 at a time; the padding reads 0), a register table's end.
+  int readable_end(Table table) const noexcept {
+    const int end = end_address(table);
+    return is_bit_table(table) ? (end + kBitBlock - 1) / kBitBlock * kBitBlock : end;
+  }
+  static constexpr int kBitBlock = 16;
 
  private:
   std::string source_;

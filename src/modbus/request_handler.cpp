@@ -15,6 +15,7 @@ constexpr std::uint8_t kIllegalValue = MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE;     
 constexpr std::uint8_t kCannotApply = MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE;       // 04
 constexpr std::uint8_t kOtherUnit = MODBUS_EXCEPTION_GATEWAY_TARGET;                  // 0B
 constexpr int kHeader = 7;  // MBAP: transaction, protocol, length, unit
+constexpr int kDeviceIdentification = 0x2B;  // FC43, encapsulated interface transport: libmodbus does not answer it
 
 int be16(const std::uint8_t* p) { return (p[0] << 8) | p[1]; }
 
@@ -26,10 +27,10 @@ std::uint8_t* table_bits(_modbus_mapping_t* m, Table t) { return t == Table::kCo
 
 }  // namespace
 
-RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, int unit_id, points::WriteGate& gate,
+RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, std::vector<int> unit_ids, points::WriteGate& gate,
                                runtime::LoopChannels& channels, Log log)
-    : map_(map), policy_(std::move(policy)), unit_id_(unit_id), gate_(gate), channels_(channels), log_(std::move(log)),
-      unlock_(policy_.unlock_key) {}
+    : map_(map), policy_(std::move(policy)), unit_ids_(std::move(unit_ids)), identity_(appliance_identity(map.source())), gate_(gate),
+      channels_(channels), log_(std::move(log)), unlock_(policy_.unlock_key) {}
 
 points::InterfaceStatus RequestHandler::status(const Session& session, std::int64_t now_ns) const {
   const core::ChangeCounters changes = gate_.counters();
@@ -40,15 +41,24 @@ points::InterfaceStatus RequestHandler::status(const Session& session, std::int6
   return s;
 }
 
-std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, Session& session, std::int64_t now_ns,
-                                    _modbus_mapping_t* image) {
+Reply RequestHandler::handle(const std::uint8_t* req, int length, Session& session, std::int64_t now_ns,
+                            _modbus_mapping_t* image) {
+  Reply reply;
+  reply.exception = respond(req, length, session, now_ns, image, reply.pdu);
+  if (reply.exception) reply.pdu.clear();
+  return reply;
+}
+
+std::uint8_t RequestHandler::respond(const std::uint8_t* req, int length, Session& session, std::int64_t now_ns,
+                                     _modbus_mapping_t* image, std::vector<std::uint8_t>& pdu) {
   ++requests_;
   if (length < kHeader + 1) return kIllegalFunction;
   const int unit = req[6];
-  if (unit != unit_id_ && unit != 0xFF) return kOtherUnit;  // 0xFF: "the server itself" on TCP
+  if (std::find(unit_ids_.begin(), unit_ids_.end(), unit) == unit_ids_.end()) return kOtherUnit;
   const int fc = req[kHeader];
   const std::uint8_t* d = req + kHeader + 1;
   const int data_length = length - kHeader - 1;
+  if (fc == kDeviceIdentification) return read_device_identification(d, data_length, identity_, pdu);
   const runtime::Snapshot snap = gate_.snapshot();  // with this client's (and others') accepted writes
   std::vector<Write> writes;
 
@@ -113,11 +123,18 @@ std::uint8_t RequestHandler::read_into(Table t, int address, int quantity, const
   const int max = is_bit_table(t) ? MODBUS_MAX_READ_BITS : MODBUS_MAX_READ_REGISTERS;
   if (quantity < 1 || quantity > max) return kIllegalValue;
   if (address + quantity > 65536) return kIllegalAddress;
+  // Bit tables up to their end rounded up to 16, where a bit nothing is mapped to reads 0
+  // (reserved); register tables only where points are mapped.
+  if (is_bit_table(t) && address + quantity > map_.readable_end(t)) return kIllegalAddress;
   const points::InterfaceStatus server = status(session, now_ns);
   const points::PointContext ctx{snap, server};
   for (int a = address; a < address + quantity;) {
     const auto hit = map_.find(t, a);
-    if (!hit.entry) return kIllegalAddress;
+    if (!hit.entry) {
+      if (!is_bit_table(t)) return kIllegalAddress;
+      table_bits(image, t)[a++] = 0;
+      continue;
+    }
     const RegisterEntry& e = *hit.entry;
     const double value = e.point->value(ctx);
     if (is_bit_table(t)) {
@@ -193,6 +210,22 @@ std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, Sess
     if (const auto r = gate_.submit(group, who); !r.accepted()) return points::modbus_exception(r.refusal);
   if (unlock) session.unlocked_until_ns = now_ns + static_cast<std::int64_t>(policy_.unlock_timeout_s * 1e9);
   return 0;
+}
+
+_modbus_mapping_t* new_register_image(const RegisterMap& map) {
+  const auto end = [&](Table t) { return static_cast<unsigned>(map.readable_end(t)); };
+  return modbus_mapping_new_start_address(0, end(Table::kCoil), 0, end(Table::kDiscreteInput), 0, end(Table::kHoldingRegister), 0,
+                                          end(Table::kInputRegister));
+}
+
+std::vector<std::uint8_t> tcp_adu(const std::uint8_t* request, std::span<const std::uint8_t> pdu) {
+  const std::size_t count = pdu.size() + 1;  // the MBAP length counts the unit id and the PDU
+  std::vector<std::uint8_t> adu(kHeader + pdu.size());  // sized first: g++ 12 misreads an insert after a 7-byte list
+  adu[0] = request[0], adu[1] = request[1];             // the transaction id; protocol 0
+  adu[4] = static_cast<std::uint8_t>(count >> 8), adu[5] = static_cast<std::uint8_t>(count & 0xFF);
+  adu[6] = request[6];
+  std::copy(pdu.begin(), pdu.end(), adu.begin() + kHeader);
+  return adu;
 }
 
 }  // namespace epa::modbus

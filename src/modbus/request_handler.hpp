@@ -1,23 +1,31 @@
 #pragma once
-// The Modbus application layer, without sockets: one request ADU in, an exception code or a
-// filled register image out (libmodbus' modbus_reply then builds the answer). Reads encode the
-// published snapshot through the point catalog; writes are decoded (mapped, writable, whole
-// 32-bit values), the unlock key is taken here, and the rest goes to the one write gate
-// (points::WriteGate) as one group: queued for the scan cycle whole, or refused whole.
+// The Modbus application layer, without sockets: one request ADU in, a Reply out: an exception
+// code, a register image filled for libmodbus' modbus_reply to build the answer from, or a whole
+// response PDU built here for what modbus_reply does not know (FC43/14, device identification).
+// Reads encode the published snapshot through the point catalog; writes are decoded (mapped,
+// writable, whole 32-bit values), the unlock key is taken here, and the rest goes to the one
+// write gate (points::WriteGate) as one group: queued for the scan cycle whole, or refused whole.
 //
-// Exceptions: 01 unsupported function; 02 unmapped address or write to a read-only register;
-// 03 bad quantity, a value outside the limits (the catalog's, the configuration's and the map's),
-// a write that covers only part of a 32-bit value, a wrong unlock key, or tuning values that do
-// not validate together; 04 the write cannot be applied (server read-only, client not allowed to
-// write, tuning locked, wrong mode, fault latched, an unlock from an address in its back-off);
-// 06 the command queue is full (busy); 0B a
-// request for another unit id.
+// Exceptions: 01 unsupported function (or MEI type); 02 unmapped address, a write to a read-only
+// register or coil, or a device identification object this device does not have; 03 bad
+// quantity, a value outside the limits (the catalog's, the configuration's and the map's), a
+// write that covers only part of a 32-bit value, a wrong unlock key, tuning values that do not
+// validate together, or a bad device identification read code; 04 the write cannot be applied
+// (server read-only, client not allowed to write, tuning locked, wrong mode, fault latched, an
+// unlock from an address in its back-off); 06 the command queue is full (busy); 0B a request
+// for a unit id that is not this device's (unit_id, and by default 0 and 0xFF).
+//
+// Bit tables (coils, discrete inputs) read in blocks of 16, as clients poll them: every address
+// from 0 up to the table's end rounded up to a multiple of 16 is readable, an unmapped one reads
+// 0 (reserved); writing one is still 02. Register tables stay strict: an unmapped register is 02.
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "modbus/device_identification.hpp"
 #include "modbus/register_map.hpp"
 #include "modbus/unlock_guard.hpp"
 #include "points/write_gate.hpp"
@@ -41,16 +49,28 @@ struct Session {
   std::int64_t unlocked_until_ns = 0;  // the unlock is this connection's, until then or until it closes
 };
 
+// What goes back for one request.
+struct Reply {
+  std::uint8_t exception = 0;     // not 0: answer with this exception code (modbus_reply_exception)
+  std::vector<std::uint8_t> pdu;  // else, when not empty: this whole response PDU, sent as tcp_adu();
+                                  // else modbus_reply answers from the register image
+};
+
+// The unit ids a server answers as itself besides its own: 0 and 0xFF, which TCP clients and
+// gateways send to mean "the server itself" ([modbus] alias_unit_ids).
+inline const std::vector<int> kDefaultAliasUnitIds = {0, 0xFF};
+
 class RequestHandler {
  public:
   using Log = std::function<void(const std::string&)>;
-  // The map, gate and channels must outlive the handler.
-  RequestHandler(const RegisterMap& map, WritePolicy policy, int unit_id, points::WriteGate& gate,
+  // `unit_ids`: every unit id answered as this device (others get 0B). The map, gate and channels
+  // must outlive the handler.
+  RequestHandler(const RegisterMap& map, WritePolicy policy, std::vector<int> unit_ids, points::WriteGate& gate,
                  runtime::LoopChannels& channels, Log log = {});
 
-  // `req` is a whole Modbus TCP ADU (7-byte MBAP header, then the PDU). Returns 0 when `image`
-  // holds what modbus_reply needs for the answer, else the exception code to send.
-  std::uint8_t handle(const std::uint8_t* req, int length, Session& session, std::int64_t now_ns, _modbus_mapping_t* image);
+  // `req` is a whole Modbus TCP ADU (7-byte MBAP header, then the PDU); `image` is the register
+  // image of new_register_image(), which the reply's modbus_reply reads.
+  Reply handle(const std::uint8_t* req, int length, Session& session, std::int64_t now_ns, _modbus_mapping_t* image);
 
   // What the interface points read for `session` (`locked` is that connection's).
   points::InterfaceStatus status(const Session& session, std::int64_t now_ns) const;
@@ -63,6 +83,8 @@ class RequestHandler {
     double value;
     std::uint64_t key = 0;  // a key64's words
   };
+  std::uint8_t respond(const std::uint8_t* req, int length, Session& session, std::int64_t now_ns, _modbus_mapping_t* image,
+                       std::vector<std::uint8_t>& pdu);
   std::uint8_t read_into(Table table, int address, int quantity, const runtime::Snapshot& snap, const Session& session,
                          std::int64_t now_ns, _modbus_mapping_t* image);
   std::uint8_t collect_register_writes(int address, int quantity, const std::uint8_t* bytes, std::vector<Write>& out) const;
@@ -72,7 +94,8 @@ class RequestHandler {
 
   const RegisterMap& map_;
   WritePolicy policy_;
-  int unit_id_;
+  std::vector<int> unit_ids_;
+  DeviceIdentity identity_;
   points::WriteGate& gate_;
   runtime::LoopChannels& channels_;
   Log log_;
@@ -80,5 +103,14 @@ class RequestHandler {
   std::uint64_t requests_ = 0;
   int clients_ = 0;
 };
+
+// libmodbus' register image for `map`: every table from address 0 to map.readable_end(), zeroed
+// (the reserved bits of a bit table stay 0). nullptr when it cannot be allocated; free it with
+// modbus_mapping_free.
+_modbus_mapping_t* new_register_image(const RegisterMap& map);
+
+// The Modbus TCP ADU that answers `request` (an ADU) with `pdu`: the request's transaction and
+// unit id, protocol 0, the length of the unit id and the PDU.
+std::vector<std::uint8_t> tcp_adu(const std::uint8_t* request, std::span<const std::uint8_t> pdu);
 
 }  // namespace epa::modbus

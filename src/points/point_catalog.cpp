@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "core/version.hpp"
+
 namespace epa::points {
 
 namespace {
@@ -67,9 +69,9 @@ const std::vector<std::string>& coefficient_names() {
 std::vector<PointDef> build() {
   // {id, name, unit, description, access, min, max, integer, audited, read}
   std::vector<PointDef> p = {
-      {P::kVersionMajor, "version_major", "", "firmware version, major", A::kRead, 0, 0, true, true, [](const Ctx&, int) { return double(kVersionMajor); }},
-      {P::kVersionMinor, "version_minor", "", "firmware version, minor", A::kRead, 0, 0, true, true, [](const Ctx&, int) { return double(kVersionMinor); }},
-      {P::kVersionPatch, "version_patch", "", "firmware version, patch", A::kRead, 0, 0, true, true, [](const Ctx&, int) { return double(kVersionPatch); }},
+      {P::kVersionMajor, "version_major", "", "firmware version, major", A::kRead, 0, 0, true, true, [](const Ctx&, int) { return double(core::kVersionMajor); }},
+      {P::kVersionMinor, "version_minor", "", "firmware version, minor", A::kRead, 0, 0, true, true, [](const Ctx&, int) { return double(core::kVersionMinor); }},
+      {P::kVersionPatch, "version_patch", "", "firmware version, patch", A::kRead, 0, 0, true, true, [](const Ctx&, int) { return double(core::kVersionPatch); }},
       {P::kMode, "mode", "", "0 stop, 1 run, 2 manual, 4 excite: the identification experiment, from STOP only, back to STOP by itself "
                              "(3 fault: read only; leave it with reset)", A::kWrite, 0, 4, true, true,
        [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.mode)); }},

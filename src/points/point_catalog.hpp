@@ -70,6 +70,4 @@ const PointDef& point(PointId id);                 // id < kCount
 std::string_view name(PointId id);                 // the public name
 const PointDef* find_point(std::string_view name);  // nullptr when unknown
 
-inline constexpr int kVersionMajor = 0, kVersionMinor = 2, kVersionPatch = 0;
-
 }  // namespace epa::points

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "control/controller_kind.hpp"
+#include "core/version.hpp"
 #include "points/point_catalog.hpp"
 #include "runtime/mode.hpp"
 
@@ -38,6 +39,7 @@ json poly(const std::array<double, control::kMaxLawOrder + 1>& c, std::size_t n)
 std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled, const StoreStats& store) {
   const bool faulted = s.mode == runtime::Mode::kFault;
   json j = {
+      {"version", std::string(core::kVersion)},
       {"cycle", s.cycle},
       {"time_s", num(s.time_s)},
       {"Ts", num(s.Ts)},

@@ -1,23 +1,52 @@
 #include "web/prometheus.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
+#include <string_view>
 
+#include "core/version.hpp"
 #include "points/point_catalog.hpp"
 
 namespace epa::web {
 
 namespace {
 
+// Prometheus wants base units in the name (promtool check metrics refuses microseconds): the
+// catalog's unit, the name's suffix instead of it, and the factor to it.
+struct BaseUnit {
+  std::string_view catalog, suffix;
+  double scale;
+};
+constexpr BaseUnit kBaseUnits[] = {{"mm", "meters", 1e-3}, {"V", "volts", 1.0}, {"s", "seconds", 1.0}, {"us", "seconds", 1e-6}};
+
 class Writer {
  public:
-  // A point's value under its catalog name: epa_<point>, the catalog's description as help.
-  void point(points::PointId id, double value) {
+  explicit Writer(const points::PointContext& ctx) : ctx_(ctx) {}
+
+  // A point as the catalog defines it: its value, its description as help, its name with the
+  // unit in base units (position_mm -> epa_position_meters, loop_wake_p99_us ->
+  // epa_loop_wake_p99_seconds), and _total when it is a counter.
+  void point(points::PointId id, const char* type = "gauge") {
     const auto& p = points::point(id);
-    metric(("epa_" + std::string(p.name)).c_str(), "gauge", (std::string(p.description) + ".").c_str(), value);
+    std::string name(p.name);
+    double value = p.value(ctx_);
+    for (const auto& u : kBaseUnits) {
+      if (p.unit != u.catalog) continue;
+      std::string tail = "_" + std::string(u.catalog);
+      for (auto& c : tail) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (name.ends_with(tail)) name.erase(name.size() - tail.size());
+      name += "_" + std::string(u.suffix);
+      value *= u.scale;
+    }
+    if (std::string_view(type) == "counter") name += "_total";
+    std::string help(p.description);
+    help += ".";
+    metric(("epa_" + name).c_str(), type, help.c_str(), value);
   }
-  void metric(const char* name, const char* type, const char* help, double value) {
+  void metric(const char* name, const char* type, const char* help, double value, const std::string& labels = "") {
     out_ += "# HELP ";
     out_ += name;
     out_ += ' ';
@@ -28,6 +57,7 @@ class Writer {
     out_ += type;
     out_ += '\n';
     out_ += name;
+    out_ += labels;
     out_ += ' ';
     out_ += number(value);
     out_ += '\n';
@@ -39,42 +69,36 @@ class Writer {
     if (std::isnan(v)) return "NaN";
     if (std::isinf(v)) return v > 0 ? "+Inf" : "-Inf";
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%.17g", v);
+    std::snprintf(buf, sizeof buf, "%.15g", v);  // 2.485, not 2.4849999999999999
+    if (std::strtod(buf, nullptr) != v) std::snprintf(buf, sizeof buf, "%.17g", v);  // unless it loses the value
     return buf;
   }
+  const points::PointContext& ctx_;
   std::string out_;
 };
 
 }  // namespace
 
 std::string prometheus_text(const runtime::Snapshot& s, const ModbusStats& modbus, std::uint64_t web_requests) {
-  Writer w;
-  const auto d = [](std::uint64_t v) { return static_cast<double>(v); };
+  points::InterfaceStatus server;  // what the points of the Modbus interface read
+  server.requests = modbus.requests;
+  server.clients = modbus.clients;
+  const points::PointContext ctx{s, server};
+  Writer w(ctx);
   using P = points::PointId;
-  w.point(P::kPosition, s.position_mm);
-  w.point(P::kSetpoint, s.setpoint_mm);
-  w.point(P::kError, s.error_mm);
-  w.metric("epa_valve_volts", "gauge", "Valve command written to the DAQ, V.", s.valve_v);
-  w.metric("epa_sensor_volts", "gauge", "Position sensor reading, V.", s.sensor_v);
-  w.point(P::kMode, static_cast<double>(s.mode));
-  w.point(P::kFaultCode, static_cast<double>(s.fault));
-  w.point(P::kController, static_cast<double>(s.controller));
-  w.metric("epa_uptime_seconds", "gauge", "Time since the scan cycle started, s.", s.time_s);
-  w.metric("epa_loop_cycles_total", "counter", "Scan cycles run.", d(s.loop.cycles));
-  w.metric("epa_loop_overruns_total", "counter", "Scan cycles that missed their deadline.", d(s.loop.overruns));
-  w.metric("epa_loop_jitter_p99_microseconds", "gauge", "99th percentile of |period - Ts|, us.", s.loop.jitter_p99_us);
-  w.metric("epa_loop_jitter_max_microseconds", "gauge", "Largest |period - Ts|, us.", s.loop.jitter_max_us);
-  w.metric("epa_loop_wake_p99_microseconds", "gauge", "99th percentile of the wake-up latency, us.", s.loop.wake_p99_us);
-  w.metric("epa_loop_compute_p99_microseconds", "gauge", "99th percentile of the compute time, us.", s.loop.compute_p99_us);
-  w.metric("epa_faults_total", "counter", "Faults latched since start.", d(s.faults));
-  w.metric("epa_io_errors_total", "counter", "DAQ read or write failures.", d(s.io_errors));
-  w.metric("epa_moves_total", "counter", "Moves started.", d(s.moves));
-  w.metric("epa_commands_applied_total", "counter", "Commands applied by the scan cycle.", d(s.commands_applied));
-  w.metric("epa_commands_rejected_total", "counter", "Commands refused by the scan cycle.", d(s.commands_rejected));
-  w.metric("epa_modbus_requests_total", "counter", "Modbus requests served.", d(modbus.requests));
-  w.metric("epa_modbus_exceptions_total", "counter", "Modbus requests answered with an exception.", d(modbus.exceptions));
-  w.metric("epa_modbus_clients", "gauge", "Connected Modbus clients.", modbus.clients);
-  w.metric("epa_web_requests_total", "counter", "HTTP requests served.", d(web_requests));
+  w.metric("epa_build_info", "gauge", "The running epa's version (project VERSION in CMakeLists.txt), in the label; always 1.", 1.0,
+           "{version=\"" + std::string(core::kVersion) + "\"}");
+  for (const P id : {P::kPosition, P::kSetpoint, P::kError, P::kValve, P::kSensor, P::kMode, P::kFaultCode, P::kController,
+                     P::kUptime, P::kLoopJitterP99, P::kLoopWakeP50, P::kLoopWakeP99, P::kLoopWakeMax, P::kLoopComputeP99})
+    w.point(id);
+  w.metric("epa_loop_jitter_max_seconds", "gauge", "scan period jitter, maximum.", s.loop.jitter_max_us * 1e-6);
+  for (const P id : {P::kCycles, P::kLoopOverruns, P::kFaults, P::kIoErrors, P::kMoves, P::kCommandsApplied, P::kCommandsRejected,
+                     P::kModbusRequests})
+    w.point(id, "counter");
+  w.metric("epa_modbus_exceptions_total", "counter", "Modbus requests answered with an exception since start.",
+           static_cast<double>(modbus.exceptions));
+  w.point(P::kModbusClients);
+  w.metric("epa_web_requests_total", "counter", "HTTP requests served since start.", static_cast<double>(web_requests));
   return w.take();
 }
 

@@ -1,6 +1,9 @@
 #pragma once
-// GET /metrics: the snapshot in the Prometheus text exposition format (version 0.0.4), with
-// HELP and TYPE lines, for the site's monitoring to scrape.
+// GET /metrics: the snapshot in the Prometheus text exposition format (version 0.0.4), for the
+// site's monitoring to scrape, as `promtool check metrics` wants it: every metric with HELP and
+// TYPE, base units in the name (meters, volts, seconds: position_mm is epa_position_meters),
+// counters ending in _total. A point's metric takes its value and help from the catalog, so
+// /metrics, Modbus and /api/status say the same thing; epa_build_info{version="..."} names the version.
 #include <string>
 
 #include "runtime/snapshot.hpp"

@@ -33,6 +33,7 @@ TEST(ApplianceConfig, ShippedFileParsesToTheDocumentedDefaults) {
   EXPECT_EQ(c->register_map_path, std::string(EPA_SOURCE_DIR) + "/registers/epa.csv");  // next to the config
   EXPECT_TRUE(c->modbus_enabled);
   EXPECT_EQ(c->modbus.port, 502);
+  EXPECT_EQ(c->modbus.alias_unit_ids, (std::vector<int>{0, 255}));  // 0 and 0xFF also mean this device
   EXPECT_FALSE(c->modbus.policy.unlock_key.has_value());  // no default key: tuning stays locked until one is set
   EXPECT_EQ(c->store_path, "epa.db");          // the appliance's data: relative to the working directory
   EXPECT_EQ(c->sim_plant, "hammerstein");
@@ -75,6 +76,20 @@ TEST(ApplianceConfig, WrongTypeAndOutOfRangeNameTheKey) {
 TEST(ApplianceConfig, AFloatForAWholeNumberIsRefusedWhateverItsSize) {
   EXPECT_NE(error_of("[modbus]\nport = 5e22\n").find("modbus.port must be a whole number"), std::string::npos);
   EXPECT_NE(error_of("[modbus]\nport = 502.0\n").find("modbus.port must be a whole number"), std::string::npos);
+}
+
+TEST(ApplianceConfig, AliasUnitIdsAreAListOfUnitIds) {
+  auto none = parse_appliance_config("[modbus]\nunit_id = 17\nalias_unit_ids = []\n", "test.toml");
+  ASSERT_TRUE(none.has_value()) << none.error().message;
+  EXPECT_EQ(none->modbus.unit_id, 17);
+  EXPECT_TRUE(none->modbus.alias_unit_ids.empty());  // unit 17 only
+  auto ff = parse_appliance_config("[modbus]\nalias_unit_ids = [255]\n", "test.toml");
+  ASSERT_TRUE(ff.has_value()) << ff.error().message;
+  EXPECT_EQ(ff->modbus.alias_unit_ids, std::vector<int>{255});
+  EXPECT_NE(error_of("[modbus]\nalias_unit_ids = [0, 256]\n").find("modbus.alias_unit_ids must contain whole numbers within 0..255"),
+            std::string::npos);
+  EXPECT_NE(error_of("[modbus]\nalias_unit_ids = 0\n").find("modbus.alias_unit_ids must be an array"), std::string::npos);
+  EXPECT_NE(error_of("[modbus]\nalias_unit_ids = [\"0\"]\n").find("test.toml:2: modbus.alias_unit_ids"), std::string::npos);
 }
 
 TEST(ApplianceConfig, SyntaxErrorNamesTheLine) {

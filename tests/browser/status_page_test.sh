@@ -8,7 +8,10 @@
 # from <source dir>/web), waits for it by polling, then: (1) the page's DOM, after its scripts ran,
 # has trend points and shows a position; (2) a setpoint of 150 mm written over Modbus (mbpoll)
 # shows up as a position that changed by more than 50 mm; (3) screenshots at laptop (1280x900) and
-# phone (390x844) size go to <artifacts dir>. The appliance is stopped by its PID.
+# phone (390x844) size go to <artifacts dir>; (4) at 1280x800 the recent-moves table, with its rows
+# and with the widest rows it can show, fits inside its card and the card inside the window (a
+# probe script, added to a copy of the page for this test only, measures it); (5) the footer shows
+# the version `epa --version` prints. The appliance is stopped by its PID.
 set -uo pipefail
 
 if [ $# -ne 3 ]; then
@@ -42,6 +45,33 @@ browser() {
 dump_dom() { browser --virtual-time-budget=3000 --dump-dom "$url"; }
 body_attr() { grep -o "<body[^>]*>" | grep -o "$1=\"[^\"]*\"" | head -1 | cut -d'"' -f2; }
 
+# The page as shipped plus a layout probe: after the page's first polls it measures the
+# recent-moves table with its rows, then with the widest rows the page can write ("never",
+# pp-ngidz, 3-digit positions, a 5-digit move number), and writes both to <body> for --dump-dom:
+# "table right, card content right, scroll overflow, viewport width, rows" in CSS pixels.
+mkdir -p "$tmp/web"
+cp -r "$src/web/." "$tmp/web/"
+cat >"$tmp/web/layout_probe.js" <<'EOF3'
+"use strict";
+setTimeout(() => {
+  const table = document.getElementById("moves"), box = table.parentElement, card = table.closest(".card");
+  const measure = () => {
+    const t = table.getBoundingClientRect(), c = card.getBoundingClientRect(), cs = getComputedStyle(card);
+    const content_right = c.right - parseFloat(cs.paddingRight) - parseFloat(cs.borderRightWidth);
+    return [t.right, content_right, box.scrollWidth - box.clientWidth, document.documentElement.clientWidth,
+            table.tBodies[0].rows.length].map((v) => Math.round(v * 10) / 10).join(" ");
+  };
+  document.body.dataset.movesReal = measure();
+  const rows = table.tBodies[0].innerHTML;
+  const widest = "<tr><td>12345</td><td>500 → 500</td><td>pp-ngidz</td><td>never</td><td>never</td><td>123.45</td><td>999.9</td></tr>";
+  table.tBodies[0].innerHTML = widest.repeat(3);
+  document.body.dataset.movesWidest = measure();
+  table.tBodies[0].innerHTML = rows;
+}, 2500);
+EOF3
+sed -i 's|</body>|<script src="/layout_probe.js"></script>\n</body>|' "$tmp/web/index.html"
+grep -q layout_probe.js "$tmp/web/index.html" || abort "could not add the layout probe to the page's copy"
+
 # ---- start the appliance ----
 modbus_port=$(free_port)
 web_port=$(free_port)
@@ -55,7 +85,7 @@ register_map = "$src/registers/epa.csv"
 [web]
 address = "127.0.0.1"
 port = $web_port
-static_dir = "$src/web"
+static_dir = "$tmp/web"
 
 [log]
 status_interval_s = 0
@@ -129,6 +159,30 @@ browser --virtual-time-budget=3000 --window-size=390,844 --screenshot="$artifact
 for f in status_page.png status_page_phone.png; do
   if [ -s "$artifacts/$f" ]; then pass "(3) screenshot $artifacts/$f"; else fail "(3) no screenshot $artifacts/$f"; fi
 done
+
+# ---- (4) at 1280x800 the recent-moves table fits its card, the card the window ----
+dom=$(browser --virtual-time-budget=3000 --window-size=1280,800 --dump-dom "$url")
+for what in real widest; do
+  read -r table_right card_right overflow viewport rows <<<"$(body_attr "data-moves-$what" <<<"$dom")"
+  if [ -z "${rows:-}" ]; then
+    fail "(4) the layout probe wrote no data-moves-$what (did the page load?)"
+  elif [ "$what" = real ] && [ "$rows" -lt 2 ]; then
+    fail "(4) the recent-moves table shows $rows rows, expected the two moves of this test"
+  elif awk -v t="$table_right" -v c="$card_right" -v o="$overflow" -v v="$viewport" 'BEGIN { exit !(t <= c + 0.5 && o <= 0 && c <= v && v == 1280) }'; then
+    pass "(4) 1280x800, $what rows ($rows): table right edge $table_right px <= card content $card_right px <= window $viewport px, no scrolling"
+  else
+    fail "(4) 1280x800, $what rows ($rows): table right edge $table_right px, card content right $card_right px, scroll overflow $overflow px, window $viewport px: the table is cut off"
+  fi
+done
+
+# ---- (5) the footer shows the version epa --version prints ----
+version=$("$epa" --version | sed -n 's/^epa //p')
+shown=$(grep -o 'id="version">[^<]*' <<<"$dom" | sed 's/.*>//')
+if [ -n "$version" ] && [ "$shown" = "$version" ]; then
+  pass "(5) the page's footer shows version $shown, as epa --version"
+else
+  fail "(5) footer id=version: expected '$version' (epa --version), got '$shown'"
+fi
 
 kill -0 "$pid" 2>/dev/null && pass "the appliance is still running" || fail "the appliance died during the test"
 stop_appliance

@@ -8,7 +8,8 @@
 # checks: the position float (input 0-1, ABCD, read with -B) is the simulated piston's (0 mm at
 # start), a setpoint written as an ABCD float plus mode RUN moves the piston there, an unmapped
 # register is refused (exception 02) and the tuning register lc_mm is refused while locked
-# (exception 04). The appliance is stopped by its PID (SIGTERM, SIGKILL after 5 s). Exit 0: all
+# (exception 04), 16 discrete inputs read in one request, and unit id 0 is answered with the
+# version epa --version prints. The appliance is stopped by its PID (SIGTERM, SIGKILL after 5 s). Exit 0: all
 # passed; 1: a check failed (each failure says what was expected and what came back).
 set -uo pipefail
 
@@ -168,6 +169,26 @@ if near "$lc" 5 0.0001; then
   pass "(5) lc_mm still reads $lc (the refused write changed nothing)"
 else
   fail "(5) lc_mm after the refused write: expected 5, got '${lc}'"
+fi
+
+# ---- (6) 16 discrete inputs in one read; unit id 0 is this device ----
+out=$(mb -t 1 -r 0 -c 16 "$host" 2>&1)
+rc=$?
+io_ok=$(value_of 2 <<<"$out")
+last=$(value_of 15 <<<"$out")
+if [ $rc -eq 0 ] && [ "$io_ok" = "1" ] && [ -n "$last" ]; then
+  pass "(6) discrete inputs 0-15 read in one request (-t 1 -c 16): io_ok [2] = $io_ok, [15] = $last"
+else
+  fail "(6) reading discrete inputs 0-15 (-t 1 -c 16): expected success with io_ok 1, got exit $rc: $out"
+fi
+out=$(mbpoll -m tcp -a 0 -p "$port" -0 -1 -o 1 -t 3 -r 12 -c 3 "$host" 2>&1)
+rc=$?
+version="$(value_of 12 <<<"$out").$(value_of 13 <<<"$out").$(value_of 14 <<<"$out")"
+expected=$("$epa" --version | sed -n 's/^epa //p')
+if [ $rc -eq 0 ] && [ "$version" = "$expected" ]; then
+  pass "(6) unit id 0 (-a 0) answered: version registers 12-14 read $version, as epa --version"
+else
+  fail "(6) unit id 0 (-a 0), input 12-14: expected $expected (epa --version), got '$version' (exit $rc): $out"
 fi
 
 # ---- the appliance is still up and stops cleanly on SIGTERM ----

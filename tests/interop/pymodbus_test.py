@@ -9,7 +9,9 @@ PID (terminate, kill after 5 s):
     is read whole and its values checked, every writable table is written (coil reset, setpoint
     as an ABCD float through FC16, mode through FC6, heartbeat, unlock and the tuning register
     lc_mm, FC23 read/write), the writes take effect (read back; the piston moves), and each
-    refusal comes back with the exception code request_handler.hpp documents;
+    refusal comes back with the exception code request_handler.hpp documents; FC43/14 device
+    identification (basic, regular, one object) names the version `epa --version` prints, unit
+    id 0 is answered as this device, and the bit tables read in blocks of 8 and 16;
   * with registers/examples/legacy-hmi.csv: the word-swapped (CDAB) float copies at 1010-1011
     decode to the same values as the scaled int16 copies at 1000 (position x10, setpoint x10),
     written either way.
@@ -18,6 +20,8 @@ Exit 0 when every test passes, 1 otherwise (unittest prints "Ran N tests ... OK/
 """
 import math
 import os
+import re
+import subprocess
 import sys
 import time
 import unittest
@@ -25,13 +29,15 @@ import unittest
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from epa_appliance import (UNIT, UNLOCK_ADDRESS, Appliance, unlock, f32_value, f32_words, i16_value, pymodbus,  # noqa: E402
                            u32_value, u32_words)
+from pymodbus.mei_message import ReadDeviceInformationRequest  # noqa: E402
 
-VERSION = (0, 2, 0)  # src/points/point_catalog.hpp kVersionMajor/Minor/Patch
+VERSION = None  # (major, minor, patch) as `epa --version` prints it: CMakeLists.txt's project(VERSION)
 MM_PER_VOLT = 50.0   # the paper's position sensor scale (config/paper-model.toml)
 HEARTBEAT_TIMEOUT_S = 5.0  # [limits] heartbeat_timeout_s of the epa.csv appliance: generous, so a test
 # process starved for a moment on a loaded CI machine does not lapse it by accident
 
 ILLEGAL_ADDRESS, ILLEGAL_VALUE, CANNOT_APPLY, OTHER_UNIT = 0x02, 0x03, 0x04, 0x0B
+BASIC, REGULAR, EXTENDED, SPECIFIC = 0x01, 0x02, 0x03, 0x04  # FC43/14 read device id codes
 
 EPA = None  # the binary and the source dir, from the command line
 SRC = None
@@ -84,6 +90,20 @@ class ApplianceTest(unittest.TestCase):
         rr = self.ok(read(address, count, slave=UNIT), what)
         self.assertEqual(len(rr.registers), count, f"{what}: register count")
         return rr.registers
+
+    def device_information(self, read_code, object_id=0x00, unit=UNIT):
+        """FC43/14: pymodbus 3.0's ReadDeviceInformationRequest (its sync client has no helper for it)."""
+        return self.c.execute(ReadDeviceInformationRequest(read_code=read_code, object_id=object_id, unit=unit))
+
+    def bit_table_ends(self, table):
+        """A bit table of this map: (its last address + 1, where reads end: that rounded up to 16)."""
+        end = 0
+        with open(os.path.join(SRC, self.REGISTER_MAP)) as f:
+            for line in f:
+                fields = line.strip().split(",")
+                if len(fields) > 2 and fields[1] == table:
+                    end = max(end, int(fields[2]) + 1)
+        return end, (end + 15) // 16 * 16
 
     def wait_until(self, predicate, timeout_s, what, every_s=0.1, tick=None, times=1):
         """Polls `predicate()` (returns (done, value)) until done `times` polls in a row, at most timeout_s."""
@@ -196,8 +216,12 @@ class EpaMapTest(ApplianceTest):
         self.refused(c.read_holding_registers(15, 1, slave=UNIT), ILLEGAL_ADDRESS, "read unmapped holding 15")
         self.refused(c.read_input_registers(200, 1, slave=UNIT), ILLEGAL_ADDRESS, "read unmapped input 200")
         self.refused(c.read_input_registers(10, 3, slave=UNIT), ILLEGAL_ADDRESS, "read input 10-12 across the hole at 11")
-        self.refused(c.read_coils(1, 1, slave=UNIT), ILLEGAL_ADDRESS, "read unmapped coil 1")
-        self.refused(c.read_discrete_inputs(5, 1, slave=UNIT), ILLEGAL_ADDRESS, "read unmapped discrete input 5")
+        coils_end, inputs_end = self.bit_table_ends("coil")[1], self.bit_table_ends("discrete")[1]
+        self.refused(c.read_coils(coils_end, 1, slave=UNIT), ILLEGAL_ADDRESS, f"read coil {coils_end}, past the padding")
+        self.refused(c.read_discrete_inputs(inputs_end, 1, slave=UNIT), ILLEGAL_ADDRESS,
+                     f"read discrete input {inputs_end}, past the padding")
+        self.refused(c.read_discrete_inputs(inputs_end - 8, 16, slave=UNIT), ILLEGAL_ADDRESS,
+                     f"read discrete inputs {inputs_end - 8}-{inputs_end + 7}, across the padding's end")
         self.refused(c.write_register(15, 1, slave=UNIT), ILLEGAL_ADDRESS, "write unmapped holding 15")
         self.refused(c.write_coil(1, True, slave=UNIT), ILLEGAL_ADDRESS, "write unmapped coil 1")
         self.refused(c.write_register(0, 0x42F0, slave=UNIT), ILLEGAL_VALUE, "FC6 on holding 0: half of setpoint_mm")
@@ -211,6 +235,9 @@ class EpaMapTest(ApplianceTest):
         self.refused(c.write_register(9, 1234, slave=UNIT), ILLEGAL_VALUE, "unlock with a wrong key")
         self.refused(c.read_holding_registers(0, 2, slave=7), OTHER_UNIT, "read for unit 7")
         self.refused(c.write_register(2, 1, slave=7), OTHER_UNIT, "write for unit 7")
+        self.refused(self.device_information(BASIC, unit=7), OTHER_UNIT, "FC43 for unit 7")
+        self.refused(self.device_information(SPECIFIC, 0x07), ILLEGAL_ADDRESS, "FC43 read code 04, object 7 (none)")
+        self.refused(self.device_information(0x05), ILLEGAL_VALUE, "FC43 read code 05")
         # Nothing refused took effect.
         h = self.regs(3, 0, 4)
         self.assertEqual((f32_value(h[0:2], "ABCD"), h[2]), (0.0, 0), "setpoint and mode unchanged")
@@ -286,6 +313,53 @@ class EpaMapTest(ApplianceTest):
         self.ok(c.write_coils(0, [True], slave=UNIT), "FC15 coil reset")
 
 
+    def test_6_device_identification(self):
+        version = ".".join(str(v) for v in VERSION).encode()
+        basic = self.ok(self.device_information(BASIC), "FC43/14 read code 01 (basic)")
+        print(f"\n  FC43 basic: read code {basic.read_code:#04x}, conformity {basic.conformity:#04x}, "
+              f"more follows {basic.more_follows:#04x}, objects {basic.information}", file=sys.stderr)
+        self.assertEqual(basic.information, {0x00: b"EPA project", 0x01: b"epa", 0x02: version},
+                         "VendorName, ProductCode, MajorMinorRevision = epa --version's")
+        self.assertEqual((basic.read_code, basic.conformity, basic.more_follows, basic.next_object_id), (BASIC, 0x82, 0, 0))
+        regular = self.ok(self.device_information(REGULAR), "FC43/14 read code 02 (regular)")
+        print(f"  FC43 regular: conformity {regular.conformity:#04x}, objects {regular.information}", file=sys.stderr)
+        self.assertEqual(regular.information, {
+            0x00: b"EPA project", 0x01: b"epa", 0x02: version, 0x03: b"http://<appliance>:8080/",
+            0x04: b"EPA electro-pneumatic axis controller", 0x05: b"epa appliance", 0x06: b"epa.csv"})
+        self.assertEqual((regular.conformity, regular.more_follows, regular.number_of_objects), (0x82, 0, 7))
+        extended = self.ok(self.device_information(EXTENDED), "FC43/14 read code 03: answered at the regular level")
+        self.assertEqual(extended.information, regular.information, "no extended objects")
+        one = self.ok(self.device_information(SPECIFIC, 0x02), "FC43/14 read code 04, object 2")
+        self.assertEqual((one.information, one.number_of_objects, one.more_follows), ({0x02: version}, 1, 0))
+        self.ok(self.device_information(BASIC, unit=0), "FC43/14 for unit 0")
+
+    def test_7_unit_id_0_and_bit_blocks(self):
+        c = self.c
+        # Unit id 0 (and 0xFF) is this device on TCP: reads and writes answered as for unit 1.
+        self.assertEqual(tuple(self.ok(c.read_input_registers(12, 3, slave=0), "FC4 for unit 0").registers), VERSION,
+                         "version_major/minor/patch read for unit 0")
+        self.assertEqual(tuple(self.ok(c.read_input_registers(12, 3, slave=0xFF), "FC4 for unit 0xFF").registers), VERSION)
+        self.ok(c.write_register(2, 0, slave=0), "FC6 mode 0 (stop) for unit 0")
+        # Bit tables read in blocks of 8 and 16: what lies past the map's bits reads 0 (reserved).
+        inputs_end, inputs_padded = self.bit_table_ends("discrete")
+        inputs = self.ok(c.read_discrete_inputs(0, 16, slave=UNIT), "16 discrete inputs from 0").bits
+        self.assertEqual(len(inputs), 16)
+        self.assertEqual(inputs[:3], [False, False, True], "fault_active, saturated, io_ok in STOP")
+        self.assertEqual(inputs[inputs_end:16], [False] * (16 - min(inputs_end, 16)), f"reserved from {inputs_end}")
+        self.assertEqual(self.ok(c.read_discrete_inputs(0, 8, slave=UNIT), "8 discrete inputs").bits[:3], inputs[:3])
+        last = self.ok(c.read_discrete_inputs(inputs_padded - 16, 16, slave=UNIT),
+                       f"discrete inputs {inputs_padded - 16}-{inputs_padded - 1}, the last block").bits
+        self.assertEqual(len(last), 16)
+        coils_end, coils_padded = self.bit_table_ends("coil")
+        coils = self.ok(c.read_coils(0, 16, slave=UNIT), "16 coils from 0").bits
+        self.assertEqual(coils[0], False, "reset reads 0")
+        self.assertEqual(coils[coils_end:16], [False] * (16 - min(coils_end, 16)), f"reserved from {coils_end}")
+        self.ok(c.read_coils(0, 8, slave=UNIT), "8 coils from 0")
+        if coils_end < coils_padded:
+            self.refused(c.write_coil(coils_padded - 1, True, slave=UNIT), ILLEGAL_ADDRESS,
+                         f"write reserved coil {coils_padded - 1}: readable, never writable")
+
+
 # ---- registers/examples/legacy-hmi.csv: CDAB floats against scaled int16 copies ----
 class LegacyHmiMapTest(ApplianceTest):
     REGISTER_MAP = "registers/examples/legacy-hmi.csv"
@@ -338,6 +412,9 @@ class LegacyHmiMapTest(ApplianceTest):
         self.refused(c.read_holding_registers(0, 2, slave=UNIT), ILLEGAL_ADDRESS, "read holding 0 (epa.csv's setpoint)")
         self.refused(c.read_input_registers(1004, 1, slave=UNIT), ILLEGAL_ADDRESS, "read unmapped input 1004")
         self.refused(c.read_input_registers(1000, 12, slave=UNIT), ILLEGAL_ADDRESS, "read input 1000-1011 across the hole")
+        # Device identification names this map as the user application.
+        app = self.ok(c.execute(ReadDeviceInformationRequest(read_code=0x04, object_id=0x06, unit=UNIT)), "FC43 object 6")
+        self.assertEqual(app.information, {0x06: b"legacy-hmi.csv"}, "UserApplicationName: the map's file name")
 
     def test_2_exceptions(self):
         c = self.c
@@ -380,13 +457,23 @@ class LegacyHmiMapTest(ApplianceTest):
             self.ok(c.write_register(1001, 0, slave=UNIT), "mode 0 (stop)")
 
 
+def epa_version(epa):
+    """The version `epa --version` prints ("epa 0.3.0") as a tuple of three numbers."""
+    out = subprocess.run([epa, "--version"], capture_output=True, text=True, timeout=10).stdout.strip()
+    match = re.fullmatch(r"epa (\d+)\.(\d+)\.(\d+)", out)
+    if not match:
+        sys.exit(f"FAIL: `{epa} --version` printed {out!r}, expected 'epa MAJOR.MINOR.PATCH'")
+    return tuple(int(g) for g in match.groups())
+
+
 def main():
-    global EPA, SRC
+    global EPA, SRC, VERSION
     if len(sys.argv) != 3:
         sys.exit(f"usage: {sys.argv[0]} <epa binary> <source dir>")
     EPA, SRC = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     if not os.access(EPA, os.X_OK):
         sys.exit(f"FAIL: {EPA} is not an executable")
+    VERSION = epa_version(EPA)
     print(f"pymodbus {pymodbus.__version__} ({os.path.dirname(pymodbus.__file__)}), python {sys.version.split()[0]}",
           file=sys.stderr)
     suite = unittest.TestSuite()

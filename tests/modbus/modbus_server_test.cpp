@@ -11,10 +11,14 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <string>
+#include <vector>
 #include <thread>
 
 #include "control/paper_controller.hpp"
+#include "core/version.hpp"
 #include "core/word_order.hpp"
 
 namespace epa::modbus {
@@ -131,7 +135,7 @@ TEST_F(Server, EveryExceptionPath) {
   std::uint16_t lc[2] = {lc_words[0], lc_words[1]};
   EXPECT_EQ(modbus_write_registers(c, 28, 2, lc), -1);
   EXPECT_EQ(errno, EMBXSFAIL);  // 04 tuning locked
-  const std::uint8_t raw_function[] = {0x01, 0x2B, 0x0E, 0x01, 0x00};  // unit 1, then the PDU
+  const std::uint8_t raw_function[] = {0x01, 0x2B, 0x0D, 0x00, 0x00};  // unit 1, then FC43 with MEI 0x0D (CANopen)
   ASSERT_GT(modbus_send_raw_request(c, const_cast<std::uint8_t*>(raw_function), sizeof raw_function), 0);
   std::uint8_t rsp[MODBUS_TCP_MAX_ADU_LENGTH];
   EXPECT_EQ(modbus_receive_confirmation(c, rsp), 9);
@@ -160,6 +164,89 @@ TEST_F(Server, OtherUnitIdGetsGatewayException) {
   std::uint16_t r[2];
   EXPECT_EQ(modbus_read_input_registers(c, 0, 2, r), -1);
   EXPECT_EQ(errno, EMBXGTAR);
+}
+
+TEST_F(Server, UnitsZeroAndFFAreThisDeviceByDefault) {
+  std::uint16_t r[2];
+  EXPECT_EQ(modbus_read_input_registers(client(0), 0, 2, r), 2);
+  EXPECT_EQ(core::decode_f32({r[0], r[1]}, core::WordOrder::kABCD), 123.5f);
+  EXPECT_EQ(modbus_read_input_registers(client(0xFF), 0, 2, r), 2);
+}
+
+TEST_F(Server, WithoutAliasesUnitZeroGetsGatewayException) {
+  server_->stop();
+  ServerConfig c;
+  c.alias_unit_ids = {};
+  start(c);
+  std::uint16_t r[2];
+  EXPECT_EQ(modbus_read_input_registers(client(0), 0, 2, r), -1);
+  EXPECT_EQ(errno, EMBXGTAR);
+  EXPECT_EQ(modbus_read_input_registers(client(1), 0, 2, r), 2);
+}
+
+TEST_F(Server, BitTablesReadInBlocksOf16) {
+  modbus_t* c = client();
+  std::uint8_t bits[32];
+  std::fill(std::begin(bits), std::end(bits), 7);
+  ASSERT_EQ(modbus_read_input_bits(c, 0, 16, bits), 16) << modbus_strerror(errno);
+  EXPECT_EQ(bits[1], 1);  // saturated
+  const int inputs_end = map_->end_address(Table::kDiscreteInput);
+  for (int a = inputs_end; a < 16; ++a) EXPECT_EQ(bits[a], 0) << "reserved discrete input " << a;
+  ASSERT_EQ(modbus_read_input_bits(c, 0, 8, bits), 8);
+  std::fill(std::begin(bits), std::end(bits), 7);
+  ASSERT_EQ(modbus_read_bits(c, 0, 16, bits), 16) << modbus_strerror(errno);
+  for (int a = 0; a < 16; ++a) EXPECT_EQ(bits[a], 0) << "coil " << a;  // reset reads 0, the rest is reserved
+  EXPECT_EQ(modbus_read_input_bits(c, map_->readable_end(Table::kDiscreteInput), 1, bits), -1);
+  EXPECT_EQ(errno, EMBXILADD);
+  EXPECT_EQ(modbus_read_bits(c, map_->readable_end(Table::kCoil) - 8, 16, bits), -1);
+  EXPECT_EQ(errno, EMBXILADD);
+  EXPECT_EQ(modbus_write_bit(c, 15, 1), -1);  // reserved: readable, never writable
+  EXPECT_EQ(errno, EMBXILADD);
+  EXPECT_EQ(drained(), 0);
+}
+
+// Reads one Modbus TCP answer from a raw socket: the MBAP header, then as many bytes as it says.
+std::vector<std::uint8_t> read_adu(int fd) {
+  timeval tv{2, 0};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  std::vector<std::uint8_t> adu(7);
+  if (recv(fd, adu.data(), 7, MSG_WAITALL) != 7) return {};
+  const int count = (adu[4] << 8) | adu[5];
+  adu.resize(static_cast<std::size_t>(6 + count));
+  if (count < 1 || recv(fd, adu.data() + 7, static_cast<std::size_t>(count - 1), MSG_WAITALL) != count - 1) return {};
+  return adu;
+}
+
+TEST_F(Server, DeviceIdentificationIsAnsweredBehindTheRequestsMbapHeader) {
+  const int fd = raw_socket();
+  // Two requests in one segment, for unit 0: the regular stream, then object 2 alone.
+  const std::uint8_t requests[] = {0x12, 0x34, 0x00, 0x00, 0x00, 0x05, 0x00, 0x2B, 0x0E, 0x02, 0x00,
+                                   0x12, 0x35, 0x00, 0x00, 0x00, 0x05, 0x00, 0x2B, 0x0E, 0x04, 0x02};
+  ASSERT_EQ(send(fd, requests, sizeof requests, 0), static_cast<ssize_t>(sizeof requests));
+  const auto stream = read_adu(fd);
+  ASSERT_GE(stream.size(), 14u);
+  EXPECT_EQ(std::vector<std::uint8_t>(stream.begin(), stream.begin() + 4), (std::vector<std::uint8_t>{0x12, 0x34, 0x00, 0x00}));
+  EXPECT_EQ(stream[6], 0x00);  // the request's unit id
+  EXPECT_EQ(std::vector<std::uint8_t>(stream.begin() + 7, stream.begin() + 14),
+            (std::vector<std::uint8_t>{0x2B, 0x0E, 0x02, 0x82, 0x00, 0x00, 0x07}));
+  EXPECT_LE(stream.size() - 7, 253u);
+  const std::string answer(stream.begin() + 14, stream.end());
+  for (const std::string_view value : {std::string_view("EPA project"), std::string_view("EPA electro-pneumatic axis controller"), std::string_view("epa.csv"), core::kVersion})
+    EXPECT_NE(answer.find(value), std::string::npos) << value;
+  const auto one = read_adu(fd);
+  const std::string version(core::kVersion);
+  std::vector<std::uint8_t> expected = {0x12, 0x35, 0x00, 0x00, 0x00, static_cast<std::uint8_t>(1 + 7 + 2 + version.size()), 0x00,
+                                        0x2B, 0x0E, 0x04, 0x82, 0x00, 0x00, 0x01, 0x02, static_cast<std::uint8_t>(version.size())};
+  expected.insert(expected.end(), version.begin(), version.end());
+  EXPECT_EQ(one, expected);
+  // An object it does not have, asked for alone: exception 02, by libmodbus as every other.
+  const std::uint8_t missing[] = {0x12, 0x36, 0x00, 0x00, 0x00, 0x05, 0x01, 0x2B, 0x0E, 0x04, 0x07};
+  ASSERT_EQ(send(fd, missing, sizeof missing, 0), static_cast<ssize_t>(sizeof missing));
+  EXPECT_EQ(read_adu(fd), (std::vector<std::uint8_t>{0x12, 0x36, 0x00, 0x00, 0x00, 0x03, 0x01, 0xAB, 0x02}));
+  // The server counts after it sent the answer: wait for it, bounded.
+  for (const auto until = Clock::now() + 1s; server_->exceptions() < 1 && Clock::now() < until;) std::this_thread::sleep_for(1ms);
+  EXPECT_EQ(server_->requests(), 3u);
+  EXPECT_EQ(server_->exceptions(), 1u);
 }
 
 TEST_F(Server, ANewClientOverTheCapEvictsTheOneIdleTheLongest) {

@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 #include <modbus.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
 #include "control/paper_controller.hpp"
+#include "core/version.hpp"
 
 namespace epa::modbus {
 namespace {
@@ -39,8 +41,10 @@ struct RecordingSink final : core::AuditSink {
 class Handler : public ::testing::Test {
  protected:
   void SetUp() override { make(WritePolicy{.read_only = false, .unlock_key = kKey, .unlock_timeout_s = 10, .write_clients = {}}); }
-  void make(WritePolicy policy) {
-    auto m = RegisterMap::load(std::string(EPA_SOURCE_DIR) + "/registers/epa.csv");
+  // With `map_text`, that map (named test-map.csv) instead of registers/epa.csv.
+  void make(WritePolicy policy, std::vector<int> unit_ids = {1, 0, 0xFF}, const std::string& map_text = "") {
+    auto m = map_text.empty() ? RegisterMap::load(std::string(EPA_SOURCE_DIR) + "/registers/epa.csv")
+                              : RegisterMap::parse(map_text, "/etc/epa/registers/test-map.csv");
     ASSERT_TRUE(m.has_value()) << m.error().message;
     map_ = std::make_unique<RegisterMap>(std::move(*m));
     auto limits = points::WriteLimits::from_config(loop_, "test.toml");
@@ -49,19 +53,23 @@ class Handler : public ::testing::Test {
     gate_ = std::make_unique<points::WriteGate>(std::move(*limits), loop_,
                                                 control::paper_controller_config(control::ControllerKind::kPpFfidz), channels_,
                                                 &sink_);
-    handler_ = std::make_unique<RequestHandler>(*map_, std::move(policy), 1, *gate_, channels_,
+    handler_ = std::make_unique<RequestHandler>(*map_, std::move(policy), std::move(unit_ids), *gate_, channels_,
                                                 [this](const std::string& line) { log_.push_back(line); });
     if (image_) modbus_mapping_free(image_);
-    image_ = modbus_mapping_new_start_address(0, map_->end_address(Table::kCoil), 0, map_->end_address(Table::kDiscreteInput), 0,
-                                              map_->end_address(Table::kHoldingRegister), 0, map_->end_address(Table::kInputRegister));
+    image_ = new_register_image(*map_);
+    ASSERT_NE(image_, nullptr);
     publish();
   }
   void TearDown() override { modbus_mapping_free(image_); }
   void publish() { channels_.snapshot.publish(snap_); }
-  std::uint8_t send(const Bytes& pdu, std::uint8_t unit = 1, const std::string& client = "127.0.0.1", std::int64_t now = 0) {
+  Reply reply(const Bytes& pdu, std::uint8_t unit = 1, const std::string& client = "127.0.0.1", std::int64_t now = 0) {
     const Bytes a = adu(pdu, unit);
     Session& session = sessions_.try_emplace(client, Session{client, client + ":50000", 0}).first->second;
     return handler_->handle(a.data(), static_cast<int>(a.size()), session, now, image_);
+  }
+  // The exception code, 0 for a normal answer.
+  std::uint8_t send(const Bytes& pdu, std::uint8_t unit = 1, const std::string& client = "127.0.0.1", std::int64_t now = 0) {
+    return reply(pdu, unit, client, now).exception;
   }
   // FC16 of a key64 to `unlock` (holding 9-12), most significant word first.
   static Bytes unlock_pdu(std::uint64_t key) {
@@ -107,13 +115,29 @@ TEST_F(Handler, ReadExceptions) {
   EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x0C}), 0x02);  // input 0..11: 11 is a gap
   EXPECT_EQ(send({0x03, 0x00, 0x00, 0x00, 0x00}), 0x03);  // quantity 0
   EXPECT_EQ(send({0x03, 0x00, 0x00, 0x00, 0x7E}), 0x03);  // quantity 126 > 125
-  EXPECT_EQ(send({0x2B, 0x0E, 0x01, 0x00}), 0x01);        // device identification: not supported
+  EXPECT_EQ(send({0x2B, 0x0D, 0x00, 0x00}), 0x01);        // FC43 with MEI 0x0D (CANopen): not supported
   EXPECT_EQ(send({0x08, 0x00, 0x00, 0x12, 0x34}), 0x01);  // diagnostics: not supported
 }
 
 TEST_F(Handler, UnitIdIsChecked) {
   EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x02}, 7), 0x0B);
   EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x02}, 0xFF), 0);
+}
+
+// The server's default: unit_id, 0 and 0xFF are this device; writes too, not only reads.
+TEST_F(Handler, UnitsZeroAndFFAreThisDeviceByDefaultAndAnotherIs0B) {
+  EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x02}, 0), 0);
+  EXPECT_EQ(image_->tab_input_registers[0], 0x42F7);  // 123.5f: really read
+  EXPECT_EQ(send({0x06, 0x00, 0x02, 0x00, 0x00}, 0), 0);  // mode stop, for unit 0
+  EXPECT_EQ(drain().size(), 1u);
+  for (const int other : {2, 7, 247, 248, 0xFE}) EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x02}, static_cast<std::uint8_t>(other)), 0x0B) << other;
+  EXPECT_EQ(send({0x2B, 0x0E, 0x01, 0x00}, 9), 0x0B);  // device identification of another unit
+}
+
+TEST_F(Handler, WithoutAliasesOnlyTheUnitIdIsThisDevice) {
+  make(WritePolicy{}, {17});  // [modbus] unit_id = 17, alias_unit_ids = []
+  EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x02}, 17), 0);
+  for (const int other : {0, 1, 0xFF}) EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x02}, static_cast<std::uint8_t>(other)), 0x0B) << other;
 }
 
 TEST_F(Handler, SetpointWriteQueuesOneCommandAndIsAudited) {
@@ -210,6 +234,216 @@ TEST_F(Handler, WriteToAnUnmappedRegisterIs02) {
   EXPECT_EQ(send({0x06, 0x00, 0x10, 0x00, 0x01}), 0x02);  // holding 16: not mapped
 }
 
+// ---- bit tables in blocks of 16 ----
+
+// A read of `quantity` bits (FC1 or FC2) from `address`.
+Bytes read_bits(std::uint8_t fc, int address, int quantity) {
+  return {fc, static_cast<std::uint8_t>(address >> 8), static_cast<std::uint8_t>(address), static_cast<std::uint8_t>(quantity >> 8),
+          static_cast<std::uint8_t>(quantity)};
+}
+
+TEST_F(Handler, TheShippedMapsBitTablesReadInBlocksOf16) {
+  for (const Table t : {Table::kDiscreteInput, Table::kCoil}) {
+    const std::uint8_t fc = t == Table::kCoil ? 0x01 : 0x02;
+    const int end = map_->end_address(t), padded = map_->readable_end(t);
+    SCOPED_TRACE(std::string(to_string(t)) + ": end " + std::to_string(end) + ", readable to " + std::to_string(padded));
+    EXPECT_EQ(padded % 16, 0);
+    EXPECT_GE(padded, end);
+    EXPECT_LT(padded - end, 16);
+    EXPECT_EQ(send(read_bits(fc, 0, 8)), 0);  // what the integrator's client asked for
+    EXPECT_EQ(send(read_bits(fc, 0, 16)), 0);
+    EXPECT_EQ(send(read_bits(fc, 0, padded)), 0);
+    EXPECT_EQ(send(read_bits(fc, padded - 1, 1)), 0);
+    EXPECT_EQ(send(read_bits(fc, padded, 1)), 0x02);      // past the padding
+    EXPECT_EQ(send(read_bits(fc, padded - 8, 16)), 0x02);  // runs past it
+  }
+  // The registers stay strict: a hole is 02.
+  EXPECT_EQ(send({0x04, 0x00, 0x0B, 0x00, 0x01}), 0x02);  // input 11
+  EXPECT_EQ(send({0x03, 0x00, 0x0F, 0x00, 0x01}), 0x02);  // holding 15
+}
+
+TEST_F(Handler, UnmappedBitsReadZeroAndStayUnwritable) {
+  // Coils 0 (reset) and 17 (reset again, as a site's HMI may want it twice), discrete input 3
+  // (fault_active), a register with a hole after it.
+  make(WritePolicy{}, {1, 0, 0xFF},
+       "name,table,address,type,access\n"
+       "reset,coil,0,bool,rw\nreset,coil,17,bool,rw\nfault_active,discrete,3,bool,r\nmode,holding,0,uint16,rw\nfault_code,input,1,uint16,r\n");
+  EXPECT_EQ(map_->readable_end(Table::kCoil), 32);
+  EXPECT_EQ(map_->readable_end(Table::kDiscreteInput), 16);
+  EXPECT_EQ(map_->readable_end(Table::kHoldingRegister), 1);
+  snap_.mode = runtime::Mode::kFault;  // fault_active reads 1
+  publish();
+  std::fill(image_->tab_input_bits, image_->tab_input_bits + 16, 1);  // whatever was there: the answer is the map's
+  std::fill(image_->tab_bits, image_->tab_bits + 32, 1);
+  ASSERT_EQ(send(read_bits(0x02, 0, 16)), 0);
+  for (int a = 0; a < 16; ++a) EXPECT_EQ(image_->tab_input_bits[a], a == 3 ? 1 : 0) << "discrete input " << a;
+  ASSERT_EQ(send(read_bits(0x01, 0, 32)), 0);
+  for (int a = 0; a < 32; ++a) EXPECT_EQ(image_->tab_bits[a], 0) << "coil " << a;  // reset reads 0, the rest is reserved
+  EXPECT_EQ(send(read_bits(0x01, 32, 1)), 0x02);
+  EXPECT_EQ(send(read_bits(0x02, 16, 1)), 0x02);
+  // Writes to a reserved coil stay refused, alone or in a block with mapped ones.
+  EXPECT_EQ(send({0x05, 0x00, 0x05, 0xFF, 0x00}), 0x02);                    // FC5 coil 5
+  EXPECT_EQ(send({0x0F, 0x00, 0x00, 0x00, 0x02, 0x01, 0x03}), 0x02);        // FC15 coils 0-1
+  EXPECT_EQ(send({0x0F, 0x00, 0x10, 0x00, 0x02, 0x01, 0x03}), 0x02);        // FC15 coils 16-17
+  EXPECT_TRUE(drain().empty());
+  EXPECT_EQ(send({0x05, 0x00, 0x11, 0xFF, 0x00}), 0);                       // coil 17: mapped
+  EXPECT_EQ(drain().size(), 1u);
+  // Register tables are not padded: holding 1, input 0 and 2 are 02.
+  EXPECT_EQ(send({0x03, 0x00, 0x00, 0x00, 0x02}), 0x02);
+  EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x01}), 0x02);
+  EXPECT_EQ(send({0x04, 0x00, 0x01, 0x00, 0x02}), 0x02);
+}
+
+TEST_F(Handler, AMapWithoutBitsHasNoBitsToRead) {
+  make(WritePolicy{}, {1, 0, 0xFF}, "name,table,address,type\nposition_mm,input,1000,float32\n");
+  EXPECT_EQ(map_->readable_end(Table::kCoil), 0);
+  EXPECT_EQ(send(read_bits(0x01, 0, 1)), 0x02);
+  EXPECT_EQ(send(read_bits(0x02, 0, 16)), 0x02);
+}
+
+// ---- FC43 / MEI 14: read device identification ----
+
+struct DeviceId {
+  std::uint8_t read_code = 0, conformity = 0, more_follows = 0, next_object = 0;
+  std::vector<std::pair<int, std::string>> objects;
+};
+
+// Decodes a response PDU, checking that the object count and lengths add up to its size.
+DeviceId decode_device_id(const Bytes& pdu) {
+  DeviceId d;
+  EXPECT_GE(pdu.size(), 7u);
+  EXPECT_LE(pdu.size(), 253u);
+  if (pdu.size() < 7) return d;
+  EXPECT_EQ(pdu[0], 0x2B);
+  EXPECT_EQ(pdu[1], 0x0E);
+  d = {pdu[2], pdu[3], pdu[4], pdu[5], {}};
+  std::size_t i = 7;
+  for (int n = 0; n < pdu[6]; ++n) {
+    if (i + 2 > pdu.size() || i + 2 + pdu[i + 1] > pdu.size()) {
+      ADD_FAILURE() << "object " << n << " runs past the PDU";
+      return d;
+    }
+    d.objects.emplace_back(pdu[i], std::string(pdu.begin() + static_cast<std::ptrdiff_t>(i + 2),
+                                               pdu.begin() + static_cast<std::ptrdiff_t>(i + 2 + pdu[i + 1])));
+    i += 2 + pdu[i + 1];
+  }
+  EXPECT_EQ(i, pdu.size()) << "bytes after the last object";
+  return d;
+}
+
+const std::vector<std::pair<int, std::string>> kRegularObjects = {
+    {0x00, "EPA project"}, {0x01, "epa"}, {0x02, std::string(core::kVersion)}, {0x03, "http://<appliance>:8080/"},
+    {0x04, "EPA electro-pneumatic axis controller"}, {0x05, "epa appliance"}, {0x06, "epa.csv"}};
+
+TEST_F(Handler, DeviceIdentificationBasicIsVendorProductAndRevision) {
+  const Reply r = reply({0x2B, 0x0E, 0x01, 0x00});
+  ASSERT_EQ(r.exception, 0);
+  // By hand: function, MEI, read code 01, conformity 0x82, no more, next 0, 3 objects.
+  const Bytes head = {0x2B, 0x0E, 0x01, 0x82, 0x00, 0x00, 0x03, 0x00, 0x0B, 'E', 'P', 'A', ' ', 'p', 'r', 'o', 'j', 'e', 'c', 't',
+                      0x01, 0x03, 'e', 'p', 'a', 0x02, static_cast<std::uint8_t>(core::kVersion.size())};
+  ASSERT_GE(r.pdu.size(), head.size());
+  EXPECT_EQ(Bytes(r.pdu.begin(), r.pdu.begin() + static_cast<std::ptrdiff_t>(head.size())), head);
+  const DeviceId d = decode_device_id(r.pdu);
+  EXPECT_EQ(d.objects, (std::vector<std::pair<int, std::string>>(kRegularObjects.begin(), kRegularObjects.begin() + 3)));
+  EXPECT_EQ(d.objects[2].second, std::to_string(core::kVersionMajor) + "." + std::to_string(core::kVersionMinor) + "." +
+                                     std::to_string(core::kVersionPatch));
+}
+
+TEST_F(Handler, DeviceIdentificationRegularAndExtendedGiveTheSevenObjects) {
+  for (const std::uint8_t code : {0x02, 0x03}) {
+    const Reply r = reply({0x2B, 0x0E, code, 0x00});
+    ASSERT_EQ(r.exception, 0) << int(code);
+    const DeviceId d = decode_device_id(r.pdu);
+    EXPECT_EQ(d.read_code, code);       // the request's, echoed
+    EXPECT_EQ(d.conformity, 0x82);      // regular, stream and individual access: no extended objects
+    EXPECT_EQ(d.more_follows, 0x00);
+    EXPECT_EQ(d.next_object, 0x00);
+    EXPECT_EQ(d.objects, kRegularObjects);
+  }
+  // A stream from object 4; a basic stream asked from a regular object starts again at 0.
+  EXPECT_EQ(decode_device_id(reply({0x2B, 0x0E, 0x02, 0x04}).pdu).objects,
+            (std::vector<std::pair<int, std::string>>(kRegularObjects.begin() + 4, kRegularObjects.end())));
+  EXPECT_EQ(decode_device_id(reply({0x2B, 0x0E, 0x01, 0x05}).pdu).objects.size(), 3u);
+  EXPECT_EQ(decode_device_id(reply({0x2B, 0x0E, 0x02, 0x80}).pdu).objects, kRegularObjects);  // unknown id: from the start
+  // Unit 0 and 0xFF ask this device too; a request counts like any other.
+  EXPECT_EQ(send({0x2B, 0x0E, 0x01, 0x00}, 0), 0);
+  EXPECT_EQ(send({0x2B, 0x0E, 0x01, 0x00}, 0xFF), 0);
+  EXPECT_TRUE(drain().empty());
+}
+
+TEST_F(Handler, DeviceIdentificationOneObjectByItsId) {
+  for (const auto& [id, value] : kRegularObjects) {
+    const Reply r = reply({0x2B, 0x0E, 0x04, static_cast<std::uint8_t>(id)});
+    ASSERT_EQ(r.exception, 0) << id;
+    const DeviceId d = decode_device_id(r.pdu);
+    EXPECT_EQ(d.read_code, 0x04);
+    EXPECT_EQ(d.more_follows, 0x00);  // individual access: always 00
+    EXPECT_EQ(d.next_object, 0x00);
+    ASSERT_EQ(d.objects.size(), 1u);
+    EXPECT_EQ(d.objects[0], std::make_pair(id, value));
+  }
+  // The user application is the register map's file name, without its folder.
+  make(WritePolicy{}, {1}, "name,table,address,type\nposition_mm,input,1000,float32\n");
+  EXPECT_EQ(decode_device_id(reply({0x2B, 0x0E, 0x04, 0x06}).pdu).objects.at(0).second, "test-map.csv");
+}
+
+TEST_F(Handler, DeviceIdentificationExceptions) {
+  EXPECT_EQ(send({0x2B, 0x0E, 0x04, 0x07}), 0x02);  // individual access to an object it does not have
+  EXPECT_EQ(send({0x2B, 0x0E, 0x04, 0x80}), 0x02);  // ... an extended one
+  EXPECT_EQ(send({0x2B, 0x0E, 0x04, 0xFF}), 0x02);
+  EXPECT_EQ(send({0x2B, 0x0E, 0x00, 0x00}), 0x03);  // read codes are 01-04
+  EXPECT_EQ(send({0x2B, 0x0E, 0x05, 0x00}), 0x03);
+  EXPECT_EQ(send({0x2B, 0x0E, 0xFF, 0x00}), 0x03);
+  EXPECT_EQ(send({0x2B, 0x0E, 0x01}), 0x03);              // the object id is missing
+  EXPECT_EQ(send({0x2B, 0x0E, 0x01, 0x00, 0x00}), 0x03);  // a byte too many
+  EXPECT_EQ(send({0x2B, 0x0D, 0x01, 0x00}), 0x01);        // another MEI type (CANopen general reference)
+  EXPECT_EQ(send({0x2B, 0x00, 0x01, 0x00}), 0x01);
+  EXPECT_EQ(send({0x2B}), 0x03);                          // no MEI type at all
+  const Reply r = reply({0x2B, 0x0E, 0x04, 0x07});
+  EXPECT_TRUE(r.pdu.empty());  // an exception carries no PDU of its own
+}
+
+TEST(DeviceIdentification, AStreamLongerThanAPduIsSplitWithMoreFollows) {
+  DeviceIdentity id;
+  for (std::size_t i = 0; i < id.objects.size(); ++i) id.objects[i] = std::string(100, static_cast<char>('a' + i));
+  id.objects[6] = std::string(300, 'z');  // longer than any response can carry: cut to 244 bytes
+  std::vector<std::string> got;
+  std::uint8_t object = 0;
+  for (int request = 0; request < 10; ++request) {
+    const std::uint8_t req[3] = {0x0E, 0x02, object};
+    Bytes pdu;
+    ASSERT_EQ(read_device_identification(req, 3, id, pdu), 0);
+    const DeviceId d = decode_device_id(pdu);
+    ASSERT_FALSE(d.objects.empty());
+    EXPECT_EQ(d.objects.front().first, object);  // from the id asked for
+    for (const auto& [i, v] : d.objects) got.push_back(v);
+    if (d.more_follows == 0x00) {
+      EXPECT_EQ(d.next_object, 0x00);
+      break;
+    }
+    EXPECT_EQ(d.more_follows, 0xFF);
+    EXPECT_EQ(d.next_object, d.objects.back().first + 1);
+    object = d.next_object;
+  }
+  ASSERT_EQ(got.size(), 7u);  // every object once, none split
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(got[i], id.objects[i]);
+  EXPECT_EQ(got[6], std::string(244, 'z'));
+  // 7 + 2 + 244: the longest object fills a PDU exactly.
+  const std::uint8_t last[3] = {0x0E, 0x04, 0x06};
+  Bytes pdu;
+  ASSERT_EQ(read_device_identification(last, 3, id, pdu), 0);
+  EXPECT_EQ(pdu.size(), 253u);
+}
+
+TEST(TcpAdu, EchoesTheTransactionAndUnitWithTheLengthOfTheAnswer) {
+  const std::uint8_t request[] = {0xBE, 0xEF, 0x00, 0x00, 0x00, 0x05, 0x00, 0x2B, 0x0E, 0x01, 0x00};
+  const Bytes pdu(200, 0x55);
+  const Bytes adu_bytes = tcp_adu(request, pdu);
+  ASSERT_EQ(adu_bytes.size(), 207u);
+  EXPECT_EQ(Bytes(adu_bytes.begin(), adu_bytes.begin() + 7), (Bytes{0xBE, 0xEF, 0x00, 0x00, 0x00, 201, 0x00}));
+  EXPECT_EQ(Bytes(adu_bytes.begin() + 7, adu_bytes.end()), pdu);
+}
+
 TEST_F(Handler, ABlockWriteArrivesAsOneGroup) {
   // setpoint (0-1) = 50.0 and mode (2) = 1 in one FC16.
   EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x03, 0x06, 0x42, 0x48, 0x00, 0x00, 0x00, 0x01}), 0);
@@ -249,7 +483,7 @@ TEST_F(Handler, TheUnlockBelongsToTheConnectionThatSentTheKey) {
   Session hmi{"127.0.0.1", "127.0.0.1:50001", 0}, other{"127.0.0.1", "127.0.0.1:50002", 0};
   auto on = [&](Session& s, const Bytes& pdu) {
     const Bytes a = adu(pdu);
-    return handler_->handle(a.data(), static_cast<int>(a.size()), s, 0, image_);
+    return handler_->handle(a.data(), static_cast<int>(a.size()), s, 0, image_).exception;
   };
   ASSERT_EQ(on(hmi, unlock_pdu(kKey)), 0);
   EXPECT_EQ(on(other, lc), 0x04);  // the same address, another connection: still locked

@@ -4,6 +4,8 @@
 #include "web/web_server.hpp"
 
 #include "control/paper_controller.hpp"
+#include "core/version.hpp"
+#include "points/point_catalog.hpp"
 
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
@@ -160,6 +162,7 @@ TEST_F(WebServerTest, StatusShowsThePublishedSnapshotWithNanAsNull) {
   EXPECT_EQ(s["modbus"]["clients"], 2);
   EXPECT_EQ(s["modbus"]["requests"], 77);
   EXPECT_FALSE(s["commands_enabled"].get<bool>());
+  EXPECT_EQ(s["version"], std::string(epa::core::kVersion));  // project(... VERSION) in CMakeLists.txt
 }
 
 TEST_F(WebServerTest, StatusNamesALatchedFaultInWords) {
@@ -221,7 +224,7 @@ TEST_F(WebServerTest, MetricsAreValidPrometheusText) {
   std::istringstream in(res->body);
   std::string line;
   std::map<std::string, double> samples;
-  std::set<std::string> help, type;
+  std::set<std::string> help, type, counters;
   while (std::getline(in, line)) {
     ASSERT_FALSE(line.empty());
     std::istringstream words(line);
@@ -232,6 +235,7 @@ TEST_F(WebServerTest, MetricsAreValidPrometheusText) {
       words >> a >> a >> b >> kind;
       EXPECT_TRUE(kind == "gauge" || kind == "counter") << line;
       type.insert(b);
+      if (kind == "counter") counters.insert(b);
       continue;
     }
     std::string value, rest;
@@ -242,16 +246,29 @@ TEST_F(WebServerTest, MetricsAreValidPrometheusText) {
     EXPECT_EQ(*end, '\0') << line;
     samples[a] = v;
   }
-  for (const char* name : {"epa_position_mm", "epa_error_mm", "epa_valve_volts", "epa_loop_jitter_p99_microseconds",
-                           "epa_loop_overruns_total", "epa_faults_total", "epa_modbus_requests_total", "epa_mode"}) {
-    EXPECT_TRUE(samples.count(name)) << name;
+  for (const char* name : {"epa_position_meters", "epa_error_meters", "epa_valve_volts", "epa_loop_jitter_p99_seconds",
+                           "epa_loop_overruns_total", "epa_faults_total", "epa_moves_total", "epa_modbus_requests_total", "epa_mode",
+                           "epa_uptime_seconds", "epa_build_info"}) {
     EXPECT_TRUE(help.count(name)) << name;
     EXPECT_TRUE(type.count(name)) << name;
   }
-  EXPECT_DOUBLE_EQ(samples["epa_position_mm"], 118.5);
+  // Every sample has its HELP and TYPE; base units only; counters and only counters end in _total.
+  for (const auto& [sample, v] : samples) {
+    const std::string name = sample.substr(0, sample.find('{'));
+    EXPECT_TRUE(help.count(name) && type.count(name)) << name;
+    for (const char* non_base : {"_mm", "_us", "_ms", "micro", "milli"}) EXPECT_EQ(name.find(non_base), std::string::npos) << name;
+  }
+  for (const auto& name : type) EXPECT_EQ(name.ends_with("_total"), counters.count(name) == 1) << name;
+  EXPECT_DOUBLE_EQ(samples["epa_position_meters"], 0.1185);  // 118.5 mm
+  EXPECT_DOUBLE_EQ(samples["epa_loop_jitter_p99_seconds"], 17e-6);
   EXPECT_DOUBLE_EQ(samples["epa_modbus_requests_total"], 77);
   EXPECT_DOUBLE_EQ(samples["epa_loop_overruns_total"], 2);
+  EXPECT_DOUBLE_EQ(samples["epa_moves_total"], 3);
   EXPECT_DOUBLE_EQ(samples["epa_mode"], 1);
+  EXPECT_DOUBLE_EQ(samples["epa_build_info{version=\"" + std::string(epa::core::kVersion) + "\"}"], 1);
+  // The help says what the catalog says the point means (moves finished, not started).
+  EXPECT_NE(res->body.find("# HELP epa_moves_total " + std::string(epa::points::point(epa::points::PointId::kMoves).description)),
+            std::string::npos);
 }
 
 TEST_F(WebServerTest, WithoutATokenEveryPostIsForbidden) {
