@@ -18,6 +18,8 @@
 #include "runtime/command_rules.hpp"
 #include "runtime/command_queue.hpp"
 #include "runtime/excitation_run.hpp"
+#include "runtime/fault_event.hpp"
+#include "runtime/fault_history.hpp"
 #include "runtime/loop_stats.hpp"
 #include "runtime/move_tracker.hpp"
 #include "runtime/runtime_config.hpp"
@@ -43,7 +45,7 @@ struct RecordRequest {
 
 inline constexpr std::size_t kCommandQueueCapacity = 64;
 
-// The two channels other threads meet the loop through, plus the recorder's.
+// The two channels other threads meet the loop through, plus the recorder's and the supervisor's.
 struct LoopChannels {
   explicit LoopChannels(std::size_t record_capacity) : samples(record_capacity) {}
   CommandQueue<Command, kCommandQueueCapacity> commands;
@@ -51,6 +53,10 @@ struct LoopChannels {
   SampleRing samples;
   SpscRing<RecordRequest, 16> record_requests;
   SpscRing<CommandOutcome, 64> refusals;  // commands the loop refused, for the gate to log and audit
+  SpscRing<FaultEvent, kFaultEventCapacity> fault_events;  // faults the loop latched, for the supervisor
+  // What the supervisor made of fault_events (the loop never touches it): here because every
+  // interface meets the loop through these channels, so each reads the one history.
+  FaultHistory fault_history;
 };
 
 class ScanCycle {
@@ -118,7 +124,7 @@ class ScanCycle {
   MoveTracker moves_;
   MoveResult last_move_;
   LoopStats stats_;
-  Snapshot snap_;
+  Snapshot snap_;  // fault_events_dropped is counted in it directly (enter_fault): publish() leaves it
 };
 
 }  // namespace epa::runtime
