@@ -33,8 +33,10 @@ RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, int u
 
 points::InterfaceStatus RequestHandler::status(const Session& session, std::int64_t now_ns) const {
   const core::ChangeCounters changes = gate_.counters();
-  return {static_cast<std::uint32_t>(changes.accepted), static_cast<std::uint32_t>(changes.saved), changes.saving, requests_,
-          clients_, now_ns >= session.unlocked_until_ns, unlock_.failures(), gate_.commission_view()};
+  points::InterfaceStatus s{static_cast<std::uint32_t>(changes.accepted), static_cast<std::uint32_t>(changes.saved), changes.saving,
+                            requests_, clients_, now_ns >= session.unlocked_until_ns, unlock_.failures(), gate_.commission_view()};
+  s.fault_history_count = channels_.fault_history.copy_newest(s.recent_faults);
+  return s;
 }
 
 std::uint8_t RequestHandler::handle(const std::uint8_t* req, int length, Session& session, std::int64_t now_ns,

@@ -6,12 +6,14 @@
 // register map binds Modbus addresses to its points, the JSON API and /metrics name values by it,
 // the store keys retained points by it, and the write gate checks writes against its access and
 // range. `epa registers --points` lists it.
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string_view>
 
 #include "points/commission_control.hpp"
 #include "points/point_id.hpp"
+#include "runtime/fault_history.hpp"
 #include "runtime/snapshot.hpp"
 
 namespace epa::points {
@@ -26,6 +28,8 @@ struct InterfaceStatus {
   bool locked = true;                // tuning points refuse this client's writes
   std::uint64_t unlock_failures = 0; // refused unlock attempts since start (wrong key, back-off)
   CommissionView commission;         // the commissioning service's state (WriteGate::commission_view)
+  std::uint64_t fault_history_count = 0;  // faults recorded (LoopChannels::fault_history)
+  std::array<runtime::FaultRecord, kFaultHistoryPoints> recent_faults{};  // newest first; code kNone: an empty slot
 };
 
 struct PointContext {

@@ -10,6 +10,7 @@
 namespace epa::points {
 
 inline constexpr std::size_t kCoefficients = control::kMaxLawOrder + 1;  // F0..F6, G0..G6, H0..H6
+inline constexpr std::size_t kFaultHistoryPoints = 8;  // the newest faults an HMI reads, 0 the newest
 
 enum class PointId : std::uint16_t {
   // identity and status
@@ -30,8 +31,16 @@ enum class PointId : std::uint16_t {
   // loop statistics and counters
   kLoopWakeP50, kLoopWakeP99, kLoopWakeMax, kLoopJitterP99, kLoopComputeP99, kLoopOverruns, kCycles, kUptime,
   kMoves, kFaults, kIoErrors, kCommandsApplied, kCommandsRejected, kLastCommandRefusal,
+  // the fault history: how many, then the newest kFaultHistoryPoints, kFaultCode0 + i ... for entry i
+  kFaultHistoryCount,
+  kFaultCode0,
+  kFaultMode0 = kFaultCode0 + kFaultHistoryPoints,
+  kFaultTime0 = kFaultMode0 + kFaultHistoryPoints,
+  kFaultPosition0 = kFaultTime0 + kFaultHistoryPoints,
+  kFaultSetpoint0 = kFaultPosition0 + kFaultHistoryPoints,
+  kFaultValve0 = kFaultSetpoint0 + kFaultHistoryPoints,
   // controller coefficients: kF0 + i, kG0 + i, kH0 + i for i < kCoefficients
-  kF0,
+  kF0 = kFaultValve0 + kFaultHistoryPoints,
   kG0 = kF0 + kCoefficients,
   kH0 = kG0 + kCoefficients,
   kCount = kH0 + kCoefficients,
@@ -42,5 +51,7 @@ inline constexpr std::size_t index(PointId id) { return static_cast<std::size_t>
 inline constexpr PointId coefficient_id(PointId first, std::size_t i) {
   return static_cast<PointId>(static_cast<std::size_t>(first) + i);
 }
+// kFaultCode0 + i and the like: the same arithmetic.
+inline constexpr PointId fault_history_id(PointId first, std::size_t i) { return coefficient_id(first, i); }
 
 }  // namespace epa::points
