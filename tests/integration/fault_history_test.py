@@ -186,8 +186,8 @@ def main():
         caused.append(("soft-limit", "manual", target))
         time.sleep(0.3)  # the supervisor drains the ring every 50 ms; the store thread writes it at once
         shown = ", ".join(f"{ms:.1f}" for ms in rig.latched_ms)
-        check(len(rig.latched_ms) == 3 and max(rig.latched_ms) < 25.0,
-              f"each fault was visible to the resetting client for less than half the supervisor's 50 ms tick: {shown} ms")
+        check(len(rig.latched_ms) == 3 and max(rig.latched_ms) < 50.0,
+              f"each fault was visible to the resetting client for less than the supervisor's 50 ms tick: {shown} ms")
 
         expected = list(reversed(caused))  # newest first
         codes = {"following-error": 6, "heartbeat-lost": 7, "soft-limit": 3}
