@@ -1,5 +1,5 @@
 // The status page: polls /api/status and /api/trend every 250 ms, the slower-changing
-// /api/moves, /api/tuning and /api/audit every 2 s, and draws with Chart.js (Debian's
+// /api/moves, /api/tuning, /api/audit and /api/faults every 2 s, and draws with Chart.js (Debian's
 // libjs-chart.js, served at /vendor/chart.js). No build step.
 "use strict";
 
@@ -177,6 +177,31 @@ function commissionPanel() {
   })();
 }
 
+// The fault history (GET /api/faults): every fault with its cause, newest first, polled with the
+// slow data on its own timer; a fault reset at once is still listed.
+function showFaults(d) {
+  const card = $("fault-history");
+  card.dataset.count = String(d.count);
+  setText("fh-head", d.count ? `${d.count} since the store was created; newest first` : "newest first");
+  const body = $("faults").tBodies[0];
+  const rows = d.faults.map((f) => `<tr class="fh-cause"><td>${new Date(f.time_ms).toLocaleString()}</td>` +
+    `<td class="fh-name">${escapeHtml(f.name)}</td><td>${escapeHtml(f.mode)}</td><td>${num(f.position_mm, 1)} mm</td>` +
+    `<td>${num(f.setpoint_mm, 1)} mm</td><td>${num(f.valve_v, 3)} V</td></tr>` +
+    `<tr><td colspan="6" class="fh-text">${escapeHtml(f.text)}</td></tr>`);
+  const html = rows.length ? rows.join("") : `<tr><td colspan="6" class="muted">no faults recorded</td></tr>`;
+  if (body.innerHTML !== html) body.innerHTML = html;
+}
+
+async function pollFaults() {
+  try {
+    showFaults(await getJson("/api/faults"));
+  } catch (e) {
+    // the fast poll shows the connection state
+  } finally {
+    setTimeout(pollFaults, SLOW_MS);
+  }
+}
+
 function linkState(ok, message) {
   const link = $("link");
   link.classList.toggle("down", !ok);
@@ -213,3 +238,4 @@ makeCharts();
 fast();
 slow();
 commissionPanel();
+pollFaults();

@@ -8,6 +8,7 @@
 #include "app/design_command.hpp"
 #include "app/diagnose_command.hpp"
 #include "app/excite_command.hpp"
+#include "app/faults_command.hpp"
 #include "app/identify_command.hpp"
 #include "app/plant_server_command.hpp"
 #include "app/registers_command.hpp"
@@ -37,6 +38,8 @@ int main(int argc, char** argv) {
   epa::app::add_excite_command(app, excite);
   epa::app::add_identify_command(app, identify);
   epa::app::add_tuning_command(app, tuning);
+  epa::app::FaultsOptions faults;
+  CLI::App* faults_command = epa::app::add_faults_command(app, faults);
   epa::app::CommissionOptions commission;
   epa::app::add_commission_command(app, commission);
   epa::app::DiagnoseOptions diagnose;
@@ -56,6 +59,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("serve")) return epa::app::run_serve(serve, std::cerr);
     if (app.got_subcommand("registers")) return epa::app::run_registers(registers, std::cout, std::cerr);
     if (app.got_subcommand("tuning")) return epa::app::run_tuning(app, tuning, std::cout, std::cerr);
+    if (app.got_subcommand(faults_command)) return epa::app::run_faults(faults, std::cout, std::cerr);
     if (app.got_subcommand("plant-server")) return epa::app::run_plant_server(plant_server, std::cout, std::cerr);
   } catch (const std::exception& e) {  // third-party code (CLI11, JSON, filesystem) at the edge
     std::cerr << "epa: " << e.what() << "\n";

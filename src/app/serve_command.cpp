@@ -9,6 +9,7 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "app/daq_factory.hpp"
 #include "app/appliance_axis.hpp"
@@ -18,6 +19,7 @@
 #include "app/run_history.hpp"
 #include "app/store_setup.hpp"
 #include "app/tuning_source.hpp"
+#include "core/audit.hpp"
 #include "core/format.hpp"
 #include "core/version.hpp"
 #include "hal/realtime.hpp"
@@ -182,24 +184,45 @@ core::Result<std::unique_ptr<web::WebServer>> start_web(const ApplianceConfig& c
   return server;
 }
 
-// What the operator should read in the log between two snapshots: mode changes, faults, moves.
+// What the operator should read in the log between two snapshots: mode changes, moves. (Faults
+// come from the loop's events: take_fault_events.)
 void log_changes(const runtime::Snapshot& previous, const runtime::Snapshot& s) {
   if (s.mode != previous.mode) spdlog::info("mode {} -> {}", runtime::to_string(previous.mode), runtime::to_string(s.mode));
-  if (s.faults != previous.faults)
-    spdlog::error("FAULT {}: {} (position {:.2f} mm, sensor {:.3f} V)", runtime::to_string(s.fault), runtime::describe(s.fault),
-                  s.position_mm, s.sensor_v);
+  if (s.fault_events_dropped != previous.fault_events_dropped)
+    spdlog::warn("{} fault(s) latched with the fault event ring full: counted in faults, missing from the fault history",
+                 s.fault_events_dropped - previous.fault_events_dropped);
   if (s.moves != previous.moves)
     spdlog::info("move {} {:.1f} -> {:.1f} mm: rise {:.3f} s, settling {:.3f} s, e_ss {:.2f} mm, overshoot {:.1f} %",
                  s.last_move.number, s.last_move.from_mm, s.last_move.to_mm, s.last_move.rise_s, s.last_move.settling_s,
                  s.last_move.ess_mm, s.last_move.overshoot_pct);
 }
 
+// Each fault the loop latched, from its event, never from the snapshot (a reset in the next cycle
+// has cleared the snapshot's fault): logged with its cause, added to the history the interfaces
+// read, and handed to the store thread. Stamped with the wall clock now, less how long ago the
+// loop latched it.
+void take_fault_events(runtime::LoopChannels& channels, store::StoreWriter& store_writer) {
+  std::vector<runtime::FaultEvent> events;
+  runtime::FaultEvent e;
+  while (channels.fault_events.try_pop(e)) events.push_back(e);
+  if (events.empty()) return;
+  const double loop_now_s = channels.snapshot.read().time_s;  // read after the events: not older than they are
+  const std::int64_t now_ms = core::unix_time_ms();
+  for (const runtime::FaultEvent& event : events) {
+    runtime::FaultRecord f = runtime::fault_record(event, runtime::fault_time_ms(event, loop_now_s, now_ms));
+    spdlog::error("FAULT {}: {} (in {}, position {:.2f} mm, setpoint {:.2f} mm, valve {:.3f} V, sensor {:.3f} V)", f.name, f.text,
+                  runtime::to_string(f.mode), f.position_mm, f.setpoint_mm, f.valve_v, f.sensor_v);
+    store_writer.record_fault(f);
+    channels.fault_history.add(std::move(f));
+  }
+}
+
 // The main thread while the appliance runs: waits for SIGTERM/SIGINT (or the duration), logs
-// events and a periodic status, has the gate log and audit the commands the loop refused after
-// acceptance, and pings the systemd watchdog only while the loop advances, so a stuck loop gets
-// the unit restarted.
-void supervise(const ApplianceConfig& c, double duration_s, const runtime::LoopChannels& channels, points::WriteGate& gate,
-               const sigset_t& signals) {
+// events and a periodic status, keeps the fault history, has the gate log and audit the commands
+// the loop refused after acceptance, and pings the systemd watchdog only while the loop advances,
+// so a stuck loop gets the unit restarted.
+void supervise(const ApplianceConfig& c, double duration_s, runtime::LoopChannels& channels, points::WriteGate& gate,
+               store::StoreWriter& store_writer, const sigset_t& signals) {
   std::uint64_t watchdog_usec = 0;
   const bool watchdog = sd_watchdog_enabled(0, &watchdog_usec) > 0;
   const auto started = std::chrono::steady_clock::now();
@@ -215,6 +238,7 @@ void supervise(const ApplianceConfig& c, double duration_s, const runtime::LoopC
     }
     const auto now = std::chrono::steady_clock::now();
     const runtime::Snapshot s = channels.snapshot.read();
+    take_fault_events(channels, store_writer);
     log_changes(previous, s);
     gate.take_refusals([](const std::string& line) { spdlog::warn("{}", line); });
     previous = s;
@@ -294,6 +318,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   runtime::LoopChannels channels(runtime::record_capacity_samples(c.runtime));
+  channels.fault_history.load(control->store.faults, control->store.fault_count);
   runtime::MonotonicClock clock;
   runtime::ScanCycle loop(c.runtime, control->tuning, **daq, clock, channels);
   store_writer.start();
@@ -342,7 +367,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
 
   sd_notify(0, "READY=1");
   spdlog::info("running");
-  supervise(c, o.duration_s, channels, gate, signals);
+  supervise(c, o.duration_s, channels, gate, store_writer, signals);
 
   sd_notify(0, "STOPPING=1");
   if (web_server) web_server->stop();        // no more commands from either interface;
@@ -350,6 +375,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   gate.attach_commission(nullptr);
   commissioning.reset();  // a commissioning run under way is aborted: valve safe, the previous set back
   loop_thread.join();  // the loop's last act: valve to its safe command
+  take_fault_events(channels, store_writer);  // latched since the supervisor's last look
   recorder.stop();     // writes what is pending; the DAQ closes on the way out
   store_writer.stop(); // every accepted change and run on disk (or logged as not saved)
   const auto saved = store_writer.counters();

@@ -5,6 +5,7 @@
 
 #include "points/point_catalog.hpp"
 #include "store/active_tuning.hpp"
+#include "store/fault_table.hpp"
 #include "store/retained_points.hpp"
 #include "store/schema.hpp"
 
@@ -56,6 +57,13 @@ core::Result<StoreStartup> open_tuning_store(const std::string& path, const stor
     if (auto it = retained->find(std::string(points::name(id))); it != retained->end())
       points::set_record_value(out.records[f.record], f.kind, it->second);
   }
+  store::FaultTable faults(opened->db);
+  auto history = faults.recent(runtime::kFaultHistoryEntries);
+  if (!history) return core::Error{history.error().code, "store: " + history.error().message};
+  auto count = faults.count();
+  if (!count) return core::Error{count.error().code, "store: " + count.error().message};
+  out.faults = std::move(*history);
+  out.fault_count = *count;
 
   out.set = loaded->set;
   out.model = loaded->model;

@@ -2,8 +2,8 @@
 // What `epa serve` takes from the tuning store at start: the database opened whatever state it
 // was in (created and seeded from the configuration's model and design on first start; moved
 // aside and replaced when damaged; refused when newer), the active tuning set loaded and
-// validated (a refused set falls back to the last good one), the retained setpoint, and the
-// store thread that keeps every accepted change from then on.
+// validated (a refused set falls back to the last good one), the retained setpoint, the fault
+// history, and the store thread that keeps every accepted change from then on.
 #include "points/position_records.hpp"
 #include <memory>
 #include <optional>
@@ -13,6 +13,7 @@
 
 #include "app/tuning_source.hpp"
 #include "core/model_file.hpp"
+#include "runtime/fault_history.hpp"
 #include "runtime/mode.hpp"
 #include "store/model_record.hpp"
 #include "store/store_file.hpp"
@@ -28,6 +29,8 @@ struct StoreStartup {
   std::optional<double> retained_setpoint_mm;
   points::PositionRecords records;  // the position-record table as retained (defaults where none was)
   runtime::FaultCode start_fault = runtime::FaultCode::kNone;  // kStoreDamaged when moved aside
+  std::vector<runtime::FaultRecord> faults;  // the fault history, newest first
+  std::uint64_t fault_count = 0;             // faults recorded since the store was created
   std::vector<std::string> notes;     // for the log: what happened at start
   std::vector<std::string> warnings;  // ... and what an operator must look at
 };

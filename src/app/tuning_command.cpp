@@ -7,6 +7,7 @@
 #include "app/output_file.hpp"
 #include "core/format.hpp"
 #include "core/text_file.hpp"
+#include "core/utc_stamp.hpp"
 #include "store/audit_log.hpp"
 #include "store/model_table.hpp"
 #include "store/run_table.hpp"
@@ -48,16 +49,7 @@ void add_tuning_command(CLI::App& app, TuningOptions& o) {
 
 namespace {
 
-std::string iso_time(std::int64_t ms) {
-  const std::time_t t = static_cast<std::time_t>(ms / 1000);
-  std::tm utc{};
-  gmtime_r(&t, &utc);
-  char buf[40];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &utc);
-  char out[48];
-  std::snprintf(out, sizeof out, "%s.%03dZ", buf, static_cast<int>(ms % 1000));
-  return out;
-}
+std::string iso_time(std::int64_t ms) { return core::iso_utc(ms); }
 
 // "2026-11-21", "2026-11-21T10:00:00Z" (UTC) or unix milliseconds.
 core::Result<std::int64_t> parse_time(const std::string& text, const char* option) {

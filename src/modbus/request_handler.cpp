@@ -38,6 +38,7 @@ points::InterfaceStatus RequestHandler::status(const Session& session, std::int6
                             requests_, clients_, now_ns >= session.unlocked_until_ns, unlock_.failures(), gate_.commission_view()};
   s.records = gate_.records();
   s.record_select = gate_.record_select();
+  s.fault_history_count = channels_.fault_history.copy_newest(s.recent_faults);
   return s;
 }
 

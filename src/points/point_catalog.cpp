@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -15,6 +17,7 @@ namespace {
 using Ctx = PointContext;
 using A = Access;
 using P = PointId;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 double b(bool v) { return v ? 1.0 : 0.0; }
 double coefficient(const std::array<double, kCoefficients>& c, std::uint8_t degree, int i) {
   return i <= degree ? c[static_cast<std::size_t>(i)] : 0.0;
@@ -64,6 +67,50 @@ const std::vector<std::string>& coefficient_names() {
     return n;
   }();
   return names;
+}
+
+// The fault history's points: what each field of entry i is called and reads.
+struct FaultField {
+  PointId first;
+  std::string_view suffix, unit, what;
+  bool integer;
+  double (*read)(const Ctx&, int);
+};
+double empty_or(const runtime::FaultRecord& r, double v) { return r.code == runtime::FaultCode::kNone ? kNaN : v; }
+const FaultField kFaultFields[] = {
+    {P::kFaultCode0, "code", "", "fault code as fault_code (0: an empty slot)", true,
+     [](const Ctx& c, int i) { return double(static_cast<int>(c.status.recent_faults[static_cast<std::size_t>(i)].code)); }},
+    {P::kFaultMode0, "mode", "", "the mode it was in before the fault, as mode (an empty slot: no value, 65535 on Modbus)", true,
+     [](const Ctx& c, int i) {
+       const auto& r = c.status.recent_faults[static_cast<std::size_t>(i)];
+       return empty_or(r, double(static_cast<int>(r.mode)));
+     }},
+    {P::kFaultTime0, "time_s", "s", "when it latched, unix time (an empty slot: no value, 4294967295 on Modbus)", true,
+     [](const Ctx& c, int i) {
+       const auto& r = c.status.recent_faults[static_cast<std::size_t>(i)];
+       return empty_or(r, std::floor(static_cast<double>(r.time_ms) / 1000.0));
+     }},
+    {P::kFaultPosition0, "position_mm", "mm", "position when it latched (NaN: not known, or an empty slot)", false,
+     [](const Ctx& c, int i) { return c.status.recent_faults[static_cast<std::size_t>(i)].position_mm; }},
+    {P::kFaultSetpoint0, "setpoint_mm", "mm", "setpoint when it latched (NaN in an empty slot)", false,
+     [](const Ctx& c, int i) { return c.status.recent_faults[static_cast<std::size_t>(i)].setpoint_mm; }},
+    {P::kFaultValve0, "valve_v", "V", "valve command applied when it latched (NaN in an empty slot)", false,
+     [](const Ctx& c, int i) { return c.status.recent_faults[static_cast<std::size_t>(i)].valve_v; }},
+};
+
+// Names and descriptions of the fault history's points (fault_0_code ...), kept alive for the
+// string_views in the catalog; in PointId order.
+const std::vector<std::pair<std::string, std::string>>& fault_history_texts() {
+  static const std::vector<std::pair<std::string, std::string>> texts = [] {
+    std::vector<std::pair<std::string, std::string>> t;
+    for (const FaultField& f : kFaultFields)
+      for (std::size_t i = 0; i < kFaultHistoryPoints; ++i)
+        t.emplace_back("fault_" + std::to_string(i) + "_" + std::string(f.suffix),
+                       "fault history, " + std::string(i == 0 ? "the newest" : std::to_string(i) + " before the newest") + ": " +
+                           std::string(f.what));
+    return t;
+  }();
+  return texts;
 }
 
 std::vector<PointDef> build() {
@@ -202,6 +249,16 @@ std::vector<PointDef> build() {
                          [](const Ctx& c, int) { return c.snapshot.axis.speed_mm_s; }});
   const auto after_select = std::find_if(p.begin(), p.end(), [](const PointDef& d) { return d.id == P::kRecordSelect; }) + 1;
   p.insert(after_select, positioning.begin(), positioning.end());
+
+  p.push_back({P::kFaultHistoryCount, "fault_history_count", "", "faults recorded since the tuning store was created (the history keeps the newest 64)",
+               A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.fault_history_count); }});
+  const auto& fault_texts = fault_history_texts();
+  for (std::size_t k = 0; k < fault_texts.size(); ++k) {
+    const FaultField& f = kFaultFields[k / kFaultHistoryPoints];
+    const int i = static_cast<int>(k % kFaultHistoryPoints);
+    p.push_back({fault_history_id(f.first, static_cast<std::size_t>(i)), fault_texts[k].first, f.unit, fault_texts[k].second,
+                 A::kRead, 0, 0, f.integer, true, f.read, i});
+  }
 
   // The position-record table.
   static constexpr std::string_view kRecordText[] = {

@@ -6,6 +6,7 @@
 // register map binds Modbus addresses to its points, the JSON API and /metrics name values by it,
 // the store keys retained points by it, and the write gate checks writes against its access and
 // range. `epa registers --points` lists it.
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string_view>
@@ -13,6 +14,7 @@
 #include "points/commission_control.hpp"
 #include "points/point_id.hpp"
 #include "points/position_records.hpp"
+#include "runtime/fault_history.hpp"
 #include "runtime/snapshot.hpp"
 
 namespace epa::points {
@@ -29,6 +31,8 @@ struct InterfaceStatus {
   CommissionView commission;         // the commissioning service's state (WriteGate::commission_view)
   PositionRecords records{};         // the position-record table (WriteGate::records)
   int record_select = 0;             // the record a start takes (0: the setpoint)
+  std::uint64_t fault_history_count = 0;  // faults recorded (LoopChannels::fault_history)
+  std::array<runtime::FaultRecord, kFaultHistoryPoints> recent_faults{};  // newest first; code kNone: an empty slot
 };
 
 // The status word (runtime/axis_words.hpp) of the loop's state and the interfaces' (warning

@@ -12,6 +12,7 @@ namespace epa::points {
 
 inline constexpr std::size_t kCoefficients = control::kMaxLawOrder + 1;  // F0..F6, G0..G6, H0..H6
 inline constexpr std::size_t kPositionRecords = 32;  // record 1..32 of the position-record table
+inline constexpr std::size_t kFaultHistoryPoints = 8;  // the newest faults an HMI reads, 0 the newest
 
 enum class PointId : std::uint16_t {
   // identity and status
@@ -37,8 +38,16 @@ enum class PointId : std::uint16_t {
   // loop statistics and counters
   kLoopWakeP50, kLoopWakeP99, kLoopWakeMax, kLoopJitterP99, kLoopComputeP99, kLoopOverruns, kCycles, kUptime,
   kMoves, kFaults, kIoErrors, kCommandsApplied, kCommandsRejected, kLastCommandRefusal,
+  // the fault history: how many, then the newest kFaultHistoryPoints, kFaultCode0 + i ... for entry i
+  kFaultHistoryCount,
+  kFaultCode0,
+  kFaultMode0 = kFaultCode0 + kFaultHistoryPoints,
+  kFaultTime0 = kFaultMode0 + kFaultHistoryPoints,
+  kFaultPosition0 = kFaultTime0 + kFaultHistoryPoints,
+  kFaultSetpoint0 = kFaultPosition0 + kFaultHistoryPoints,
+  kFaultValve0 = kFaultSetpoint0 + kFaultHistoryPoints,
   // the position-record table: kRecordTarget0 + i ... for record i + 1, i < kPositionRecords
-  kRecordTarget0,
+  kRecordTarget0 = kFaultValve0 + kFaultHistoryPoints,
   kRecordSpeed0 = kRecordTarget0 + kPositionRecords,
   kRecordWindow0 = kRecordSpeed0 + kPositionRecords,
   kRecordController0 = kRecordWindow0 + kPositionRecords,
@@ -54,5 +63,7 @@ inline constexpr std::size_t index(PointId id) { return static_cast<std::size_t>
 inline constexpr PointId indexed_id(PointId first, std::size_t i) {
   return static_cast<PointId>(static_cast<std::size_t>(first) + i);
 }
+// kFaultCode0 + i and the like: the same arithmetic.
+inline constexpr PointId fault_history_id(PointId first, std::size_t i) { return indexed_id(first, i); }
 
 }  // namespace epa::points

@@ -39,6 +39,8 @@ ScanCycle::ScanCycle(const RuntimeConfig& config, const Tuning& tuning, hal::Daq
     mode_ = Mode::kFault;  // before any start mode: a fault found before the start is latched
     fault_ = config.start_fault;
     faults_ = 1;
+    // In the history too; it never ran (STOP) and has read nothing yet (NaN).
+    ch_.fault_events.try_push({0, 0.0, fault_, Mode::kStop, kNaN, setpoint_mm_, valve_v_, kNaN});  // the ring is empty
   } else if (config.start_mode == Mode::kRun) {
     mode_ = Mode::kRun;
     init_state_on_next_read_ = true;  // the position is known only after the first read
@@ -305,6 +307,11 @@ FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
 }
 
 void ScanCycle::enter_fault(FaultCode code) noexcept {
+  // The cause, as it is before anything below changes it: a reset in the next cycle clears the
+  // snapshot's fault, never this. A full ring drops it, counted.
+  if (!ch_.fault_events.try_push({cycle_, static_cast<double>(cycle_) * config_.period_s, code, mode_, position_mm_,
+                                  setpoint_mm_, valve_v_, sensor_v_}))
+    ++snap_.fault_events_dropped;
   if (moves_.active()) finish_move(MoveEnd::kFault);
   jog_law_ = profile_law_ = false;
   if (mode_ == Mode::kExcite) end_excitation(ExcitationEnd::kFault);

@@ -19,6 +19,8 @@
 #include "runtime/command_rules.hpp"
 #include "runtime/command_queue.hpp"
 #include "runtime/excitation_run.hpp"
+#include "runtime/fault_event.hpp"
+#include "runtime/fault_history.hpp"
 #include "runtime/loop_stats.hpp"
 #include "runtime/move_tracker.hpp"
 #include "runtime/runtime_config.hpp"
@@ -44,7 +46,7 @@ struct RecordRequest {
 
 inline constexpr std::size_t kCommandQueueCapacity = 64;
 
-// The two channels other threads meet the loop through, plus the recorder's.
+// The two channels other threads meet the loop through, plus the recorder's and the supervisor's.
 struct LoopChannels {
   explicit LoopChannels(std::size_t record_capacity) : samples(record_capacity) {}
   CommandQueue<Command, kCommandQueueCapacity> commands;
@@ -52,6 +54,10 @@ struct LoopChannels {
   SampleRing samples;
   SpscRing<RecordRequest, 16> record_requests;
   SpscRing<CommandOutcome, 64> refusals;  // commands the loop refused, for the gate to log and audit
+  SpscRing<FaultEvent, kFaultEventCapacity> fault_events;  // faults the loop latched, for the supervisor
+  // What the supervisor made of fault_events (the loop never touches it): here because every
+  // interface meets the loop through these channels, so each reads the one history.
+  FaultHistory fault_history;
 };
 
 class ScanCycle {
@@ -142,7 +148,7 @@ class ScanCycle {
   int readings_ = 0;                    // up to 2: the speed needs two readings before this one
   std::uint64_t last_sequence_ = 0;
   LoopStats stats_;
-  Snapshot snap_;
+  Snapshot snap_;  // fault_events_dropped is counted in it directly (enter_fault): publish() leaves it
 };
 
 }  // namespace epa::runtime

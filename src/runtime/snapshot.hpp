@@ -50,6 +50,7 @@ struct Snapshot {
   std::uint32_t heartbeat = 0;
   std::uint64_t moves = 0, faults = 0, io_errors = 0, commands_applied = 0, commands_rejected = 0;
   CommandRefusal last_refusal = CommandRefusal::kNone;  // why the loop last refused a command
+  std::uint64_t fault_events_dropped = 0;  // faults the fault_events ring had no room for: not in the history
   ExcitationSettings excitation;  // what the next EXCITE starts with
   double excitation_left_s = 0;   // of the running experiment; 0 when none runs
   MoveMetricsView last_move;

@@ -94,6 +94,20 @@ INSERT INTO tuning_sets_v3 (id, name, created_ms, modified_ms, source, model_id,
 DROP TABLE tuning_sets;
 ALTER TABLE tuning_sets_v3 RENAME TO tuning_sets;
 )sql",
+    // 4: the fault history (issue 16): each fault the loop latched, with its cause; the store thread
+    // keeps the newest 64 (store/fault_table.hpp). AUTOINCREMENT: an id is never reused, so the
+    // newest id is the number of faults since the store was created.
+    R"sql(
+CREATE TABLE fault_history (
+  id INTEGER PRIMARY KEY AUTOINCREMENT,
+  time_ms INTEGER NOT NULL,          -- when it latched, unix ms (wall clock)
+  code INTEGER NOT NULL,             -- the fault code, as the fault_code register
+  name TEXT NOT NULL,                -- "following-error"
+  text TEXT NOT NULL,                -- the sentence for an operator, as written then
+  mode INTEGER NOT NULL,             -- the mode it was in before the fault, as the mode register (0 stop, 1 run, 2 manual, 4 excite)
+  position_mm REAL, setpoint_mm REAL, valve_v REAL, sensor_v REAL  -- NULL: not known (nothing read yet)
+);
+)sql",
 };
 
 }  // namespace

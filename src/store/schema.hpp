@@ -7,7 +7,7 @@
 
 namespace epa::store {
 
-inline constexpr int kSchemaVersion = 3;
+inline constexpr int kSchemaVersion = 4;
 
 core::Result<int> schema_version(Database& db);
 

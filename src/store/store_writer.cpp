@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "store/audit_log.hpp"
+#include "store/fault_table.hpp"
 #include "store/retained_points.hpp"
 #include "store/run_table.hpp"
 #include "store/set_activation.hpp"
@@ -55,6 +56,14 @@ void StoreWriter::record_run(const RunRecord& run) {
   wake_.notify_one();
 }
 
+void StoreWriter::record_fault(const runtime::FaultRecord& fault) {
+  {
+    std::lock_guard lock(mutex_);
+    pending_.emplace_back(fault);
+  }
+  wake_.notify_one();
+}
+
 void StoreWriter::switch_running_set(const TuningSet& set, bool persist, const std::string& source) {
   {
     std::lock_guard lock(mutex_);
@@ -92,6 +101,10 @@ core::Status StoreWriter::write(const std::deque<Item>& batch, TuningSet& runnin
       RunRecord r = *run;
       r.tuning_set_id = running.id;
       if (auto id = runs.insert(r); !id) return id.error();
+      continue;
+    }
+    if (const auto* fault = std::get_if<runtime::FaultRecord>(&item)) {
+      if (auto s = FaultTable(db_).add(*fault); !s) return s;
       continue;
     }
     if (const auto* sw = std::get_if<SetSwitch>(&item)) {

@@ -1,6 +1,7 @@
 #pragma once
-// The store thread. The Modbus and web threads hand it accepted changes (AuditSink::record) and
-// the recorder hands it run files; it writes them in one transaction per batch (group commit),
+// The store thread. The Modbus and web threads hand it accepted changes (AuditSink::record), the
+// recorder hands it run files and the supervisor the faults the loop latched (record_fault); it
+// writes them in one transaction per batch (group commit),
 // appending the audit entries and applying the persisted points to the running tuning set or
 // the retained points. The saved counter advances only after COMMIT returned, with
 // synchronous=FULL, so "saved" means on disk. A failed write (disk full, read-only) keeps the
@@ -18,6 +19,7 @@
 
 #include "core/audit.hpp"
 #include "points/point_id.hpp"
+#include "runtime/fault_history.hpp"
 #include "store/database.hpp"
 #include "store/run_record.hpp"
 #include "store/tuning_set.hpp"
@@ -50,6 +52,8 @@ class StoreWriter final : public core::AuditSink {
   void record(const std::vector<core::AuditEntry>& change) override;
   core::ChangeCounters counters() const override;
   void record_run(const RunRecord& run);
+  // A fault for the fault history (store/fault_table.hpp: the newest 64 are kept).
+  void record_fault(const runtime::FaultRecord& fault);
   // The loop runs `set` from now on (the write gate switched it): persisted tuning points edit its
   // row from here on, in order with the changes before. `persist`: it also becomes the store's
   // active set (audited "active_tuning_set" with `source`), what the next start loads.
@@ -68,7 +72,7 @@ class StoreWriter final : public core::AuditSink {
     bool persist = false;
     std::string source;
   };
-  using Item = std::variant<std::vector<core::AuditEntry>, RunRecord, SetSwitch>;
+  using Item = std::variant<std::vector<core::AuditEntry>, RunRecord, SetSwitch, runtime::FaultRecord>;
   core::Status write(const std::deque<Item>& batch, TuningSet& running);
   void loop();
 

@@ -5,6 +5,7 @@
 
 #include "control/controller_kind.hpp"
 #include "core/version.hpp"
+#include "core/utc_stamp.hpp"
 #include "points/point_catalog.hpp"
 #include "runtime/mode.hpp"
 
@@ -128,6 +129,19 @@ std::string audit_json(const std::vector<core::AuditEntry>& entries) {
     a.push_back({{"unix_time_ms", it->unix_time_ms}, {"source", it->source}, {"point", it->point},
                  {"old_value", num(it->old_value)}, {"new_value", num(it->new_value)}});
   return json{{"entries", std::move(a)}}.dump();
+}
+
+std::string faults_json(std::uint64_t count, const std::vector<runtime::FaultRecord>& newest_first,
+                        std::optional<std::uint64_t> dropped) {
+  json a = json::array();
+  for (const auto& f : newest_first)
+    a.push_back({{"time", core::iso_utc(f.time_ms)}, {"time_ms", f.time_ms}, {"code", static_cast<int>(f.code)},
+                 {"name", f.name}, {"text", f.text}, {k(P::kMode), std::string(runtime::to_string(f.mode))},
+                 {k(P::kPosition), num(f.position_mm)}, {k(P::kSetpoint), num(f.setpoint_mm)}, {k(P::kValve), num(f.valve_v)},
+                 {k(P::kSensor), num(f.sensor_v)}});
+  json j = {{"count", count}, {"faults", std::move(a)}};
+  if (dropped) j["dropped"] = *dropped;
+  return j.dump();
 }
 
 std::string points_json(const points::WriteLimits& limits) {

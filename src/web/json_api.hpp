@@ -2,11 +2,13 @@
 // The JSON bodies of the read-only API, built from the published snapshot and the web thread's
 // own buffers. Numbers that mean "never" / "no value" (NaN) are written as null.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/audit.hpp"
 #include "points/write_limits.hpp"
+#include "runtime/fault_history.hpp"
 #include "runtime/snapshot.hpp"
 #include "web/trend_buffer.hpp"
 
@@ -35,6 +37,12 @@ std::string trend_json(const std::vector<TrendPoint>& points, const runtime::Sna
 std::string moves_json(const std::vector<MoveRecord>& moves);
 std::string tuning_json(const runtime::Snapshot& s);
 std::string audit_json(const std::vector<core::AuditEntry>& entries);
+// The fault history: {"count": faults recorded, "faults": [newest first]}, each with its time as
+// ISO 8601 UTC and unix ms, code and name, text, the mode it was in and the position, setpoint,
+// valve and sensor values then (null: not known). `dropped` (when given): faults the loop's event
+// ring had no room for, missing from the history.
+std::string faults_json(std::uint64_t count, const std::vector<runtime::FaultRecord>& newest_first,
+                        std::optional<std::uint64_t> dropped = std::nullopt);
 // The point catalog with each writable point's range as the write gate applies it.
 std::string points_json(const points::WriteLimits& limits);
 std::string error_json(const std::string& message);

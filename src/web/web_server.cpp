@@ -274,6 +274,11 @@ struct WebServer::Impl {
     s.Get("/api/audit", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(audit_json(audit ? audit->entries() : std::vector<core::AuditEntry>{}), kJson);
     });
+    s.Get("/api/faults", [this](const httplib::Request&, httplib::Response& res) {
+      std::uint64_t count = 0;
+      const auto faults = channels.fault_history.newest(runtime::kFaultHistoryEntries, &count);
+      res.set_content(faults_json(count, faults, channels.snapshot.read().fault_events_dropped), kJson);
+    });
     s.Get("/metrics", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(prometheus_text(channels.snapshot.read(), modbus(), requests.load()),
                       "text/plain; version=0.0.4; charset=utf-8");

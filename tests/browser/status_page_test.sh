@@ -7,10 +7,12 @@
 # Starts `epa serve` (sim, RUN, setpoint 50 mm; Modbus and web on free loopback ports; the page
 # from <source dir>/web), waits for it by polling, then: (1) the page's DOM, after its scripts ran,
 # has trend points and shows a position; (2) a setpoint of 150 mm written over Modbus (mbpoll)
-# shows up as a position that changed by more than 50 mm; (3) screenshots at laptop (1280x900) and
-# phone (390x844) size go to <artifacts dir>; (4) at 1280x800 the recent-moves table, with its rows
+# shows up as a position that changed by more than 50 mm; (3) a soft-limit fault caused over
+# Modbus (MANUAL, 1.5 V up past [limits] soft_max_mm = 300) and reset at once over Modbus appears
+# in the Fault history card with its mode; (4) screenshots at laptop (1280x900) and phone
+# (390x844) size go to <artifacts dir>; (5) at 1280x800 the recent-moves table, with its rows
 # and with the widest rows it can show, fits inside its card and the card inside the window (a
-# probe script, added to a copy of the page for this test only, measures it); (5) the footer shows
+# probe script, added to a copy of the page for this test only, measures it); (6) the footer shows
 # the version `epa --version` prints. The appliance is stopped by its PID.
 set -uo pipefail
 
@@ -90,6 +92,10 @@ static_dir = "$tmp/web"
 [log]
 status_interval_s = 0
 
+[limits]
+soft_max_mm = 300
+setpoint_max_mm = 300
+
 [recorder]
 directory = "$tmp/runs"
 EOF2
@@ -152,12 +158,49 @@ fi
 dump_dom | grep -q 'id="s-tuning-set">paper<' && pass "(2) the page names the tuning set 'paper'" \
   || fail "(2) id=s-tuning-set does not name the tuning set 'paper'"
 
-# ---- (3) screenshots ----
+# ---- (3) a fault caused and reset shows in the Fault history card ----
+grep -q 'id="fault-history" data-count="0"' <<<"$(dump_dom)" && pass "(3) the Fault history card is empty at first" \
+  || fail "(3) the Fault history card should read data-count=\"0\" before any fault"
+out=$(mbpoll -m tcp -a 1 -p "$modbus_port" -0 -1 -o 1 -r 2 "$host" 2 2>&1)  # mode 2: MANUAL
+grep -q "Written 1 references" <<<"$out" || fail "(3) writing mode 2 (MANUAL) over Modbus: $out"
+sleep 0.2
+out=$(mbpoll -m tcp -a 1 -p "$modbus_port" -0 -1 -o 1 -t 4:float -B -r 4 "$host" 1.5 2>&1)  # manual_valve_v: up towards 300 mm
+grep -q "Written 1 references" <<<"$out" || fail "(3) writing manual_valve_v 1.5 over Modbus: $out"
+faulted=0
+deadline=$(( $(now_ms) + 15000 ))
+while [ "$(now_ms)" -lt "$deadline" ]; do
+  if http_get "${url}api/status" | grep -q '"mode":"fault"'; then faulted=1; break; fi
+  sleep 0.05
+done
+out=$(mbpoll -m tcp -a 1 -p "$modbus_port" -0 -1 -o 1 -t 0 -r 0 "$host" 1 2>&1)  # reset (coil 0)
+if [ "$faulted" -eq 1 ] && grep -q "Written 1 references" <<<"$out"; then
+  pass "(3) soft-limit fault caused in MANUAL and reset over Modbus"
+else
+  fail "(3) no soft-limit fault within 15 s, or the reset failed: $out"
+fi
+card=""
+deadline=$(( $(now_ms) + 10000 ))
+while [ "$(now_ms)" -lt "$deadline" ]; do
+  dom=$(dump_dom)
+  card=$(sed -n '/id="fault-history"/,/<\/section>/p' <<<"$dom")
+  grep -q '<td class="fh-name">soft-limit</td><td>manual</td>' <<<"$card" && break
+  sleep 0.5
+done
+if grep -q '<td class="fh-name">soft-limit</td><td>manual</td>' <<<"$card" && grep -q 'data-count="1"' <<<"$card" \
+   && grep -q 'the piston left the soft limits' <<<"$card"; then
+  pass "(3) the Fault history card lists the reset fault: soft-limit, in manual, with its cause"
+else
+  fail "(3) the Fault history card does not list soft-limit in manual after the reset: $card"
+fi
+http_get "${url}api/status" | grep -q '"mode":"stop"' && pass "(3) the appliance is in STOP after the reset" \
+  || fail "(3) the appliance is not in STOP after the reset"
+
+# ---- (4) screenshots ----
 rm -f "$artifacts/status_page.png" "$artifacts/status_page_phone.png"
 browser --virtual-time-budget=3000 --window-size=1280,900 --screenshot="$artifacts/status_page.png" "$url" >/dev/null
 browser --virtual-time-budget=3000 --window-size=390,844 --screenshot="$artifacts/status_page_phone.png" "$url" >/dev/null
 for f in status_page.png status_page_phone.png; do
-  if [ -s "$artifacts/$f" ]; then pass "(3) screenshot $artifacts/$f"; else fail "(3) no screenshot $artifacts/$f"; fi
+  if [ -s "$artifacts/$f" ]; then pass "(4) screenshot $artifacts/$f"; else fail "(4) no screenshot $artifacts/$f"; fi
 done
 
 # ---- (4) at 1280x800 the recent-moves table fits its card, the card the window ----

@@ -214,7 +214,7 @@ class EpaMapTest(ApplianceTest):
     def test_2_exceptions(self):
         c = self.c
         self.refused(c.read_holding_registers(15, 1, slave=UNIT), ILLEGAL_ADDRESS, "read unmapped holding 15")
-        self.refused(c.read_input_registers(200, 1, slave=UNIT), ILLEGAL_ADDRESS, "read unmapped input 200")
+        self.refused(c.read_input_registers(199, 1, slave=UNIT), ILLEGAL_ADDRESS, "read unmapped input 199")
         self.refused(c.read_input_registers(10, 3, slave=UNIT), ILLEGAL_ADDRESS, "read input 10-12 across the hole at 11")
         coils_end, inputs_end = self.bit_table_ends("coil")[1], self.bit_table_ends("discrete")[1]
         self.refused(c.read_coils(coils_end, 1, slave=UNIT), ILLEGAL_ADDRESS, f"read coil {coils_end}, past the padding")

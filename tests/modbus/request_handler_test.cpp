@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 
 #include "control/paper_controller.hpp"
@@ -108,6 +109,52 @@ TEST_F(Handler, ReadsThePositionFloatFromTheSnapshot) {
   EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x02}), 0);
   EXPECT_EQ(image_->tab_input_registers[0], 0x42F7);  // 123.5f
   EXPECT_EQ(image_->tab_input_registers[1], 0x0000);
+}
+
+// Issue 16: fault_history_count (input 200-201) and the newest 8 entries of 10 registers each from
+// 202 (code, mode, time uint32, position, setpoint, valve float32), newest first; empty slots read
+// code 0, the integer sentinels and NaN. One read of all 82 registers: the block has no gap.
+TEST_F(Handler, TheFaultHistoryReadsNewestFirstWithEmptySlots) {
+  auto record = [](std::int64_t time_ms, runtime::FaultCode code, runtime::Mode mode, double position, double setpoint, double valve) {
+    runtime::FaultRecord r;
+    r.time_ms = time_ms, r.code = code, r.mode = mode, r.position_mm = position, r.setpoint_mm = setpoint, r.valve_v = valve;
+    return r;
+  };
+  const runtime::FaultRecord stored[] = {
+      record(1'795'579'167'123, runtime::FaultCode::kSoftLimit, runtime::Mode::kManual, 300.0, 150.0, 1.5),
+      record(1'000'000'000'500, runtime::FaultCode::kHeartbeatLost, runtime::Mode::kRun, 100.0, 100.0, 0.0)};
+  channels_.fault_history.load(stored, 12);
+  ASSERT_EQ(send({0x04, 0x00, 0xC8, 0x00, 0x52}), 0);  // input 200, 82 registers
+  const std::uint16_t* w = image_->tab_input_registers + 200;
+  EXPECT_EQ(w[0], 0x0000);  // count 12
+  EXPECT_EQ(w[1], 0x000C);
+  const std::uint16_t newest[] = {3, 2, 0x6B06, 0x5D1F, 0x4396, 0x0000, 0x4316, 0x0000, 0x3FC0, 0x0000};
+  const std::uint16_t older[] = {7, 1, 0x3B9A, 0xCA00, 0x42C8, 0x0000, 0x42C8, 0x0000, 0x0000, 0x0000};
+  for (int i = 0; i < 10; ++i) {
+    EXPECT_EQ(w[2 + i], newest[i]) << "entry 0, word " << i;
+    EXPECT_EQ(w[12 + i], older[i]) << "entry 1, word " << i;
+  }
+  for (int entry = 2; entry < 8; ++entry) {
+    const std::uint16_t* e = w + 2 + 10 * entry;
+    EXPECT_EQ(e[0], 0) << entry;       // code 0: empty
+    EXPECT_EQ(e[1], 0xFFFF) << entry;  // mode: uint16's "no value"
+    EXPECT_EQ(e[2], 0xFFFF) << entry;  // time: uint32's
+    EXPECT_EQ(e[3], 0xFFFF) << entry;
+    for (int f = 4; f < 10; f += 2) {
+      std::uint32_t bits = (std::uint32_t{e[f]} << 16) | e[f + 1];
+      float v;
+      std::memcpy(&v, &bits, sizeof v);
+      EXPECT_TRUE(std::isnan(v)) << entry << " word " << f;
+    }
+  }
+  // A new fault pushes the others down: the supervisor adds, every read sees it.
+  channels_.fault_history.add(record(1'795'579'200'000, runtime::FaultCode::kIoErrors, runtime::Mode::kStop, 50.0, 60.0, 0.0));
+  ASSERT_EQ(send({0x04, 0x00, 0xC8, 0x00, 0x52}), 0);
+  EXPECT_EQ(w[1], 13);
+  EXPECT_EQ(w[2], 4);
+  EXPECT_EQ(w[12], 3);
+  EXPECT_EQ(w[22], 7);
+  EXPECT_EQ(w[32], 0);
 }
 
 TEST_F(Handler, ReadExceptions) {

@@ -50,7 +50,8 @@ const std::map<std::string, std::string> kFormatFiles = {
     {"commission/commission_spec.cpp", "the commissioning spec's keys"},
     {"commission/commission_sequence.cpp", "epa-commission/1 keys"},
     {"app/tuning_command.cpp", "epa tuning show's labels"},
-    {"web/json_api.cpp", "the loop statistics' cycle count and the recent-moves list, other values than the points"},
+    {"app/faults_command.cpp", "the subcommand's own name, `epa faults`"},
+    {"web/json_api.cpp", "the loop statistics' cycle count, the recent-moves list and the fault history, other values than the points"},
 };
 
 TEST(PointCatalog, APointsNameIsWrittenOnceInTheSourceTreeInTheCatalog) {

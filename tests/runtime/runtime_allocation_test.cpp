@@ -44,7 +44,7 @@ TEST(RuntimeAllocation, TenThousandScanCyclesAllocateNothing) {
 
 // Mode EXCITE: entering it (the generator made in place), a whole experiment against the sim
 // plant, its end in STOP with the run handed to the recorder, new settings, and a second
-// experiment ended by a fault: all inside the counted span.
+// experiment ended by a fault (its event handed to the supervisor's ring): all inside the counted span.
 TEST(RuntimeAllocation, AnExcitationExperimentAllocatesNothing) {
   RuntimeConfig config;
   config.excitation.duration_s = 10.0;
@@ -105,6 +105,10 @@ TEST(RuntimeAllocation, AnExcitationExperimentAllocatesNothing) {
   int experiments = 0;
   while (ch.record_requests.try_pop(r)) experiments += r.reason == RecordRequest::Reason::kExcitation ? 1 : 0;
   EXPECT_EQ(experiments, 2);
+  FaultEvent fault;  // the fault was handed on inside the counted span too
+  ASSERT_TRUE(ch.fault_events.try_pop(fault));
+  EXPECT_EQ(fault.code, FaultCode::kIoErrors);
+  EXPECT_EQ(fault.mode, Mode::kExcite);
 }
 
 }  // namespace

@@ -63,7 +63,7 @@ while [ "$(now_ms)" -lt "$deadline" ]; do
 done
 [ "$ready" -eq 1 ] || abort "the web server did not answer on $url within 10 s"
 mbpoll -m tcp -a 1 -p "$modbus_port" -0 -1 -o 1 -t 3 -r 0 -c 2 "$host" >/dev/null 2>&1 || fail "a Modbus read of input 0-1 was refused"
-mbpoll -m tcp -a 1 -p "$modbus_port" -0 -1 -o 1 -t 3 -r 200 -c 1 "$host" >/dev/null 2>&1 && fail "input 200 (unmapped) was answered"
+mbpoll -m tcp -a 1 -p "$modbus_port" -0 -1 -o 1 -t 3 -r 199 -c 1 "$host" >/dev/null 2>&1 && fail "input 199 (unmapped) was answered"
 deadline=$(( $(now_ms) + 10000 ))
 metrics=""
 while [ "$(now_ms)" -lt "$deadline" ]; do

@@ -215,6 +215,55 @@ TEST_F(WebServerTest, TrendMovesTuningAndAuditHaveTheirShapes) {
   EXPECT_EQ(log_.entries.size(), 1u);  // forwarded to the next sink
 }
 
+// Issue 16: GET /api/faults, no token needed; the supervisor adds to the history, the page reads it.
+TEST_F(WebServerTest, FaultsListTheHistoryNewestFirstWithoutAToken) {
+  start("a-token-that-is-long-enough");
+  json f = get_json("/api/faults");
+  EXPECT_EQ(f["count"], 0);
+  EXPECT_TRUE(f["faults"].empty());
+  EXPECT_EQ(f["dropped"], 0);
+
+  epa::runtime::FaultRecord older;
+  older.time_ms = 1'795'579'167'123;  // 2026-11-25T03:59:27.123Z
+  older.code = epa::runtime::FaultCode::kFollowingError;
+  older.mode = epa::runtime::Mode::kRun;
+  older.position_mm = 113.5, older.setpoint_mm = 150.0, older.valve_v = 1.25, older.sensor_v = 2.27;
+  older.name = "following-error";
+  older.text = "the position did not follow the setpoint";
+  epa::runtime::FaultRecord unread;  // latched before anything was read: NaN position and sensor
+  unread.time_ms = 1'795'579'200'000;
+  unread.code = epa::runtime::FaultCode::kStoreDamaged;
+  unread.setpoint_mm = 0.0, unread.valve_v = 0.0;
+  unread.name = "store-damaged";
+  unread.text = "the tuning database was damaged";
+  channels_.fault_history.load(std::vector<epa::runtime::FaultRecord>{older}, 5);
+  channels_.fault_history.add(unread);
+  snap_.fault_events_dropped = 2;
+  channels_.snapshot.publish(snap_);
+
+  f = get_json("/api/faults");
+  EXPECT_EQ(f["count"], 6);
+  EXPECT_EQ(f["dropped"], 2);
+  ASSERT_EQ(f["faults"].size(), 2u);
+  const json& newest = f["faults"][0];
+  EXPECT_EQ(newest["name"], "store-damaged");
+  EXPECT_EQ(newest["code"], 9);
+  EXPECT_EQ(newest["mode"], "stop");
+  EXPECT_TRUE(newest["position_mm"].is_null());
+  EXPECT_TRUE(newest["sensor_v"].is_null());
+  const json& e = f["faults"][1];
+  EXPECT_EQ(e["time"], "2026-11-25T03:59:27.123Z");
+  EXPECT_EQ(e["time_ms"], 1'795'579'167'123);
+  EXPECT_EQ(e["code"], 6);
+  EXPECT_EQ(e["name"], "following-error");
+  EXPECT_EQ(e["text"], "the position did not follow the setpoint");
+  EXPECT_EQ(e["mode"], "run");
+  EXPECT_DOUBLE_EQ(e["position_mm"].get<double>(), 113.5);
+  EXPECT_DOUBLE_EQ(e["setpoint_mm"].get<double>(), 150.0);
+  EXPECT_DOUBLE_EQ(e["valve_v"].get<double>(), 1.25);
+  EXPECT_DOUBLE_EQ(e["sensor_v"].get<double>(), 2.27);
+}
+
 TEST_F(WebServerTest, MetricsAreValidPrometheusText) {
   start();
   auto res = client_->Get("/metrics");

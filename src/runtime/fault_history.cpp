@@ -1,0 +1,50 @@
+#include "runtime/fault_history.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace epa::runtime {
+
+FaultRecord fault_record(const FaultEvent& e, std::int64_t time_ms) {
+  return {time_ms, e.code, e.mode, e.position_mm, e.setpoint_mm, e.valve_v, e.sensor_v, std::string(to_string(e.code)),
+          std::string(describe(e.code))};
+}
+
+std::int64_t fault_time_ms(const FaultEvent& e, double loop_now_s, std::int64_t now_ms) {
+  const double age_s = std::max(0.0, loop_now_s - e.loop_time_s);
+  return now_ms - std::llround(age_s * 1000.0);
+}
+
+void FaultHistory::load(std::span<const FaultRecord> newest_first, std::uint64_t total) {
+  std::lock_guard lock(mutex_);
+  entries_.assign(newest_first.begin(), newest_first.begin() + static_cast<std::ptrdiff_t>(
+                                                                   std::min(newest_first.size(), kFaultHistoryEntries)));
+  total_ = std::max<std::uint64_t>(total, entries_.size());
+}
+
+void FaultHistory::add(FaultRecord record) {
+  std::lock_guard lock(mutex_);
+  entries_.push_front(std::move(record));
+  if (entries_.size() > kFaultHistoryEntries) entries_.pop_back();
+  ++total_;
+}
+
+std::vector<FaultRecord> FaultHistory::newest(std::size_t limit, std::uint64_t* total) const {
+  std::lock_guard lock(mutex_);
+  if (total) *total = total_;
+  const std::size_t n = std::min(limit, entries_.size());
+  return {entries_.begin(), entries_.begin() + static_cast<std::ptrdiff_t>(n)};
+}
+
+std::uint64_t FaultHistory::total() const {
+  std::lock_guard lock(mutex_);
+  return total_;
+}
+
+std::uint64_t FaultHistory::copy_newest(std::span<FaultRecord> out) const {
+  std::lock_guard lock(mutex_);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = i < entries_.size() ? entries_[i] : FaultRecord{};
+  return total_;
+}
+
+}  // namespace epa::runtime
