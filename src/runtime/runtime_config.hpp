@@ -51,7 +51,7 @@ struct RuntimeConfig {
   // RUN entered holds the piston where it is (the setpoint follows it), so a retained or stale
   // setpoint never moves the axis; a start or a setpoint written in RUN moves it. false: RUN drives
   // to the setpoint (the behaviour before the positioning interface).
-  bool enable_holds_position = false;
+  bool enable_holds_position = true;
   // At start-up in RUN: drive to start_setpoint_mm (it was asked for explicitly), even when
   // enable_holds_position holds otherwise.
   bool start_moves_to_setpoint = false;

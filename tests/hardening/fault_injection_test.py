@@ -145,8 +145,7 @@ class Rig:
             return json.load(r)
 
     def move_to(self, mm, timeout_s=5.0):
-        self.write(0, f32_words(mm, "ABCD"))
-        self.write(2, [1])
+        self.write(0, f32_words(mm, "ABCD") + [1])  # setpoint and RUN in one write: enable, then move
         return wait_until(lambda: abs(self.position() - mm) < 5.0, timeout_s)
 
     def reset(self):

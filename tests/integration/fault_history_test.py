@@ -152,13 +152,13 @@ def main():
     started_s = time.time()
     caused = []  # (name, mode, setpoint) in the order caused
     try:
-        # 1: following-error in RUN. The setpoint 50 mm above the piston, then RUN: after 10 ms with
-        # more than 20 mm to go the loop faults.
+        # 1: following-error in RUN. RUN (which holds the piston), then a setpoint 50 mm above it:
+        # after 10 ms with more than 20 mm to go the loop faults.
         start_mm = rig.position()
         target = start_mm + 50.0
-        rig.write(0, f32_words(target, "ABCD"))
         before = rig.faults_counter()
         rig.write(2, [1])
+        rig.write(0, f32_words(target, "ABCD"))
         check(wait_until(lambda: rig.faults_counter() == before + 1, 3.0), "following-error: latched")
         check(wait_until(lambda: rig.mode() == 0, 2.0), "following-error: reset to STOP at once by the second client")
         caused.append(("following-error", "run", target))

@@ -6,7 +6,7 @@
 #
 # Starts `epa serve` on a free loopback port with registers/epa.csv, waits for it by polling, and
 # checks: the position float (input 0-1, ABCD, read with -B) is the simulated piston's (0 mm at
-# start), a setpoint written as an ABCD float plus mode RUN moves the piston there, an unmapped
+# start), mode RUN (which holds) and then a setpoint written as an ABCD float moves the piston there, an unmapped
 # register is refused (exception 02) and the tuning register lc_mm is refused while locked
 # (exception 04), 16 discrete inputs read in one request, and unit id 0 is answered with the
 # version epa --version prints. The appliance is stopped by its PID (SIGTERM, SIGKILL after 5 s). Exit 0: all
@@ -92,7 +92,14 @@ else
   fail "(1) position through the 1-based reference -r 1: expected 0 +- 0.5 mm, got '${pos1}' (mbpoll exit $rc): $out"
 fi
 
-# ---- (2) write setpoint 120 mm (holding 0-1, float ABCD) and mode 1 (RUN, holding 2) ----
+# ---- (2) mode 1 (RUN, holding 2: enable holds the piston), then setpoint 120 mm (holding 0-1, float ABCD) moves it ----
+out=$(mb -t 4 -r 2 "$host" 1 2>&1)
+rc=$?
+if [ $rc -eq 0 ] && grep -q "Written 1 references" <<<"$out"; then
+  pass "(2) mode 1 (run) written at holding 2"
+else
+  fail "(2) writing mode 1 (-t 4 -r 2): expected success, mbpoll exit $rc: $out"
+fi
 out=$(mb -t 4:float -B -r 0 "$host" 120 2>&1)
 rc=$?
 if [ $rc -eq 0 ] && grep -q "Written 1 references" <<<"$out"; then
@@ -105,13 +112,6 @@ if near "$sp" 120 0; then
   pass "(2) setpoint reads back as $sp"
 else
   fail "(2) setpoint read back (-t 4:float -B -r 0): expected 120, got '${sp}'"
-fi
-out=$(mb -t 4 -r 2 "$host" 1 2>&1)
-rc=$?
-if [ $rc -eq 0 ] && grep -q "Written 1 references" <<<"$out"; then
-  pass "(2) mode 1 (run) written at holding 2"
-else
-  fail "(2) writing mode 1 (-t 4 -r 2): expected success, mbpoll exit $rc: $out"
 fi
 
 # ---- (3) the simulated piston reaches 120 +- 3 mm within 15 s (polled every 0.2 s) ----

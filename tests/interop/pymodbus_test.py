@@ -261,10 +261,11 @@ class EpaMapTest(ApplianceTest):
     def test_4_setpoint_mode_move_and_fc23(self):
         c = self.c
         try:
-            self.ok(c.write_registers(0, f32_words(120.0, "ABCD"), slave=UNIT), "FC16 setpoint 120 (ABCD)")
+            # RUN first (it holds the piston where it is), then the setpoint moves it.
             self.beat()
             self.ok(c.write_register(2, 1, slave=UNIT), "FC6 mode 1 (run)")
             self.wait_until(lambda: (self.mode() == 1, self.mode()), 2.0, "mode reads 1 (run)", every_s=0.02)
+            self.ok(c.write_registers(0, f32_words(120.0, "ABCD"), slave=UNIT), "FC16 setpoint 120 (ABCD)")
             self.assertEqual(f32_value(self.regs(3, 0, 2), "ABCD"), 120.0, "setpoint reads back 120")
             start = time.monotonic()
             moving = self.position()
@@ -429,8 +430,8 @@ class LegacyHmiMapTest(ApplianceTest):
         c = self.c
         try:
             # Setpoint written as a CDAB float: the int16 copy reads x10, the float reads back the same.
-            self.ok(c.write_registers(1010, f32_words(80.0, "CDAB"), slave=UNIT), "FC16 setpoint 80 (CDAB)")
-            self.ok(c.write_register(1001, 1, slave=UNIT), "mode 1 (run)")
+            self.ok(c.write_register(1001, 1, slave=UNIT), "mode 1 (run): holds the piston")
+            self.ok(c.write_registers(1010, f32_words(80.0, "CDAB"), slave=UNIT), "FC16 setpoint 80 (CDAB): moves it")
             self.wait_until(lambda: (self.regs(3, 1000, 2) == [800, 1], self.regs(3, 1000, 2)), 2.0,
                             "holding 1000-1001 read setpoint x10 = 800, mode 1", every_s=0.02)
             words = self.regs(3, 1010, 2)

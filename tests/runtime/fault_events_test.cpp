@@ -24,6 +24,7 @@ class FaultEvents : public ::testing::Test {
  protected:
   void start(RuntimeConfig c = {}) {
     c.start_mode = Mode::kRun;
+    c.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
     c.start_setpoint_mm = 300.0;
     c.soft_min_mm = c.setpoint_min_mm = 50.0;
     c.soft_max_mm = c.setpoint_max_mm = 450.0;
