@@ -45,9 +45,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       // Each command against the loop's rules in the state the group leaves it, as the gate promises.
       runtime::Mode m = mode;
       runtime::ExcitationSettings excitation = rig.gate.excitation_settings();
+      std::uint16_t word = snap.axis.control_word;  // the gate's, as the loop last applied it (no write was queued)
       for (const auto& c : commands) {
-        if (runtime::check_command(c, m, snap.position_mm, excitation, rig.config) != runtime::CommandRefusal::kNone)
+        if (runtime::check_command(c, m, snap.position_mm, excitation, word, rig.config) != runtime::CommandRefusal::kNone)
           __builtin_trap();
+        if (c.kind == runtime::CommandKind::kControl) word = c.control_word;
         if (c.kind == runtime::CommandKind::kMode) m = c.mode;
         if (c.kind == runtime::CommandKind::kExcitation) excitation = c.excitation;
         if (c.kind == runtime::CommandKind::kReset && m == runtime::Mode::kFault) m = runtime::Mode::kStop;
