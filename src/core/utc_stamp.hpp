@@ -8,10 +8,15 @@
 
 namespace epa::core {
 
-inline std::string utc_stamp(std::int64_t unix_time_ms) {
+inline std::tm utc_time(std::int64_t unix_time_ms) {
   const std::time_t t = static_cast<std::time_t>(unix_time_ms / 1000);
   std::tm utc{};
   gmtime_r(&t, &utc);
+  return utc;
+}
+
+inline std::string utc_stamp(std::int64_t unix_time_ms) {
+  const std::tm utc = utc_time(unix_time_ms);
   char text[32];
   std::strftime(text, sizeof text, "%Y%m%dT%H%M%SZ", &utc);
   return text;
@@ -20,9 +25,7 @@ inline std::string utc_stamp(std::int64_t unix_time_ms) {
 // ISO 8601 in UTC to the millisecond, as the JSON API and the command line show times:
 // "2026-11-24T21:33:05.120Z".
 inline std::string iso_utc(std::int64_t unix_time_ms) {
-  const std::time_t t = static_cast<std::time_t>(unix_time_ms / 1000);
-  std::tm utc{};
-  gmtime_r(&t, &utc);
+  const std::tm utc = utc_time(unix_time_ms);
   char text[40];
   std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%S", &utc);
   char out[48];

@@ -15,14 +15,15 @@
 
 namespace epa::runtime {
 
+// Filled from RuntimeConfig's [motion] settings (their defaults live there, once).
 struct MotionConfig {
-  double in_position_window_mm = 1.0;  // |target - position| at most this ...
-  double in_position_time_s = 0.1;     // ... for this long: in position
-  double halt_decel_mm_s2 = 2500.0;    // braking of a halt
-  double jog_speed_mm_s = 20.0;        // a jog's top speed
-  double jog_accel_mm_s2 = 500.0;      // a jog's acceleration and braking
-  double min_mm = 0.0, max_mm = 500.0; // the setpoint range: a jog or a halt never aims beyond it
-  double Ts = 0.005;
+  double in_position_window_mm = 0;  // |target - position| at most this ...
+  double in_position_time_s = 0;     // ... for this long: in position
+  double halt_decel_mm_s2 = 0;       // braking of a halt
+  double jog_speed_mm_s = 0;         // a jog's top speed
+  double jog_accel_mm_s2 = 0;        // a jog's acceleration and braking
+  double min_mm = 0, max_mm = 0;     // the setpoint range: a jog or a halt never aims beyond it
+  double Ts = 0;
 };
 
 enum class MotionTask : std::uint8_t {
