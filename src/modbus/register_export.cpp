@@ -5,6 +5,7 @@
 
 #include "core/format.hpp"
 #include "modbus/device_identification.hpp"
+#include "modbus/register_guide.hpp"
 
 namespace epa::modbus {
 
@@ -31,6 +32,15 @@ std::string reference_alias(Table table, int address) {
   char buf[16];
   std::snprintf(buf, sizeof buf, address < 9999 ? "%c%04d" : "%c%05d", prefix, address + 1);
   return buf;
+}
+
+std::string markdown_cell(std::string_view text) {
+  std::string cell;
+  for (const char c : text) {
+    if (c == '|') cell += '\\';
+    cell += c;
+  }
+  return cell;
 }
 
 namespace {
@@ -80,7 +90,10 @@ std::string export_markdown(const RegisterMap& map) {
       << "reference is the 1-based alias many HMIs use. 32-bit values take two registers, word order as given "
          "(ABCD: high word first). Integer registers hold round(value x scale); NaN (\"never reached\") reads as the "
          "type's sentinel (int16 -32768, uint16 65535, int32 -2147483648, uint32 4294967295).\n\n";
+  write_positioning_guide(out, map);
+  out << "## Protocol\n\n";
   write_protocol_notes(out, map);
+  out << "## Every register\n\n";
   out << "| point | table | address | reference | type | word order | scale | unit | access | range | default | persisted | description |\n"
       << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
   for (const auto& e : map.entries()) {
@@ -90,7 +103,7 @@ std::string export_markdown(const RegisterMap& map) {
         << (e.type == DataType::kFloat32 || e.type == DataType::kBool ? "" : core::format_number(e.scale)) << " | " << e.unit
         << " | " << (e.writable ? "rw" : "r") << (e.writable && e.point->tuning() ? " (unlock)" : "") << " | " << range_text(e)
         << " | " << (e.default_value ? core::format_number(*e.default_value) : "") << " | " << (e.persisted ? "yes" : "")
-        << " | " << e.description << " |\n";
+        << " | " << markdown_cell(e.description) << " |\n";
   }
   return out.str();
 }
@@ -114,7 +127,8 @@ std::string points_markdown() {
   out << "| point | unit | writes | range | description |\n| --- | --- | --- | --- | --- |\n";
   for (const auto& p : points::point_catalog()) {
     out << "| " << p.name << " | " << p.unit << " | " << (p.tuning() ? "yes, after unlock" : p.writable() ? "yes" : "") << " | "
-        << (p.writable() ? core::format_number(p.min) + " .. " + core::format_number(p.max) : "") << " | " << p.description << " |\n";
+        << (p.writable() ? core::format_number(p.min) + " .. " + core::format_number(p.max) : "") << " | " << markdown_cell(p.description)
+        << " |\n";
   }
   return out.str();
 }

@@ -228,7 +228,8 @@ std::vector<PointDef> build() {
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.commands_rejected); }},
       {P::kLastCommandRefusal, "last_command_refusal", "", "why the scan cycle last refused a command: 0 none, 1 setpoint out of range, 2 manual valve out of range, "
                                                             "3 not in MANUAL, 4 fault latched, 5 FAULT not settable, 6 recorder busy, 7 record seconds out of range, "
-                                                            "8 EXCITE not from STOP, 9 piston outside the excitation's guard lines, 10 excitation settings invalid",
+                                                            "8 EXCITE not from STOP, 9 piston outside the excitation's guard lines, 10 excitation settings invalid, "
+                                                            "11 the law cannot use the tuning set's model, 12 start outside RUN, 13 jog outside MANUAL",
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.last_refusal)); }},
   };
   // Positioning: the control bits as coils, the status word and its bits, reference and speed.

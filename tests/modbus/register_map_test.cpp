@@ -160,6 +160,56 @@ TEST(RegisterExport, MarkdownAndCsvListEveryEntry) {
   EXPECT_EQ(static_cast<std::size_t>(lines), m->entries().size() + 1);
 }
 
+// Every row of every Markdown table has as many cells as its header: a "|" inside a description
+// (|target - position|) is escaped, or it would split the cell.
+TEST(RegisterExport, EveryTableRowHasItsHeadersCells) {
+  auto m = RegisterMap::load(std::string(EPA_SOURCE_DIR) + "/registers/epa.csv");
+  ASSERT_TRUE(m.has_value());
+  std::istringstream md(export_markdown(*m));
+  auto cells = [](const std::string& line) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < line.size(); ++i) n += line[i] == '|' && (i == 0 || line[i - 1] != '\\');
+    return n;
+  };
+  std::size_t header = 0, rows = 0;
+  for (std::string line; std::getline(md, line);) {
+    const auto start = line.find_first_not_of(' ');
+    if (start == std::string::npos || line[start] != '|') {
+      header = 0;
+      continue;
+    }
+    if (header == 0) {
+      header = cells(line);
+      continue;
+    }
+    ++rows;
+    EXPECT_EQ(cells(line), header) << line;
+  }
+  EXPECT_GT(rows, m->entries().size());
+}
+
+// The guide names this map's addresses: the shipped map's words and bits where they are, a map
+// without them says so instead of naming addresses it does not serve.
+TEST(RegisterExport, TheGuideNamesTheMapsOwnAddresses) {
+  auto shipped = RegisterMap::load(std::string(EPA_SOURCE_DIR) + "/registers/epa.csv");
+  ASSERT_TRUE(shipped.has_value());
+  const auto md = export_markdown(*shipped);
+  EXPECT_NE(md.find("The control word is holding register 50 / 40051"), std::string::npos);
+  EXPECT_NE(md.find("| 0 | 0x1 | start | 16 (00017) |"), std::string::npos);
+  EXPECT_NE(md.find("| 8 | 0x100 | ack | 24 (10025) |"), std::string::npos);
+  EXPECT_NE(md.find("record N (1..32) starts at holding register 1000 + 8·(N-1)"), std::string::npos);
+  EXPECT_NE(md.find("`mbpoll -0 -B -t 3:float -r 0 -c 1 HOST`"), std::string::npos);
+
+  auto small = RegisterMap::parse(kHeader + "position_mm,input,7,float32,ABCD,,mm,r,,,,no,\n"
+                                            "setpoint_mm,holding,3,float32,ABCD,,mm,rw,0,500,,yes,\n", "small.csv");
+  ASSERT_TRUE(small.has_value()) << small.error().message;
+  const auto guide = export_markdown(*small);
+  EXPECT_NE(guide.find("This map leaves out `mode`, `status_word`, `control_word`"), std::string::npos) << guide.substr(0, 1500);
+  EXPECT_NE(guide.find("This map has neither word nor their bits."), std::string::npos);
+  EXPECT_NE(guide.find("This map has no position records"), std::string::npos);
+  EXPECT_EQ(guide.find("holding register 50"), std::string::npos);
+}
+
 // docs/registers.md is what integrators read: it must be the export of the shipped map.
 TEST(RegisterExport, ShippedDocumentationIsTheExportOfTheShippedMap) {
   auto m = RegisterMap::load(std::string(EPA_SOURCE_DIR) + "/registers/epa.csv");

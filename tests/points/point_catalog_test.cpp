@@ -9,6 +9,9 @@
 #include <map>
 #include <regex>
 #include <set>
+#include <string>
+
+#include "runtime/command_rules.hpp"
 
 namespace epa::points {
 namespace {
@@ -53,6 +56,17 @@ const std::map<std::string, std::string> kFormatFiles = {
     {"app/faults_command.cpp", "the subcommand's own name, `epa faults`"},
     {"web/json_api.cpp", "the loop statistics' cycle count, the recent-moves list and the fault history, other values than the points"},
 };
+
+// An HMI decodes last_command_refusal from its description: every refusal the loop can give is
+// named there (codes 11-13 were missing once, when they were added to the loop only).
+TEST(PointCatalog, LastCommandRefusalNamesEveryRefusal) {
+  const std::string text(point(PointId::kLastCommandRefusal).description);
+  int code = 1;
+  for (; runtime::describe(static_cast<runtime::CommandRefusal>(code)) != "unknown"; ++code)
+    EXPECT_NE(text.find(std::to_string(code) + " "), std::string::npos) << "refusal " << code << " (" << runtime::describe(static_cast<runtime::CommandRefusal>(code)) << ")";
+  EXPECT_GE(code, 14);
+  EXPECT_EQ(text.find(std::to_string(code) + " "), std::string::npos) << "names a refusal the loop does not have";
+}
 
 TEST(PointCatalog, APointsNameIsWrittenOnceInTheSourceTreeInTheCatalog) {
   std::set<std::string> names;
