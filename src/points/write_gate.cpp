@@ -92,15 +92,9 @@ runtime::Snapshot WriteGate::with_unapplied(runtime::Snapshot s) const {
         if (c.control_word & ~s.axis.control_word & runtime::kControlStart) s.setpoint_mm = c.value;
         s.axis.control_word = c.control_word;
         break;
-      case runtime::CommandKind::kTuning: {
-        const auto& t = tuning_;  // the gate's copy is what the loop takes
-        s.tuning.m_r = t.dead_zone.m_r, s.tuning.m_l = t.dead_zone.m_l, s.tuning.b_r = t.dead_zone.b_r, s.tuning.b_l = t.dead_zone.b_l;
-        s.tuning.lc_mm = t.lc_v * loop_rules_.mm_per_volt;
-        s.tuning.traj_speed_fraction = t.trajectory.speed_fraction;
-        s.tuning.traj_bandwidth_rad_s = t.trajectory.feedback_bandwidth_rad_s;
-        s.tuning.traj_hold_band_mm = t.trajectory.hold_band_v * loop_rules_.mm_per_volt;
+      case runtime::CommandKind::kTuning:  // the gate's copy is what the loop takes
+        s.tuning.set_writable(tuning_.dead_zone, tuning_.lc_v, tuning_.trajectory, loop_rules_.mm_per_volt);
         break;
-      }
       case runtime::CommandKind::kReset:
       case runtime::CommandKind::kRecord: break;
     }

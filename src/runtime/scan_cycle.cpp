@@ -149,9 +149,10 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
 
 double ScanCycle::position_v() const noexcept { return (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain; }
 
+// The same speed a halt brakes from: a one-sample difference would start pp-traj's profile from
+// one sample of sensor noise or of the printed B's spike.
 void ScanCycle::start_law_at_the_piston(const control::ControllerParams& law) noexcept {
-  const double speed_v_s = (sensor_v_ - previous_sensor_v_) * config_.sensor_gain / config_.period_s;
-  control::controller_start(law, state_, position_v(), speed_v_s);
+  control::controller_start(law, state_, position_v(), plausible_speed_mm_s() / config_.mm_per_volt);
 }
 
 void ScanCycle::enter_run(std::int64_t now_ns) noexcept {
@@ -464,13 +465,13 @@ void ScanCycle::publish(bool full_stats) noexcept {
   s.loop.overruns = stats_.overruns;
   const auto& p = tuning_.for_kind(controller_);
   const auto& rst = p.rst();
-  s.tuning = {rst.F, rst.G, rst.H, static_cast<std::uint8_t>(rst.nF), static_cast<std::uint8_t>(rst.nG),
-              static_cast<std::uint8_t>(rst.nH), p.dead_zone().m_r, p.dead_zone().m_l, p.dead_zone().b_r,
-              p.dead_zone().b_l, p.lc_v() * config_.mm_per_volt, p.valve_limit_v()};
-  const auto& traj = tuning_.traj.trajectory_config();  // pp-traj's, whichever law runs
-  s.tuning.traj_speed_fraction = traj.speed_fraction;
-  s.tuning.traj_bandwidth_rad_s = traj.feedback_bandwidth_rad_s;
-  s.tuning.traj_hold_band_mm = traj.hold_band_v * config_.mm_per_volt;
+  s.tuning = {};
+  s.tuning.F = rst.F, s.tuning.G = rst.G, s.tuning.H = rst.H;
+  s.tuning.nF = static_cast<std::uint8_t>(rst.nF), s.tuning.nG = static_cast<std::uint8_t>(rst.nG);
+  s.tuning.nH = static_cast<std::uint8_t>(rst.nH);
+  s.tuning.valve_limit_v = p.valve_limit_v();
+  // pp-traj's settings whichever law runs: they are points whatever the law
+  s.tuning.set_writable(p.dead_zone(), p.lc_v(), tuning_.traj.trajectory_config(), config_.mm_per_volt);
   ch_.snapshot.publish(s);
 }
 

@@ -6,6 +6,8 @@
 
 #include "control/controller_kind.hpp"
 #include "control/rst_law.hpp"
+#include "control/trajectory_law.hpp"
+#include "core/dead_zone.hpp"
 #include "runtime/command_rules.hpp"
 #include "runtime/excitation_settings.hpp"
 #include "runtime/loop_stats.hpp"
@@ -25,6 +27,16 @@ struct TuningView {
   std::uint8_t nF = 0, nG = 0, nH = 0;
   double m_r = 0, m_l = 0, b_r = 0, b_l = 0, lc_mm = 0, valve_limit_v = 0;
   double traj_speed_fraction = 0, traj_bandwidth_rad_s = 0, traj_hold_band_mm = 0;  // pp-traj's settings
+
+  // The writable settings (the tuning points), in the units the points show: the loop fills them
+  // from what runs, the write gate from what it has accepted and the loop has not taken yet.
+  void set_writable(const core::DeadZone& dz, double lc_v, const control::TrajectoryConfig& traj, double mm_per_volt) noexcept {
+    m_r = dz.m_r, m_l = dz.m_l, b_r = dz.b_r, b_l = dz.b_l;
+    lc_mm = lc_v * mm_per_volt;
+    traj_speed_fraction = traj.speed_fraction;
+    traj_bandwidth_rad_s = traj.feedback_bandwidth_rad_s;
+    traj_hold_band_mm = traj.hold_band_v * mm_per_volt;
+  }
 };
 
 // The positioning interface's state (axis_words.hpp composes the status word from it).
