@@ -5,6 +5,7 @@
 
 #include <csignal>
 #include <ctime>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
@@ -200,8 +201,11 @@ void log_changes(const runtime::Snapshot& previous, const runtime::Snapshot& s) 
 // Each fault the loop latched, from its event, never from the snapshot (a reset in the next cycle
 // has cleared the snapshot's fault): logged with its cause, added to the history the interfaces
 // read, and handed to the store thread. Stamped with the wall clock now, less how long ago the
-// loop latched it.
+// loop latched it. Called by the supervisor on its tick and by every reader of the history before
+// it reads (FaultHistory::set_intake): the ring has one consumer at a time, whichever looks first.
 void take_fault_events(runtime::LoopChannels& channels, store::StoreWriter& store_writer) {
+  static std::mutex one_consumer;
+  std::lock_guard lock(one_consumer);
   std::vector<runtime::FaultEvent> events;
   runtime::FaultEvent e;
   while (channels.fault_events.try_pop(e)) events.push_back(e);
@@ -319,6 +323,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
 
   runtime::LoopChannels channels(runtime::record_capacity_samples(c.runtime));
   channels.fault_history.load(control->store.faults, control->store.fault_count);
+  channels.fault_history.set_intake([&channels, &store_writer] { take_fault_events(channels, store_writer); });
   runtime::MonotonicClock clock;
   runtime::ScanCycle loop(c.runtime, control->tuning, **daq, clock, channels);
   store_writer.start();

@@ -30,6 +30,7 @@ void FaultHistory::add(FaultRecord record) {
 }
 
 std::vector<FaultRecord> FaultHistory::newest(std::size_t limit, std::uint64_t* total) const {
+  take_in();
   std::lock_guard lock(mutex_);
   if (total) *total = total_;
   const std::size_t n = std::min(limit, entries_.size());
@@ -37,11 +38,13 @@ std::vector<FaultRecord> FaultHistory::newest(std::size_t limit, std::uint64_t* 
 }
 
 std::uint64_t FaultHistory::total() const {
+  take_in();
   std::lock_guard lock(mutex_);
   return total_;
 }
 
 std::uint64_t FaultHistory::copy_newest(std::span<FaultRecord> out) const {
+  take_in();
   std::lock_guard lock(mutex_);
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = i < entries_.size() ? entries_[i] : FaultRecord{};
   return total_;

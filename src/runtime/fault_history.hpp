@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <span>
@@ -41,6 +42,12 @@ std::int64_t fault_time_ms(const FaultEvent& event, double loop_now_s, std::int6
 
 class FaultHistory {
  public:
+  // Run before every read, outside the lock: adds what the loop has latched and nobody has added
+  // yet (serve drains the loop's fault-event ring with it). So a client that has read a fault in a
+  // snapshot finds it here at once, however quickly it was reset, instead of one supervisor tick
+  // (50 ms) later. Set before the reading threads start; it must be safe to call from several.
+  void set_intake(std::function<void()> intake) { intake_ = std::move(intake); }
+
   // What the store kept (newest first; only the newest kFaultHistoryEntries are used) and how many
   // faults it has recorded in all. Replaces what was there.
   void load(std::span<const FaultRecord> newest_first, std::uint64_t total);
@@ -55,6 +62,11 @@ class FaultHistory {
   std::uint64_t copy_newest(std::span<FaultRecord> out) const;
 
  private:
+  void take_in() const {
+    if (intake_) intake_();
+  }
+
+  std::function<void()> intake_;
   mutable std::mutex mutex_;
   std::deque<FaultRecord> entries_;  // newest first
   std::uint64_t total_ = 0;

@@ -220,5 +220,25 @@ TEST(FaultHistoryTest, NewestFirstAtMostSixtyFourWithTheTotalCount) {
   EXPECT_EQ(few[2].time_ms, 1067);
 }
 
+// A reader never sees the history behind the loop: each read first takes in what is pending
+// (serve's intake drains the loop's fault ring), so a fault reset within a cycle is already there
+// when the client that saw it latch asks.
+TEST(FaultHistoryTest, EveryReadTakesInThePendingFaultsFirst) {
+  FaultHistory h;
+  int pending = 2;
+  h.set_intake([&] {
+    for (; pending > 0; --pending) h.add(at(500 + pending, FaultCode::kSoftLimit));
+  });
+  EXPECT_EQ(h.total(), 2u);
+  pending = 1;
+  std::array<FaultRecord, 2> newest{};
+  EXPECT_EQ(h.copy_newest(newest), 3u);
+  EXPECT_EQ(newest[0].time_ms, 501);
+  pending = 1;
+  std::uint64_t total = 0;
+  EXPECT_EQ(h.newest(10, &total).size(), 4u);
+  EXPECT_EQ(total, 4u);
+}
+
 }  // namespace
 }  // namespace epa::runtime
