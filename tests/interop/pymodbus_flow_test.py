@@ -105,8 +105,8 @@ class FlowTest(unittest.TestCase):
 
     # ---- the map: addresses by point name ----
     def at(self, name, table, type_=None):
-        row = self.p.get(name)
-        self.assertIsNotNone(row, f"point {name} in the exported map")
+        row = self.p.get((name, table))
+        self.assertIsNotNone(row, f"point {name} ({table}) in the exported map")
         self.assertEqual(row["table"], table, f"{name}: table")
         if type_:
             self.assertEqual(row["type"], type_, f"{name}: type")
@@ -129,8 +129,8 @@ class FlowTest(unittest.TestCase):
 
     def write(self, name, value):
         """FC6 for a 16-bit point, FC16 for a float (ABCD)."""
-        row = self.p[name]
         a = self.at(name, "holding")
+        row = self.p[(name, "holding")]
         if row["type"] == "float32":
             return self.ok(self.c.write_registers(a, f32_words(value, "ABCD"), slave=UNIT), f"write {name} {value}")
         return self.ok(self.c.write_register(a, value, slave=UNIT), f"write {name} {value}")
@@ -192,7 +192,7 @@ class FlowTest(unittest.TestCase):
                              capture_output=True, text=True, timeout=30)
         self.assertEqual(out.returncode, 0, f"epa registers --csv: {out.stderr}")
         rows = list(csv.DictReader(io.StringIO(out.stdout)))
-        type(self).p = {r["point"]: r for r in rows}
+        type(self).p = {(r["point"], r["table"]): r for r in rows}  # `reset` is a holding register and a coil
         self.say(f"map: {len(rows)} points exported by `epa registers --csv`")
         for name, table, type_ in [("setpoint_mm", "holding", "float32"), ("mode", "holding", "uint16"),
                                    ("manual_valve_v", "holding", "float32"), ("heartbeat", "holding", "uint32"),
@@ -241,8 +241,8 @@ class FlowTest(unittest.TestCase):
         back = self.ok(self.c.read_holding_registers(base, 7, slave=UNIT), "read record 1").registers
         self.assertEqual(back, words, "record 1 reads back as written")
         base2 = self.at("record2_target_mm", "holding")
-        words2 = f32_words(40.0, "ABCD") + f32_words(60.0, "ABCD") + f32_words(0.0, "ABCD") + [255]
-        self.ok(self.c.write_registers(base2, words2, slave=UNIT), "record 2 (target 40, speed 60 mm/s) in one FC16")
+        words2 = f32_words(40.0, "ABCD") + f32_words(60.0, "ABCD") + f32_words(0.0, "ABCD") + [3]
+        self.ok(self.c.write_registers(base2, words2, slave=UNIT), "record 2 (target 40, speed 60 mm/s, law 3 pp-traj: made for a profile) in one FC16")
         self.write("record_select", 1)
         self.assertEqual(self.holding("record_select")[0], 1)
 
@@ -341,8 +341,15 @@ class FlowTest(unittest.TestCase):
         self.write("control_word", 0)
         self.assertEqual(self.holding("mode")[0], 0, "mode 0 (stop) after the reset")
         self.assertEqual(self.inputs("fault_code")[0], 0, "fault_code cleared")
-        count = u32_value(self.inputs("fault_history_count", 2))
-        self.assertEqual(count, count_before + 1, "fault_history_count")
+        # An HMI reads the history when the fault is gone (ready again): it should hold the fault then.
+        count_at_ready = u32_value(self.inputs("fault_history_count", 2))
+        t2 = time.monotonic()
+        count = count_at_ready
+        while count == count_before and time.monotonic() - t2 < 2.0:
+            time.sleep(0.005)
+            count = u32_value(self.inputs("fault_history_count", 2))
+        lag_ms = (time.monotonic() - t2) * 1000
+        self.assertEqual(count, count_before + 1, "fault_history_count (waited up to 2 s)")
         e = self.inputs("fault_0_code", 10)
         code, mode, when = e[0], e[1], u32_value(e[2:4])
         position, setpoint, valve = (f32_value(e[i:i + 2], "ABCD") for i in (4, 6, 8))
@@ -353,9 +360,13 @@ class FlowTest(unittest.TestCase):
         self.assertTrue(math.isfinite(setpoint), f"newest entry: setpoint {setpoint}")
         self.assertAlmostEqual(valve, 1.5, places=3, msg="newest entry: valve 1.5 V")
         self.say(f"fault: soft-limit latched {t_fault:.2f} s after valve 1.5 V, reset bit -> ready in "
-                 f"{t_reset * 1000:.0f} ms; history count {count}, newest: code {code}, mode {mode}, time {when}, "
+                 f"{t_reset * 1000:.0f} ms; history count at ready {count_at_ready}, {count} after {lag_ms:.0f} ms; newest: code {code}, mode {mode}, time {when}, "
                  f"position {position:.2f} mm, setpoint {setpoint:.2f} mm, valve {valve:.3f} V")
         self.assertEqual(self.hb.errors, [], "every heartbeat write answered")
+        self.assertEqual(count_at_ready, count_before + 1,
+                         f"DEVICE: fault_history_count read right after the reset (status ready, mode 0) was still "
+                         f"{count_at_ready}; the reset fault was counted {lag_ms:.0f} ms later (the reset bit was written "
+                         f"{(t1 - t0 - t_fault) * 1000:.0f} ms after fault_latched was read)")
 
 
 def main():
