@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages the project builds, tests, runs and benchmarks with. Idempotent:
-# it only calls apt-get when something is missing, so repeated runs cost nothing.
+# Installs the Debian 12 packages the project builds, tests, runs and benchmarks with, and the node
+# modules of tests/interop/node (npm ci from its package-lock.json). Idempotent:
+# it only calls apt-get (and npm) when something is missing, so repeated runs cost nothing.
 #
 #   scripts/install-deps.sh          # build, run and the whole test suite (scripts/run.sh, scripts/test.sh)
 #   scripts/install-deps.sh bench    # also what the benchmarks compare against (bench/, CI's smoke step)
@@ -25,6 +26,8 @@ packages=(
   # installs the Prometheus server as a service: the tests use promtool alone); sqlite3 is the
   # database's own shell, for looking into the tuning store (epa.db)
   python3 python3-pymodbus python3-serial-asyncio mbpoll chromium curl sqlite3 util-linux mount prometheus
+  # Node.js and npm: the modbus-serial interop test (tests/interop/node, its modules by `npm ci` below)
+  nodejs npm
 )
 bench_packages=(
   # bench/jitter_vs_cyclictest.sh: cyclictest is the scan cycle's timing peer
@@ -41,15 +44,27 @@ esac
 
 missing=()
 for p in "${packages[@]}"; do
+  # A nodejs from elsewhere (NodeSource's) bundles npm and conflicts with Debian's npm package:
+  # the commands on PATH count as installed.
+  case "$p" in nodejs) command -v node >/dev/null && continue ;; npm) command -v npm >/dev/null && continue ;; esac
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-[ ${#missing[@]} -eq 0 ] && exit 0
 
-sudo=""
-if [ "$(id -u)" -ne 0 ]; then
-  command -v sudo >/dev/null || { echo "install-deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
-  sudo="sudo"
+if [ ${#missing[@]} -gt 0 ]; then
+  sudo=""
+  if [ "$(id -u)" -ne 0 ]; then
+    command -v sudo >/dev/null || { echo "install-deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+    sudo="sudo"
+  fi
+  echo "install-deps: installing ${missing[*]}"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
-echo "install-deps: installing ${missing[*]}"
-$sudo apt-get update -qq
-DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+
+# The modbus-serial interop test's node modules, exactly as package-lock.json pins them (from the npm
+# registry); again only when they are missing or older than the lockfile.
+node_dir="$(cd "$(dirname "$0")/.." && pwd)/tests/interop/node"
+if [ ! "$node_dir/node_modules/.package-lock.json" -nt "$node_dir/package-lock.json" ]; then
+  echo "install-deps: npm ci in $node_dir"
+  (cd "$node_dir" && npm ci --no-audit --no-fund)
+fi

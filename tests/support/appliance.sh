@@ -54,3 +54,42 @@ abort() {  # a failure the later checks cannot recover from
 }
 
 free_port() { python3 -c "import socket; s=socket.socket(); s.bind(('127.0.0.1',0)); print(s.getsockname()[1])"; }
+
+unlock_key="5e3a9c17d24b086f"  # [modbus] unlock_key of the test appliances (as tests/support/epa_appliance.py)
+
+# Starts `epa serve` (mode STOP, simulated plant) on a free loopback port: writes "$tmp/epa.toml"
+# with the register map $1, the tests' unlock key, no web server, and the TOML text $2 appended
+# (e.g. a [limits] section), logs to "$tmp/epa.log", and waits (at most 10 s) until it accepts TCP
+# connections. Sets `port` and `pid`; aborts when it exits or never listens.
+start_appliance() {
+  local map=$1 extra=${2:-}
+  port=$(free_port)
+  cat >"$tmp/epa.toml" <<CONFIG
+# written by tests/support/appliance.sh
+[modbus]
+address = "127.0.0.1"
+port = $port
+register_map = "$map"
+unlock_key = "$unlock_key"
+
+[web]
+enabled = false
+
+[log]
+status_interval_s = 0
+
+[recorder]
+directory = "$tmp/runs"
+$extra
+CONFIG
+  "$epa" serve --config "$tmp/epa.toml" --db "$tmp/epa.db" --mode stop >"$tmp/epa.log" 2>&1 &
+  pid=$!
+  echo "appliance pid $pid on 127.0.0.1:$port (config $tmp/epa.toml)"
+  local deadline=$(( $(now_ms) + 10000 ))
+  while [ "$(now_ms)" -lt "$deadline" ]; do
+    kill -0 "$pid" 2>/dev/null || abort "the appliance exited during start-up"
+    if (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null; then return 0; fi
+    sleep 0.05
+  done
+  abort "the appliance did not accept connections on 127.0.0.1:$port within 10 s"
+}

@@ -2,7 +2,7 @@
 under /usr/bin/python3 when another python3 comes first in PATH), float/uint32 encoding with an
 explicit word order, a free loopback port, and `epa serve` as a child process that is stopped by
 its PID (SIGTERM, SIGKILL after 5 s) or killed outright, and can be started again on the same
-folder, port and database.
+folder, port and database; and a supervising client's heartbeat on its own connection.
 """
 import os
 import sys
@@ -27,6 +27,7 @@ import socket
 import struct
 import subprocess
 import tempfile
+import threading
 import time
 
 from pymodbus.client import ModbusTcpClient
@@ -201,3 +202,43 @@ class Appliance:
         shutil.rmtree(self.dir, ignore_errors=True)
 
 
+
+
+class Heartbeat:
+    """What a supervising HMI does while it is connected: increments the `heartbeat` uint32 (holding
+    6-7 of registers/epa.csv, ABCD) every `every_s` on its own connection, in a thread. `pause()` and
+    `resume()` stop and restart the beat (a client that went away); `close()` ends the thread.
+    `errors` lists the writes that were not answered normally."""
+
+    def __init__(self, port, address=6, every_s=0.2):
+        self.address, self.every_s = address, every_s
+        self.client = ModbusTcpClient(HOST, port=port, timeout=2, retries=1)
+        if not self.client.connect():
+            raise RuntimeError(f"heartbeat: pymodbus could not connect to {HOST}:{port}")
+        self.count = 0
+        self.errors = []
+        self.beating = threading.Event()
+        self.beating.set()
+        self.stopping = threading.Event()
+        self.thread = threading.Thread(target=self._run, daemon=True)
+        self.thread.start()
+
+    def _run(self):
+        while not self.stopping.is_set():
+            if self.beating.is_set():
+                self.count += 1
+                rr = self.client.write_registers(self.address, u32_words(self.count & 0xFFFFFFFF), slave=UNIT)
+                if rr.isError():
+                    self.errors.append(str(rr))
+            self.stopping.wait(self.every_s)
+
+    def pause(self):
+        self.beating.clear()
+
+    def resume(self):
+        self.beating.set()
+
+    def close(self):
+        self.stopping.set()
+        self.thread.join(timeout=5)
+        self.client.close()

@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# Interoperability: the npm package modbus-serial (Node.js), the whole integration an HMI does
+# (tests/interop/node/flow_test.js says which steps), against a running appliance on the
+# simulated plant.
+#
+#   modbus_serial_test.sh <epa binary> <source dir>
+#
+# Needs node and tests/interop/node/node_modules (scripts/install-deps.sh runs `npm ci` there from
+# the committed package-lock.json). Starts `epa serve` on a free loopback port with
+# registers/epa.csv, [limits] soft_max_mm = 300 (a fault can be caused) and heartbeat_timeout_s = 5
+# (the script keeps a heartbeat), runs the flow, then stops the appliance by its PID (SIGTERM,
+# SIGKILL after 5 s) and expects exit status 0. Exit 0: all passed; 1: a step failed (named).
+set -uo pipefail
+
+if [ $# -ne 2 ]; then
+  echo "usage: $0 <epa binary> <source dir>" >&2
+  exit 2
+fi
+epa=$1
+src=$2
+node_dir="$(cd "$(dirname "$0")" && pwd)/node"
+
+command -v node >/dev/null || { echo "FAIL: node is not installed (scripts/install-deps.sh installs nodejs and npm)" >&2; exit 1; }
+command -v python3 >/dev/null || { echo "FAIL: python3 is needed to pick a free port" >&2; exit 1; }
+[ -f "$node_dir/node_modules/modbus-serial/package.json" ] \
+  || { echo "FAIL: $node_dir/node_modules has no modbus-serial: run scripts/install-deps.sh (npm ci there)" >&2; exit 1; }
+[ -x "$epa" ] || { echo "FAIL: $epa is not an executable" >&2; exit 1; }
+
+source "$(dirname "$0")/../support/appliance.sh" modbus-serial
+
+echo "node $(node --version), modbus-serial $(node -p "require('$node_dir/node_modules/modbus-serial/package.json').version")"
+start_appliance "$src/registers/epa.csv" "[limits]
+soft_max_mm = 300.0
+setpoint_max_mm = 290.0
+heartbeat_timeout_s = 5.0"
+
+timeout 100 node "$node_dir/flow_test.js" "$epa" "$src" 127.0.0.1 "$port"
+rc=$?
+if [ $rc -eq 0 ]; then pass "the modbus-serial flow"; else fail "the modbus-serial flow exited with status $rc"; fi
+
+if kill -0 "$pid" 2>/dev/null; then
+  stop_appliance
+  status=$?
+  if [ $status -eq 0 ]; then pass "appliance stopped on SIGTERM with exit status 0"; else fail "appliance stop: exit status $status after SIGTERM"; fi
+else
+  fail "the appliance died during the test"
+  pid=""
+fi
+
+[ "$failed" -eq 0 ] || show_log
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
