@@ -1,8 +1,7 @@
 #include "web/command_body.hpp"
 
-#include <algorithm>
-#include <iterator>
 #include <nlohmann/json.hpp>
+#include <utility>
 
 #include "control/controller_kind.hpp"
 #include "points/point_catalog.hpp"
@@ -61,9 +60,10 @@ CommandBody record_body(const json& j) {
   CommandBody out;
   for (const auto& [k, v] : j.items()) {
     if (k == "record") continue;
-    const auto* f = std::find_if(std::begin(kFields), std::end(kFields), [&k](const auto& field) { return k == field.first; });
-    if (f == std::end(kFields))
-      return malformed("unknown field '" + k + "' (a record has target_mm, speed_mm_s, window_mm, controller)");
+    const std::pair<const char*, P>* f = nullptr;
+    for (const auto& field : kFields)
+      if (k == field.first) f = &field;
+    if (!f) return malformed("unknown field '" + k + "' (a record has target_mm, speed_mm_s, window_mm, controller)");
     const P id = points::indexed_id(f->second, i);
     std::string error;
     auto value = value_of(id, v, error);
