@@ -81,8 +81,22 @@ function showStatus(s) {
   setText("lm-settling", m ? `${fmt(m.settling_s, 3)}${m.settling_s === null ? "" : " s"}` : "–");
   setText("lm-ess", m ? `${fmt(m.ess_mm, 2)}${m.ess_mm === null ? "" : " mm"}` : "–");
   setText("lm-overshoot", m ? `${fmt(m.overshoot_pct, 1)}${m.overshoot_pct === null ? "" : " %"}` : "–");
+  showStatusBits(s);
+  document.dispatchEvent(new CustomEvent("epa-status", { detail: s }));  // commands.js
   document.body.dataset.positionMm = Number.isFinite(s.position_mm) ? s.position_mm.toFixed(3) : "";
   document.body.dataset.mode = s.mode;
+}
+
+// The status word's bits as lamps (data-on "1"/"0" for the browser test), the word in hex.
+function showStatusBits(s) {
+  if (s.status_word === undefined) return;
+  setText("sb-word", "0x" + s.status_word.toString(16).toUpperCase().padStart(4, "0"));
+  for (const [bit, on] of Object.entries(s.status_bits)) {
+    const lamp = $(`sb-${bit}`);
+    if (!lamp) continue;
+    lamp.classList.toggle("on", on);
+    lamp.dataset.on = on ? "1" : "0";
+  }
 }
 
 function showTrend(t) {

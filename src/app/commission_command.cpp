@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "app/appliance_http.hpp"
 #include "app/output_file.hpp"
 #include "core/text_file.hpp"
 
@@ -38,14 +39,6 @@ std::string progress_bar(double percent) {
   return "[" + std::string(static_cast<std::size_t>(filled), '#') + std::string(static_cast<std::size_t>(width - filled), '.') + "]";
 }
 
-// The JSON error message of the appliance's answer, or the HTTP failure.
-std::string why(const httplib::Result& r) {
-  if (!r) return "no answer: " + httplib::to_string(r.error());
-  const auto j = nlohmann::json::parse(r->body, nullptr, false);
-  if (j.is_object() && j.contains("error") && j["error"].is_string()) return "HTTP " + std::to_string(r->status) + ": " + j["error"].get<std::string>();
-  return "HTTP " + std::to_string(r->status);
-}
-
 }  // namespace
 
 int run_commission(const CommissionOptions& o, std::ostream& out, std::ostream& err) {
@@ -56,14 +49,13 @@ int run_commission(const CommissionOptions& o, std::ostream& out, std::ostream& 
     if (!text) return fail(text.error().message);
     spec = *text;
   }
-  httplib::Client client(o.url);
-  if (!client.is_valid()) return fail("--url '" + o.url + "' is not http://HOST:PORT");
-  client.set_connection_timeout(5, 0);
-  client.set_read_timeout(10, 0);
-  const httplib::Headers auth = {{"Authorization", "Bearer " + o.token}};
+  auto made = appliance_client(o.url);
+  if (!made) return fail(made.error().message);
+  httplib::Client& client = **made;
+  const httplib::Headers auth = bearer(o.token);
 
   auto started = client.Post("/api/commission", auth, spec, "application/json");
-  if (!started || started->status != 202) return fail("the appliance refused to start: " + why(started));
+  if (!started || started->status != 202) return fail("the appliance refused to start: " + http_failure(started, o.url));
   out << "commissioning started on " << o.url << (o.spec_path.empty() ? " with the default spec" : " with " + o.spec_path) << "\n";
 
   auto* previous = std::signal(SIGINT, on_interrupt);
@@ -77,13 +69,13 @@ int run_commission(const CommissionOptions& o, std::ostream& out, std::ostream& 
     if ((interrupted || late) && !abort_sent) {
       err << "\n" << (late ? "timeout" : "interrupted") << ": aborting the commissioning run\n";
       auto a = client.Post("/api/commission/abort", auth, "", "application/json");
-      if (!a || a->status != 200) err << "abort: " << why(a) << "\n";
+      if (!a || a->status != 200) err << "abort: " << http_failure(a, o.url) << "\n";
       abort_sent = true;
     }
     auto r = client.Get("/api/commission");
     if (!r || r->status != 200) {
       std::signal(SIGINT, previous);
-      return fail("progress: " + why(r));
+      return fail("progress: " + http_failure(r, o.url));
     }
     status = nlohmann::json::parse(r->body, nullptr, false);
     if (!status.is_object()) continue;
@@ -97,14 +89,14 @@ int run_commission(const CommissionOptions& o, std::ostream& out, std::ostream& 
   err << "\n";
 
   auto result = client.Get("/api/commission/result");
-  if (!result || result->status != 200) return fail("the outcome: " + why(result));
+  if (!result || result->status != 200) return fail("the outcome: " + http_failure(result, o.url));
   const auto outcome = nlohmann::json::parse(result->body, nullptr, false);
   if (!outcome.is_object()) return fail("the outcome is not JSON");
   if (!o.json_path.empty())
     if (auto s = write_output(o.json_path, result->body, out); !s) return fail(s.error().message);
   if (!o.report_path.empty()) {
     auto report = client.Get("/api/commission/report");
-    if (!report || report->status != 200) return fail("the report: " + why(report));
+    if (!report || report->status != 200) return fail("the report: " + http_failure(report, o.url));
     if (auto s = write_output(o.report_path, report->body, out); !s) return fail(s.error().message);
   }
   const std::string verdict = outcome.value("verdict", std::string());

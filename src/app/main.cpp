@@ -11,6 +11,7 @@
 #include "app/faults_command.hpp"
 #include "app/identify_command.hpp"
 #include "app/plant_server_command.hpp"
+#include "app/records_command.hpp"
 #include "app/registers_command.hpp"
 #include "app/serve_command.hpp"
 #include "app/simulate_command.hpp"
@@ -42,6 +43,8 @@ int main(int argc, char** argv) {
   CLI::App* faults_command = epa::app::add_faults_command(app, faults);
   epa::app::CommissionOptions commission;
   epa::app::add_commission_command(app, commission);
+  epa::app::RecordsOptions records;
+  CLI::App* records_command = epa::app::add_records_command(app, records);
   epa::app::DiagnoseOptions diagnose;
   epa::app::add_diagnose_command(app, diagnose);
   try {
@@ -59,6 +62,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("serve")) return epa::app::run_serve(serve, std::cerr);
     if (app.got_subcommand("registers")) return epa::app::run_registers(registers, std::cout, std::cerr);
     if (app.got_subcommand("tuning")) return epa::app::run_tuning(app, tuning, std::cout, std::cerr);
+    if (app.got_subcommand(records_command)) return epa::app::run_records(records, std::cout, std::cerr);
     if (app.got_subcommand(faults_command)) return epa::app::run_faults(faults, std::cout, std::cerr);
     if (app.got_subcommand("plant-server")) return epa::app::run_plant_server(plant_server, std::cout, std::cerr);
   } catch (const std::exception& e) {  // third-party code (CLI11, JSON, filesystem) at the edge

@@ -1,9 +1,11 @@
 #include "web/command_body.hpp"
 
 #include <nlohmann/json.hpp>
+#include <utility>
 
 #include "control/controller_kind.hpp"
 #include "points/point_catalog.hpp"
+#include "points/record_controller.hpp"
 #include "runtime/mode.hpp"
 
 namespace epa::web {
@@ -12,6 +14,7 @@ namespace {
 
 using nlohmann::json;
 using P = points::PointId;
+using points::RecordField;
 
 CommandBody malformed(std::string message) { return {std::move(message), {}}; }
 
@@ -32,8 +35,43 @@ std::optional<double> value_of(P id, const json& v, std::string& error) {
     error = point + ": " + c.error().message;
     return std::nullopt;
   }
+  RecordField field;
+  if (v.is_string() && record_field(id, field) && field.kind == RecordField::kController) {
+    auto c = points::parse_record_controller(v.get<std::string>());
+    if (c) return static_cast<double>(*c);
+    error = point + ": " + c.error().message;
+    return std::nullopt;
+  }
   error = point + " must be a number";
   return std::nullopt;
+}
+
+// POST /api/records: the record's number, then its fields as the record<N>_* points.
+CommandBody record_body(const json& j) {
+  constexpr std::pair<const char*, P> kFields[] = {{"target_mm", P::kRecordTarget0}, {"speed_mm_s", P::kRecordSpeed0},
+                                                   {"window_mm", P::kRecordWindow0}, {"controller", P::kRecordController0}};
+  const std::string range = "1.." + std::to_string(points::kPositionRecords);
+  const auto number = j.find("record");
+  if (number == j.end()) return malformed("name the record: {\"record\": " + range + ", \"target_mm\": ...}");
+  if (!number->is_number_integer() || number->get<std::int64_t>() < 1 ||
+      number->get<std::int64_t>() > static_cast<std::int64_t>(points::kPositionRecords))
+    return malformed("record must be a whole number " + range + ", not " + number->dump());
+  const auto i = static_cast<std::size_t>(number->get<std::int64_t>() - 1);
+  CommandBody out;
+  for (const auto& [k, v] : j.items()) {
+    if (k == "record") continue;
+    const std::pair<const char*, P>* f = nullptr;
+    for (const auto& field : kFields)
+      if (k == field.first) f = &field;
+    if (!f) return malformed("unknown field '" + k + "' (a record has target_mm, speed_mm_s, window_mm, controller)");
+    const P id = points::indexed_id(f->second, i);
+    std::string error;
+    auto value = value_of(id, v, error);
+    if (!value) return malformed(error);
+    out.writes.push_back({id, *value});
+  }
+  if (out.writes.empty()) return malformed("give at least one of target_mm, speed_mm_s, window_mm, controller for record " + std::to_string(i + 1));
+  return out;
 }
 
 }  // namespace
@@ -65,6 +103,7 @@ CommandBody parse_command_body(CommandEndpoint endpoint, const std::string& body
     if (!v) return malformed(error);
     return {"", {{id, *v}}};
   }
+  if (endpoint == CommandEndpoint::kRecord) return record_body(j);
   // /api/points: any writable points, one group.
   if (j.empty()) return malformed("name at least one point, e.g. {\"" + std::string(points::name(P::kSetpoint)) + "\": 120}");
   CommandBody out;

@@ -5,7 +5,11 @@
 //   POST /api/mode      {"mode": "run"}            (stop, run, manual)
 //   POST /api/reset     {}
 //   POST /api/points    {"<point>": value, ...}    any writable points as one group, by their
-//                       catalog names; mode and controller also by name ("run", "pp-ffidz")
+//                       catalog names; mode and controller also by name ("run", "pp-ffidz"), a
+//                       record's controller also "running"
+//   POST /api/records   {"record": 3, "target_mm": 120, "speed_mm_s": 50, "window_mm": 0.5,
+//                        "controller": "pp-traj"}  one record's fields (any of the four), one group:
+//                       the same points as record3_target_mm ... through /api/points
 #include <string>
 #include <vector>
 
@@ -13,7 +17,7 @@
 
 namespace epa::web {
 
-enum class CommandEndpoint { kSetpoint, kMode, kReset, kPoints };
+enum class CommandEndpoint { kSetpoint, kMode, kReset, kPoints, kRecord };
 
 struct CommandBody {
   std::string error;  // set: the body is malformed (HTTP 400), naming what was expected

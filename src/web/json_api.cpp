@@ -7,6 +7,7 @@
 #include "core/version.hpp"
 #include "core/utc_stamp.hpp"
 #include "points/point_catalog.hpp"
+#include "points/record_controller.hpp"
 #include "runtime/mode.hpp"
 
 namespace epa::web {
@@ -35,10 +36,19 @@ json poly(const std::array<double, control::kMaxLawOrder + 1>& c, std::size_t n)
   return a;
 }
 
+// The status word (points::status_word) packed and bit by bit, each bit by its point's name.
+json status_bits(std::uint16_t word) {
+  json bits = json::object();
+  for (int i = 0; i < runtime::kStatusBits; ++i)
+    bits[k(points::indexed_id(P::kStatusBit0, static_cast<std::size_t>(i)))] = (word & (1u << i)) != 0;
+  return bits;
+}
+
 }  // namespace
 
 std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled, const StoreStats& store) {
   const bool faulted = s.mode == runtime::Mode::kFault;
+  const std::uint16_t word = points::status_word(s, store.ok);
   json j = {
       {"version", std::string(core::kVersion)},
       {"cycle", s.cycle},
@@ -80,6 +90,9 @@ std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, b
        {{"enabled", store.enabled}, {"ok", store.ok}, {"accepted", store.accepted}, {"saved", store.saved},
         {"last_error", store.last_error.empty() ? json(nullptr) : json(store.last_error)},
         {"tuning_set", store.enabled ? json(store.tuning_set) : json(nullptr)}}},
+      {k(P::kStatusWord), word},
+      {"status_bits", status_bits(word)},
+      {k(P::kControlWord), s.axis.control_word},
       {"commands_enabled", commands_enabled},
   };
   return j.dump();
@@ -159,6 +172,16 @@ std::string points_json(const points::WriteLimits& limits) {
     a.push_back(std::move(e));
   }
   return json{{"points", std::move(a)}}.dump();
+}
+
+std::string records_json(const points::PositionRecords& records, int record_select) {
+  json a = json::array();
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const auto& r = records[i];
+    a.push_back({{"record", i + 1}, {"target_mm", num(r.target_mm)}, {"speed_mm_s", num(r.speed_mm_s)},
+                 {"window_mm", num(r.window_mm)}, {"controller", points::record_controller_name(r.controller)}});
+  }
+  return json{{"records", std::move(a)}, {k(P::kRecordSelect), record_select}}.dump();
 }
 
 std::string error_json(const std::string& message) { return json{{"error", message}}.dump(); }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/audit.hpp"
+#include "points/position_records.hpp"
 #include "points/write_limits.hpp"
 #include "runtime/fault_history.hpp"
 #include "runtime/snapshot.hpp"
@@ -31,6 +32,8 @@ struct StoreStats {
   std::string tuning_set;        // the running set's name
 };
 
+// With the status word as "status_word" and bit by bit in "status_bits" (ready, run_enabled, ...:
+// the bits' point names), and the control word as the loop applied it.
 std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled,
                         const StoreStats& store = {});
 std::string trend_json(const std::vector<TrendPoint>& points, const runtime::Snapshot& s);
@@ -45,6 +48,10 @@ std::string faults_json(std::uint64_t count, const std::vector<runtime::FaultRec
                         std::optional<std::uint64_t> dropped = std::nullopt);
 // The point catalog with each writable point's range as the write gate applies it.
 std::string points_json(const points::WriteLimits& limits);
+// The position-record table: {"records": [{"record": 1..32, "target_mm", "speed_mm_s" (0: no limit),
+// "window_mm" (0: the configured window), "controller" (a law's name, or "running")}, ...],
+// "record_select": the record a start takes (0: the setpoint)}.
+std::string records_json(const points::PositionRecords& records, int record_select);
 std::string error_json(const std::string& message);
 
 }  // namespace epa::web

@@ -271,6 +271,10 @@ struct WebServer::Impl {
       if (!gate) return send_error(res, 404, "no point catalog on this server");
       res.set_content(points_json(gate->limits()), kJson);
     });
+    s.Get("/api/records", [this](const httplib::Request&, httplib::Response& res) {
+      if (!gate) return send_error(res, 404, "no position-record table on this server (no write gate)");
+      res.set_content(records_json(gate->records(), gate->record_select()), kJson);
+    });
     s.Get("/api/audit", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(audit_json(audit ? audit->entries() : std::vector<core::AuditEntry>{}), kJson);
     });
@@ -293,6 +297,7 @@ struct WebServer::Impl {
     s.Post("/api/mode", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kMode, q, r); });
     s.Post("/api/reset", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kReset, q, r); });
     s.Post("/api/points", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kPoints, q, r); });
+    s.Post("/api/records", [this](const httplib::Request& q, httplib::Response& r) { command(CommandEndpoint::kRecord, q, r); });
     commission_routes();
     s.Get(R"(/.*)", [this](const httplib::Request& q, httplib::Response& r) { serve_static(q, r); });  // last: the page
 

@@ -1,9 +1,9 @@
 #pragma once
 // The status page's HTTP server (cpp-httplib): the JSON API, /metrics, the page's static files
 // and Chart.js, and, when a token is configured, the commands (setpoint, mode, reset, and any
-// writable point through /api/points), each decided by the one write gate. It reads only
-// the published snapshot and keeps its own buffers (a sampler thread fills the 30 s trend), so it
-// cannot slow the scan cycle; workers started per connection up to a cap (elastic_task_queue.hpp),
+// writable point through /api/points, a position record through /api/records), each decided by
+// the one write gate. It reads only the published snapshot and keeps its own buffers (a sampler
+// thread fills the 30 s trend), so it cannot slow the scan cycle; workers started per connection up to a cap (elastic_task_queue.hpp),
 // a deadline per request (deadline_http_server.hpp), caps on the request head and body, and a token
 // back-off bound what a crowd of clients can cost.
 #include <functional>

@@ -32,20 +32,12 @@ command -v curl >/dev/null || command -v python3 >/dev/null || { echo "FAIL: nee
 mkdir -p "$artifacts"
 
 source "$(dirname "$0")/../support/appliance.sh" browser
+source "$(dirname "$0")/../support/chromium.sh"
 
 http_get() { curl -s --max-time 2 "$1" 2>/dev/null; }
 
-# Chromium, headless, in a fresh profile each time, bounded by `timeout`; its stderr is noise.
-browser() {
-  local profile
-  profile=$(mktemp -d "$tmp/chromium.XXXXXX")
-  timeout 60 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run \
-    --disable-background-networking --disable-component-update --disable-sync --hide-scrollbars \
-    --user-data-dir="$profile" "$@" 2>>"$tmp/chromium.log"
-}
 # The page after 3 s of its own polling (virtual time: chromium runs the timers and fetches).
 dump_dom() { browser --virtual-time-budget=3000 --dump-dom "$url"; }
-body_attr() { grep -o "<body[^>]*>" | grep -o "$1=\"[^\"]*\"" | head -1 | cut -d'"' -f2; }
 
 # The page as shipped plus a layout probe: after the page's first polls it measures the
 # recent-moves table with its rows, then with the widest rows the page can write ("never",

@@ -165,6 +165,36 @@ TEST_F(WebServerTest, StatusShowsThePublishedSnapshotWithNanAsNull) {
   EXPECT_EQ(s["version"], std::string(epa::core::kVersion));  // project(... VERSION) in CMakeLists.txt
 }
 
+// The status word as the register map has it (points::status_word), packed and as named bits, and
+// the control word as the loop applied it.
+TEST_F(WebServerTest, StatusCarriesTheStatusWordPackedAndBitByBit) {
+  snap_.axis.in_position = true;
+  snap_.axis.target_reached = true;
+  snap_.axis.control_word = epa::runtime::kControlStart;
+  start();
+  const json s = get_json("/api/status");
+  // ready (bit 0), run_enabled (1), in_position (3), target_reached (4)
+  EXPECT_EQ(s["status_word"], 0x1B);
+  EXPECT_EQ(s["status_word"], epa::points::status_word(snap_, true));
+  EXPECT_EQ(s["control_word"], 1);
+  const std::map<std::string, bool> expected = {
+      {"ready", true}, {"run_enabled", true}, {"moving", false}, {"in_position", true}, {"target_reached", true},
+      {"following_error", false}, {"warning", false}, {"fault_latched", false}, {"ack", false}, {"halted", false},
+      {"jogging", false}, {"manual_mode", false}};
+  ASSERT_EQ(s["status_bits"].size(), expected.size()) << s["status_bits"];
+  for (const auto& [bit, on] : expected) EXPECT_EQ(s["status_bits"][bit], on) << bit;
+
+  snap_.mode = epa::runtime::Mode::kManual;
+  snap_.axis = {};
+  snap_.axis.jogging = snap_.axis.moving = true;
+  channels_.snapshot.publish(snap_);
+  const json m = get_json("/api/status");
+  EXPECT_EQ(m["status_word"], (1 << 0) | (1 << 2) | (1 << 10) | (1 << 11));
+  EXPECT_FALSE(m["status_bits"]["run_enabled"].get<bool>());
+  EXPECT_TRUE(m["status_bits"]["jogging"].get<bool>());
+  EXPECT_TRUE(m["status_bits"]["manual_mode"].get<bool>());
+}
+
 TEST_F(WebServerTest, StatusNamesALatchedFaultInWords) {
   start();
   snap_.mode = epa::runtime::Mode::kFault;
@@ -322,7 +352,7 @@ TEST_F(WebServerTest, MetricsAreValidPrometheusText) {
 
 TEST_F(WebServerTest, WithoutATokenEveryPostIsForbidden) {
   start();
-  for (const char* path : {"/api/setpoint", "/api/mode", "/api/reset"}) {
+  for (const char* path : {"/api/setpoint", "/api/mode", "/api/reset", "/api/points", "/api/records"}) {
     auto res = post(path, "{}", "anything");
     ASSERT_TRUE(res);
     EXPECT_EQ(res->status, 403) << path;
@@ -444,6 +474,102 @@ TEST_F(WebServerTest, CommandsAreValidatedLikeModbusWrites) {
   auto reset = post("/api/reset", "", "t");  // reset is what a latched fault needs
   ASSERT_TRUE(reset);
   EXPECT_EQ(reset->status, 200);
+}
+
+// GET /api/records: the table as the gate holds it, read without a token; a write through
+// /api/points shows at once (read after write, before the loop took it).
+TEST_F(WebServerTest, RecordsListTheTableAsTheGateHoldsIt) {
+  start("t");
+  const json empty = get_json("/api/records");
+  ASSERT_EQ(empty["records"].size(), epa::points::kPositionRecords);
+  EXPECT_EQ(empty["record_select"], 0);
+  for (std::size_t i = 0; i < epa::points::kPositionRecords; ++i) {
+    const json& r = empty["records"][i];
+    EXPECT_EQ(r["record"], i + 1);
+    EXPECT_EQ(r["target_mm"], 0.0);
+    EXPECT_EQ(r["speed_mm_s"], 0.0);
+    EXPECT_EQ(r["window_mm"], 0.0);
+    EXPECT_EQ(r["controller"], "running");
+  }
+  auto res = post("/api/points",
+                  R"({"record3_target_mm": 120.5, "record3_speed_mm_s": 50, "record3_window_mm": 0.5,
+                      "record3_controller": "pp-traj", "record_select": 3, "record4_controller": 1})", "t");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  const json after = get_json("/api/records");
+  EXPECT_EQ(after["record_select"], 3);
+  const json& r3 = after["records"][2];
+  EXPECT_EQ(r3["record"], 3);
+  EXPECT_DOUBLE_EQ(r3["target_mm"].get<double>(), 120.5);
+  EXPECT_DOUBLE_EQ(r3["speed_mm_s"].get<double>(), 50.0);
+  EXPECT_DOUBLE_EQ(r3["window_mm"].get<double>(), 0.5);
+  EXPECT_EQ(r3["controller"], "pp-traj");
+  EXPECT_EQ(after["records"][3]["controller"], "pp-ngidz");
+  EXPECT_EQ(after["records"][1]["target_mm"], 0.0);  // its neighbours untouched
+  EXPECT_EQ(after["records"][3]["target_mm"], 0.0);
+}
+
+// POST /api/records: one record's fields as its record<N>_* points in one gate group, all or
+// nothing; a malformed body is 400 naming what was wrong, before the gate sees it.
+TEST_F(WebServerTest, ARecordIsWrittenAsOneGroupAllOrNothing) {
+  start("t");
+  auto ok = post("/api/records", R"({"record": 5, "target_mm": 200, "speed_mm_s": 10, "window_mm": 2, "controller": "pp"})", "t");
+  ASSERT_TRUE(ok);
+  ASSERT_EQ(ok->status, 200) << ok->body;
+  auto record5 = [this] { return get_json("/api/records")["records"][4]; };
+  EXPECT_DOUBLE_EQ(record5()["target_mm"].get<double>(), 200.0);
+  EXPECT_DOUBLE_EQ(record5()["speed_mm_s"].get<double>(), 10.0);
+  EXPECT_DOUBLE_EQ(record5()["window_mm"].get<double>(), 2.0);
+  EXPECT_EQ(record5()["controller"], "pp");
+  std::set<std::string> audited;
+  for (const auto& e : audit_.entries()) audited.insert(e.point);
+  EXPECT_EQ(audited, (std::set<std::string>{"record5_target_mm", "record5_speed_mm_s", "record5_window_mm", "record5_controller"}));
+  auto some = post("/api/records", R"({"record": 5, "controller": "running"})", "t");  // the others kept
+  ASSERT_TRUE(some);
+  ASSERT_EQ(some->status, 200) << some->body;
+  EXPECT_EQ(record5()["controller"], "running");
+  EXPECT_DOUBLE_EQ(record5()["target_mm"].get<double>(), 200.0);
+
+  // Refused by the gate: the whole group, with the gate's reason.
+  const std::pair<const char*, const char*> refused[] = {
+      {R"({"record": 5, "target_mm": 300, "window_mm": 1000})", "record5_window_mm"},
+      {R"({"record": 5, "target_mm": 600, "window_mm": 1})", "setpoint range [0, 500]"},
+      {R"({"record": 5, "target_mm": 300, "controller": 7})", "record5_controller"},
+  };
+  for (const auto& [body, named] : refused) {
+    auto res = post("/api/records", body, "t");
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 400) << body;
+    EXPECT_NE(json::parse(res->body)["error"].get<std::string>().find(named), std::string::npos) << body << ": " << res->body;
+    EXPECT_DOUBLE_EQ(record5()["target_mm"].get<double>(), 200.0) << body;
+    EXPECT_DOUBLE_EQ(record5()["window_mm"].get<double>(), 2.0) << body;
+  }
+  // Malformed: named before the gate sees it.
+  const std::pair<const char*, const char*> malformed[] = {
+      {R"({"record": 5, "target_mm": 300, "speed": 3})", "unknown field 'speed'"},
+      {R"({"target_mm": 300})", "name the record"},
+      {R"({"record": 0, "target_mm": 300})", "record must be a whole number 1..32, not 0"},
+      {R"({"record": 33, "target_mm": 300})", "not 33"},
+      {R"({"record": "5", "target_mm": 300})", "not \"5\""},
+      {R"({"record": 2.5, "target_mm": 300})", "not 2.5"},
+      {R"({"record": 5})", "give at least one of"},
+      {R"({"record": 5, "target_mm": "far"})", "record5_target_mm must be a number"},
+      {R"({"record": 5, "controller": "pp-fast"})", "unknown controller 'pp-fast'"},
+      {R"([5])", "JSON object"},
+  };
+  const auto entries_before = audit_.entries().size();
+  for (const auto& [body, named] : malformed) {
+    auto res = post("/api/records", body, "t");
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 400) << body;
+    EXPECT_NE(json::parse(res->body)["error"].get<std::string>().find(named), std::string::npos) << body << ": " << res->body;
+  }
+  EXPECT_EQ(audit_.entries().size(), entries_before);
+  EXPECT_DOUBLE_EQ(record5()["target_mm"].get<double>(), 200.0);
+  auto wrong = post("/api/records", R"({"record": 5, "target_mm": 300})", "T");
+  ASSERT_TRUE(wrong);
+  EXPECT_EQ(wrong->status, 401);
+  EXPECT_DOUBLE_EQ(record5()["target_mm"].get<double>(), 200.0);
 }
 
 // Mode EXCITE over HTTP: by its name, from STOP only (409 otherwise, naming why); its time left in the status.
