@@ -318,6 +318,11 @@ GateResult WriteGate::submit(std::span<const PointWrite> writes, const Requester
     const PointDef& p = point(w.id);
     if (!p.audited) continue;
     core::AuditEntry e{time_ms, who.source, std::string(p.name), p.value(ctx), w.value};
+    // The control word (or a bit of it) written again as it was is a held jog's keep-alive, several
+    // a second: no change, so not in the audit trail and the store.
+    const bool control = w.id == PointId::kControlWord ||
+                         index(w.id) - index(PointId::kControlBit0) < static_cast<std::size_t>(runtime::kControlBits);
+    if (control && e.old_value == e.new_value) continue;
     std::uint64_t sequence = first + d.commands.size() - 1;  // a tuning point: the tuning command, last
     if (excitation_point(w.id)) sequence = first;            // an excitation point: the excitation command, first
     for (std::size_t i = 0; i < d.commands.size() && !p.tuning(); ++i)

@@ -193,6 +193,29 @@ TEST(WriteGate, AGroupIsTakenWholeOrNotAtAll) {
   EXPECT_EQ(sink.entries.size(), 4u);
 }
 
+// A held jog is kept alive by writing the control word again as it is, several times a second:
+// those writes are no change, so they stay out of the audit trail (and the store); the press and
+// the release are in it.
+TEST(WriteGate, AControlWordWrittenAgainAsItIsIsAKeepAliveNotAnAuditedChange) {
+  const runtime::RuntimeConfig config;
+  runtime::LoopChannels channels(16);
+  RecordingSink sink;
+  WriteGate gate(limits_of(config), config, paper(), channels, &sink);
+  const PointWrite manual[] = {{PointId::kMode, 2.0}};
+  ASSERT_TRUE(gate.submit(manual, kOperator).accepted());
+  const PointWrite jog[] = {{PointId::kControlWord, 4.0}};
+  const PointWrite jog_bit[] = {{points::indexed_id(PointId::kControlBit0, 2), 1.0}};
+  const PointWrite release[] = {{PointId::kControlWord, 0.0}};
+  for (const auto* group : {jog, jog, jog, jog_bit, release}) ASSERT_TRUE(gate.submit({group, 1}, kOperator).accepted());
+  std::vector<std::string> audited;
+  for (const auto& e : sink.entries) audited.push_back(e.point + " " + std::to_string(int(e.old_value)) + "->" + std::to_string(int(e.new_value)));
+  EXPECT_EQ(audited, (std::vector<std::string>{"mode 0->2", "control_word 0->4", "control_word 4->0"}));
+  runtime::Command c;
+  int queued = 0;
+  while (channels.commands.try_pop(c)) queued += c.kind == runtime::CommandKind::kControl;
+  EXPECT_EQ(queued, 5);  // every write still reaches the loop: it is the keep-alive
+}
+
 TEST(WriteGate, PpTrajIsRefusedOnAModelItCannotUseAndTakenOnOneItCan) {
   const runtime::RuntimeConfig config;
   runtime::LoopChannels channels(16);
