@@ -269,6 +269,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   TableReader mo(top.subtable("motion"), "motion", file, error);
   mo.number("in_position_window_mm", r.in_position_window_mm, above(0, 100, "mm"));
   mo.number("in_position_time_s", r.in_position_time_s, closed(0, 60, "s"));
+  mo.number("standstill_time_s", r.standstill_time_s, above(0, 60, "s"));
   mo.number("halt_decel_mm_s2", r.halt_decel_mm_s2, above(0, 1e6, "mm/s^2"));
   mo.number("jog_speed_mm_s", r.jog_speed_mm_s, above(0, 10000, "mm/s"));
   mo.number("jog_accel_mm_s2", r.jog_accel_mm_s2, above(0, 1e6, "mm/s^2"));

@@ -5,7 +5,9 @@
 #include <nlohmann/json.hpp>
 
 #include "app/appliance_http.hpp"
+#include "points/point_catalog.hpp"
 #include "points/point_id.hpp"
+#include "web/json_api.hpp"
 
 namespace epa::app {
 
@@ -40,9 +42,10 @@ std::string number(const nlohmann::json& v, const char* format, const char* zero
 
 void print_row(const nlohmann::json& r, std::ostream& out) {
   char line[160];
-  std::snprintf(line, sizeof line, "%6d  %10s  %16s  %9s  %s\n", r.value("record", 0), number(r["target_mm"], "%.3f", nullptr).c_str(),
-                number(r["speed_mm_s"], "%.3f", "no limit").c_str(), number(r["window_mm"], "%.3f", "default").c_str(),
-                r.value("controller", std::string("-")).c_str());
+  using K = web::RecordKeys;
+  std::snprintf(line, sizeof line, "%6d  %10s  %16s  %9s  %s\n", r.value(K::kRecord, 0), number(r[K::kTarget], "%.3f", nullptr).c_str(),
+                number(r[K::kSpeed], "%.3f", "no limit").c_str(), number(r[K::kWindow], "%.3f", "default").c_str(),
+                r.value(K::kController, std::string("-")).c_str());
   out << line;
 }
 constexpr const char* kHead = "record   target mm  speed limit mm/s  window mm  law\n";
@@ -56,14 +59,15 @@ int run_records(const RecordsOptions& o, std::ostream& out, std::ostream& err) {
   httplib::Client& client = **made;
 
   if (o.set) {
-    nlohmann::json body = {{"record", o.record}};
-    if (o.target_mm) body["target_mm"] = *o.target_mm;
-    if (o.speed_mm_s) body["speed_mm_s"] = *o.speed_mm_s;
-    if (o.window_mm) body["window_mm"] = *o.window_mm;
-    if (o.controller) body["controller"] = *o.controller;
+    using K = web::RecordKeys;
+    nlohmann::json body = {{K::kRecord, o.record}};
+    if (o.target_mm) body[K::kTarget] = *o.target_mm;
+    if (o.speed_mm_s) body[K::kSpeed] = *o.speed_mm_s;
+    if (o.window_mm) body[K::kWindow] = *o.window_mm;
+    if (o.controller) body[K::kController] = *o.controller;
     if (body.size() == 1) return fail("record " + std::to_string(o.record) + ": nothing to set: give --target-mm, --speed-mm-s, --window-mm or --controller");
     if (o.token.empty()) return fail("record " + std::to_string(o.record) + ": no token: give --token or set EPA_TOKEN to the appliance's [web] token");
-    for (const char* f : {"target_mm", "speed_mm_s", "window_mm"})
+    for (const char* f : {K::kTarget, K::kSpeed, K::kWindow})
       if (body.contains(f) && !std::isfinite(body[f].get<double>())) return fail(std::string(f) + " must be a finite number");
     auto r = client.Post("/api/records", bearer(o.token), body.dump(), "application/json");
     if (!r) return fail("record " + std::to_string(o.record) + ": " + http_failure(r, o.url));
@@ -83,8 +87,9 @@ int run_records(const RecordsOptions& o, std::ostream& out, std::ostream& err) {
   if (o.json) return out << r->body << "\n", 0;
   out << kHead;
   for (const auto& rec : table["records"]) print_row(rec, out);
-  const int selected = table.value("record_select", 0);
-  out << "record_select: " << selected << (selected == 0 ? " (a start moves to setpoint_mm)" : "") << "\n";
+  const std::string record_select(points::name(points::PointId::kRecordSelect));
+  const int selected = table.value(record_select, 0);
+  out << record_select << ": " << selected << (selected == 0 ? " (a start moves to setpoint_mm)" : "") << "\n";
   return 0;
 }
 

@@ -43,20 +43,22 @@ constexpr std::string_view kControlBitText[runtime::kControlBits] = {
     "control word bit 4: rising edge clears a latched fault"};
 constexpr std::string_view kStatusBitNames[runtime::kStatusBits] = {"ready", "run_enabled", "moving", "in_position", "target_reached",
                                                                     "following_error", "warning", "fault_latched", "ack", "halted",
-                                                                    "jogging", "manual_mode"};
+                                                                    "jogging", "manual_mode", "off_target"};
 constexpr std::string_view kStatusBitText[runtime::kStatusBits] = {
     "status bit 0: no fault latched and the I/O works",
     "status bit 1: mode RUN (the law holds or moves the axis)",
-    "status bit 2: a move, halt or jog is under way",
+    "status bit 2: a move, halt or jog is under way (a move ends in position, or standing off target: bit 12)",
     "status bit 3: |target - position| within the window for in_position_time_s (RUN)",
     "status bit 4: the last started move came into position (cleared by the next start)",
     "status bit 5: |reference - position| beyond following_error_mm now (the fault follows after following_error_time_s)",
-    "status bit 6: following error, I/O errors or the store not saving",
+    "status bit 6: following error, off target, I/O errors or the store not saving",
     "status bit 7: a fault is latched (fault_code)",
     "status bit 8: acknowledge: mirrors the control word's start bit once the loop applied it",
     "status bit 9: the last task was a halt",
     "status bit 10: a jog (or its braking) is under way",
-    "status bit 11: mode MANUAL"};
+    "status bit 11: mode MANUAL",
+    "status bit 12: the move stopped outside its window: the piston has stood within one window's width for standstill_time_s (RUN); "
+    "clears if it comes in, or at the next start"};
 
 // Names of the coefficient points (F0..H6), kept alive for the string_views in the catalog.
 const std::vector<std::string>& coefficient_names() {
@@ -239,7 +241,8 @@ std::vector<PointDef> build() {
     positioning.push_back({indexed_id(P::kControlBit0, static_cast<std::size_t>(i)), kControlBitNames[i], "", kControlBitText[i], A::kWrite,
                            0, 1, true, true, [](const Ctx& c, int bit) { return b(c.snapshot.axis.control_word & (1u << bit)); }, i});
   positioning.push_back({P::kStatusWord, "status_word", "", "bits 0 ready, 1 enabled, 2 moving, 3 in_position, 4 target_reached, "
-                                                              "5 following_error, 6 warning, 7 fault, 8 ack, 9 halted, 10 jogging, 11 manual",
+                                                              "5 following_error, 6 warning, 7 fault, 8 ack, 9 halted, 10 jogging, 11 manual, "
+                                                              "12 off_target",
                          A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(status_word(c.snapshot, c.status.saving)); }});
   for (int i = 0; i < runtime::kStatusBits; ++i)
     positioning.push_back({indexed_id(P::kStatusBit0, static_cast<std::size_t>(i)), kStatusBitNames[i], "", kStatusBitText[i], A::kRead, 0, 0,
@@ -314,9 +317,10 @@ const std::vector<PointDef>& catalog() {
 std::uint16_t status_word(const runtime::Snapshot& s, bool store_saving) {
   using namespace runtime;
   const bool fault = s.mode == Mode::kFault;
-  const bool warning = s.axis.following_error || !s.io_ok || !store_saving;
+  const bool warning = s.axis.following_error || s.axis.off_target || !s.io_ok || !store_saving;
   const bool bits[kStatusBits] = {!fault && s.io_ok, s.mode == Mode::kRun, s.axis.moving, s.axis.in_position, s.axis.target_reached,
-                                  s.axis.following_error, warning, fault, s.axis.ack, s.axis.halted, s.axis.jogging, s.mode == Mode::kManual};
+                                  s.axis.following_error, warning, fault, s.axis.ack, s.axis.halted, s.axis.jogging, s.mode == Mode::kManual,
+                                  s.axis.off_target};
   std::uint16_t w = 0;
   for (int i = 0; i < kStatusBits; ++i)
     if (bits[i]) w = static_cast<std::uint16_t>(w | (1u << i));

@@ -8,7 +8,8 @@ namespace epa::runtime {
 AxisMotion::AxisMotion(const MotionConfig& config) noexcept
     : config_(config),
       window_mm_(config.in_position_window_mm),
-      samples_needed_(static_cast<std::uint32_t>(std::max(1L, std::lround(config.in_position_time_s / config.Ts)))) {
+      samples_needed_(static_cast<std::uint32_t>(std::max(1L, std::lround(config.in_position_time_s / config.Ts)))),
+      still_needed_(static_cast<std::uint32_t>(std::max(1L, std::lround(config.standstill_time_s / config.Ts)))) {
   limits_.Ts = config.Ts;
 }
 
@@ -18,8 +19,8 @@ void AxisMotion::hold(double position_mm) noexcept {
   window_mm_ = config_.in_position_window_mm;
   profiled_ = false;
   jog_direction_ = 0;
-  samples_in_window_ = 0;
-  in_position_ = target_reached_ = halted_ = false;
+  samples_in_window_ = still_samples_ = 0;
+  off_target_ = in_position_ = target_reached_ = halted_ = false;
 }
 
 void AxisMotion::move(double target_mm, double speed_limit_mm_s, double window_mm, double position_mm, double speed_mm_s) noexcept {
@@ -27,8 +28,8 @@ void AxisMotion::move(double target_mm, double speed_limit_mm_s, double window_m
   target_mm_ = target_mm;
   window_mm_ = window_mm > 0.0 ? window_mm : config_.in_position_window_mm;
   jog_direction_ = 0;
-  samples_in_window_ = 0;
-  in_position_ = target_reached_ = halted_ = false;
+  samples_in_window_ = still_samples_ = 0;
+  off_target_ = in_position_ = target_reached_ = halted_ = false;
   if (speed_limit_mm_s > 0.0) {
     start_profile(position_mm, speed_mm_s, speed_limit_mm_s, config_.halt_decel_mm_s2);
   } else {
@@ -44,8 +45,8 @@ void AxisMotion::halt(double position_mm, double speed_mm_s) noexcept {
   target_mm_ = std::clamp(position_mm + v * std::abs(v) / (2.0 * a), config_.min_mm, config_.max_mm);
   window_mm_ = config_.in_position_window_mm;
   jog_direction_ = 0;
-  samples_in_window_ = 0;
-  in_position_ = target_reached_ = false;
+  samples_in_window_ = still_samples_ = 0;
+  off_target_ = in_position_ = target_reached_ = false;
   halted_ = true;
   start_profile(position_mm, v, std::max(std::abs(v), 1.0), a);
 }
@@ -63,8 +64,8 @@ void AxisMotion::jog(int direction, double position_mm, double speed_mm_s) noexc
   jog_direction_ = direction > 0 ? 1 : -1;
   target_mm_ = jog_direction_ > 0 ? config_.max_mm : config_.min_mm;
   window_mm_ = config_.in_position_window_mm;
-  samples_in_window_ = 0;
-  in_position_ = target_reached_ = halted_ = false;
+  samples_in_window_ = still_samples_ = 0;
+  off_target_ = in_position_ = target_reached_ = halted_ = false;
   start_profile(position_mm, speed_mm_s, config_.jog_speed_mm_s, config_.jog_accel_mm_s2);
 }
 
@@ -88,6 +89,19 @@ double AxisMotion::step(double position_mm) noexcept {
   }
   in_position_ = samples_in_window_ >= samples_needed_;
   if (in_position_ && task_ == MotionTask::kMove) target_reached_ = true;
+
+  // A move or halt whose reference has arrived and whose piston stands outside the window has
+  // ended there: a client waiting for moving to clear must not wait for ever.
+  if (std::isfinite(position_mm) && still_samples_ > 0 && std::max(still_max_mm_, position_mm) - std::min(still_min_mm_, position_mm) <= window_mm_) {
+    still_min_mm_ = std::min(still_min_mm_, position_mm);
+    still_max_mm_ = std::max(still_max_mm_, position_mm);
+    if (still_samples_ < still_needed_) ++still_samples_;
+  } else {
+    still_min_mm_ = still_max_mm_ = position_mm;
+    still_samples_ = std::isfinite(position_mm) ? 1 : 0;
+  }
+  const bool ending_task = task_ == MotionTask::kMove || task_ == MotionTask::kHalt;
+  off_target_ = ending_task && !in_position_ && !profile_running() && still_samples_ >= still_needed_;
   if (task_ == MotionTask::kJog && !jog_running) task_ = MotionTask::kHold;  // braked: holding where the jog stopped
   return reference_mm_;
 }
@@ -98,7 +112,8 @@ MotionStatus AxisMotion::status() const noexcept {
   s.in_position = in_position_;
   s.target_reached = target_reached_;
   s.halted = halted_;
-  s.moving = s.jogging || ((task_ == MotionTask::kMove || task_ == MotionTask::kHalt) && !in_position_);
+  s.off_target = off_target_;
+  s.moving = s.jogging || ((task_ == MotionTask::kMove || task_ == MotionTask::kHalt) && !in_position_ && !off_target_);
   return s;
 }
 

@@ -19,6 +19,7 @@ namespace epa::runtime {
 struct MotionConfig {
   double in_position_window_mm = 0;  // |target - position| at most this ...
   double in_position_time_s = 0;     // ... for this long: in position
+  double standstill_time_s = 0;      // within one window's width for this long: the piston stands
   double halt_decel_mm_s2 = 0;       // braking of a halt
   double jog_speed_mm_s = 0;         // a jog's top speed
   double jog_accel_mm_s2 = 0;        // a jog's acceleration and braking
@@ -34,11 +35,13 @@ enum class MotionTask : std::uint8_t {
 };
 
 struct MotionStatus {
-  bool moving = false;          // a move, halt or jog under way (not yet in position / stopped)
+  bool moving = false;          // a move, halt or jog under way (not in position, not stood still off target)
   bool in_position = false;     // |target - position| <= window for in_position_time_s
   bool target_reached = false;  // the last started move came into position (cleared by the next start)
   bool halted = false;          // the last task was a halt (cleared by the next start)
   bool jogging = false;         // a jog or its braking is under way
+  bool off_target = false;      // a move or halt has stopped outside its window: the piston stands, the law
+                                // does not bring it in (a dead band, stiction); clears if it comes in later
 };
 
 class AxisMotion {
@@ -55,8 +58,8 @@ class AxisMotion {
   // direction +1 / -1: jog that way (from the piston's position and speed); 0: release (brake).
   void jog(int direction, double position_mm, double speed_mm_s) noexcept;
 
-  // One cycle: advances the reference and the in-position timer with the measured position.
-  // Returns the reference for the control law, mm.
+  // One cycle: advances the reference, the in-position timer and the standstill watch with the
+  // measured position. Returns the reference for the control law, mm.
   double step(double position_mm) noexcept;
 
   double reference_mm() const noexcept { return reference_mm_; }
@@ -77,6 +80,11 @@ class AxisMotion {
   control::MotionProfileState profile_;
   std::uint32_t samples_in_window_ = 0, samples_needed_ = 1;
   bool in_position_ = false, target_reached_ = false, halted_ = false;
+  // Standstill: the range of positions since still_samples_ began stays within the window's width
+  // (a window, not a speed: sensor noise makes a speed estimate at 200 Hz useless near zero).
+  double still_min_mm_ = 0.0, still_max_mm_ = 0.0;
+  std::uint32_t still_samples_ = 0, still_needed_ = 1;
+  bool off_target_ = false;
   int jog_direction_ = 0;
 };
 

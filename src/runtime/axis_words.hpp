@@ -25,13 +25,14 @@ enum StatusBit : int {
   kStatusInPosition = 3,      // |target - position| <= the window for the in-position time (RUN)
   kStatusTargetReached = 4,   // the last started move came into position (cleared by the next start)
   kStatusFollowingError = 5,  // |reference - position| beyond following_error_mm now (the fault follows after its time)
-  kStatusWarning = 6,         // following error, I/O errors or the store not saving: look before it faults
+  kStatusWarning = 6,         // following error, off target, I/O errors or the store not saving: look before it faults
   kStatusFault = 7,           // a fault is latched (fault_code says which)
   kStatusAck = 8,             // mirrors the control word's start bit once the loop applied it (handshake)
   kStatusHalted = 9,          // the last task was a halt
   kStatusJogging = 10,        // a jog (or its braking) is under way
   kStatusManual = 11,         // mode MANUAL
+  kStatusOffTarget = 12,      // the move stopped outside its window: the piston stands there (also a warning)
 };
-inline constexpr int kStatusBits = 12;
+inline constexpr int kStatusBits = 13;
 
 }  // namespace epa::runtime

@@ -16,6 +16,7 @@ core::Status validate(const RuntimeConfig& c) {
       {"following_error_mm", c.following_error_mm, true},
       {"move_window_s", c.move_window_s, true}, {"record_buffer_s", c.record_buffer_s, true},
       {"in_position_window_mm", c.in_position_window_mm, true}, {"in_position_time_s", c.in_position_time_s, false},
+      {"standstill_time_s", c.standstill_time_s, true},
       {"halt_decel_mm_s2", c.halt_decel_mm_s2, true}, {"jog_speed_mm_s", c.jog_speed_mm_s, true},
       {"jog_accel_mm_s2", c.jog_accel_mm_s2, true}, {"jog_keepalive_s", c.jog_keepalive_s, false},
   };

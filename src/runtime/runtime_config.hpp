@@ -44,6 +44,7 @@ struct RuntimeConfig {
   // [motion]: the positioning interface (status and control words, axis_motion.hpp).
   double in_position_window_mm = 1.0;  // in position: |target - position| <= this ...
   double in_position_time_s = 0.1;     // ... for this long
+  double standstill_time_s = 0.5;      // a move whose piston stands (within the window's width) this long off target has ended
   double halt_decel_mm_s2 = 2500.0;    // a halt brakes the reference at this
   double jog_speed_mm_s = 20.0;        // jog: top speed, ...
   double jog_accel_mm_s2 = 500.0;      // ... acceleration and braking

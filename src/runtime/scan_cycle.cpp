@@ -15,6 +15,7 @@ double or_nan(const std::optional<double>& v) { return v ? *v : kNaN; }
 
 MotionConfig motion_config(const RuntimeConfig& c) {
   return {.in_position_window_mm = c.in_position_window_mm, .in_position_time_s = c.in_position_time_s,
+          .standstill_time_s = c.standstill_time_s,
           .halt_decel_mm_s2 = c.halt_decel_mm_s2, .jog_speed_mm_s = c.jog_speed_mm_s, .jog_accel_mm_s2 = c.jog_accel_mm_s2,
           .min_mm = c.setpoint_min_mm, .max_mm = c.setpoint_max_mm, .Ts = c.period_s};
 }
@@ -459,7 +460,7 @@ void ScanCycle::publish(bool full_stats) noexcept {
   const bool axis_active = mode_ == Mode::kRun || (mode_ == Mode::kManual && jog_law_);
   s.axis = {axis_active && motion.moving, mode_ == Mode::kRun && motion.in_position, motion.target_reached,
             following_error_since_ns_ >= 0, (control_word_ & kControlStart) != 0, motion.halted, axis_active && motion.jogging,
-            control_word_, axis_active ? motion_.reference_mm() : position_mm_, speed_mm_s_};
+            control_word_, axis_active ? motion_.reference_mm() : position_mm_, speed_mm_s_, mode_ == Mode::kRun && motion.off_target};
   s.last_sequence = last_sequence_;
   if (cycle_ % 200 == 0 || full_stats) s.loop = stats_.view();  // percentiles scan the bins: a few times a second
   s.loop.overruns = stats_.overruns;

@@ -46,6 +46,7 @@ struct AxisView {
   std::uint16_t control_word = 0;  // as the loop last applied it
   double reference_mm = 0;         // what the control law follows (a halt's or jog's profile, or the target)
   double speed_mm_s = 0;           // measured, filtered (20 ms)
+  bool off_target = false;         // the last move or halt stopped outside its window (RUN)
 };
 
 struct Snapshot {

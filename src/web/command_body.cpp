@@ -7,6 +7,7 @@
 #include "points/point_catalog.hpp"
 #include "points/record_controller.hpp"
 #include "runtime/mode.hpp"
+#include "web/json_api.hpp"
 
 namespace epa::web {
 
@@ -48,10 +49,11 @@ std::optional<double> value_of(P id, const json& v, std::string& error) {
 
 // POST /api/records: the record's number, then its fields as the record<N>_* points.
 CommandBody record_body(const json& j) {
-  constexpr std::pair<const char*, P> kFields[] = {{"target_mm", P::kRecordTarget0}, {"speed_mm_s", P::kRecordSpeed0},
-                                                   {"window_mm", P::kRecordWindow0}, {"controller", P::kRecordController0}};
+  using K = RecordKeys;
+  constexpr std::pair<const char*, P> kFields[] = {{K::kTarget, P::kRecordTarget0}, {K::kSpeed, P::kRecordSpeed0},
+                                                   {K::kWindow, P::kRecordWindow0}, {K::kController, P::kRecordController0}};
   const std::string range = "1.." + std::to_string(points::kPositionRecords);
-  const auto number = j.find("record");
+  const auto number = j.find(K::kRecord);
   if (number == j.end()) return malformed("name the record: {\"record\": " + range + ", \"target_mm\": ...}");
   if (!number->is_number_integer() || number->get<std::int64_t>() < 1 ||
       number->get<std::int64_t>() > static_cast<std::int64_t>(points::kPositionRecords))
@@ -59,7 +61,7 @@ CommandBody record_body(const json& j) {
   const auto i = static_cast<std::size_t>(number->get<std::int64_t>() - 1);
   CommandBody out;
   for (const auto& [k, v] : j.items()) {
-    if (k == "record") continue;
+    if (k == K::kRecord) continue;
     const std::pair<const char*, P>* f = nullptr;
     for (const auto& field : kFields)
       if (k == field.first) f = &field;

@@ -178,8 +178,9 @@ std::string records_json(const points::PositionRecords& records, int record_sele
   json a = json::array();
   for (std::size_t i = 0; i < records.size(); ++i) {
     const auto& r = records[i];
-    a.push_back({{"record", i + 1}, {"target_mm", num(r.target_mm)}, {"speed_mm_s", num(r.speed_mm_s)},
-                 {"window_mm", num(r.window_mm)}, {"controller", points::record_controller_name(r.controller)}});
+    using K = RecordKeys;
+    a.push_back({{K::kRecord, i + 1}, {K::kTarget, num(r.target_mm)}, {K::kSpeed, num(r.speed_mm_s)},
+                 {K::kWindow, num(r.window_mm)}, {K::kController, points::record_controller_name(r.controller)}});
   }
   return json{{"records", std::move(a)}, {k(P::kRecordSelect), record_select}}.dump();
 }

@@ -48,6 +48,16 @@ std::string faults_json(std::uint64_t count, const std::vector<runtime::FaultRec
                         std::optional<std::uint64_t> dropped = std::nullopt);
 // The point catalog with each writable point's range as the write gate applies it.
 std::string points_json(const points::WriteLimits& limits);
+// A record's keys in /api/records (GET and POST) and `epa records`: the HTTP format's own, written
+// here once (they are not point names, though two of them spell like one: speed_mm_s, controller).
+struct RecordKeys {
+  static constexpr const char* kRecord = "record";
+  static constexpr const char* kTarget = "target_mm";
+  static constexpr const char* kSpeed = "speed_mm_s";
+  static constexpr const char* kWindow = "window_mm";
+  static constexpr const char* kController = "controller";
+};
+
 // The position-record table: {"records": [{"record": 1..32, "target_mm", "speed_mm_s" (0: no limit),
 // "window_mm" (0: the configured window), "controller" (a law's name, or "running")}, ...],
 // "record_select": the record a start takes (0: the setpoint)}.

@@ -80,7 +80,7 @@ position() { mb -t 3:float -B -r "$A_POS" -c 1 "$host" 2>/dev/null | value_of "$
 status() { mb -t 3 -r "$A_STATUS" -c 1 "$host" 2>/dev/null | value_of "$A_STATUS"; }
 mode() { mb -t 4 -r "$A_MODE" -c 1 "$host" 2>/dev/null | value_of "$A_MODE"; }
 write16() { local out; out=$(mb -t 4 -r "$1" "$host" "$2" 2>&1); written "$out" || die "writing $2 at holding $1: $out"; }
-names=(ready run_enabled moving in_position target_reached following_error warning fault_latched ack halted jogging manual_mode)
+names=(ready run_enabled moving in_position target_reached following_error warning fault_latched ack halted jogging manual_mode off_target)
 bits() { local w=$1 i s=""; for i in "${!names[@]}"; do (( w >> i & 1 )) && s+="${names[$i]},"; done; echo "${s%,}"; }
 # wait_status SET CLEAR TIMEOUT_MS WHAT: polls until all of SET are set and all of CLEAR clear; sets `waited` (ms) and `word`
 wait_status() {

@@ -53,9 +53,9 @@ JOG_KEEPALIVE_S = 1.0     # [motion] jog_keepalive_s, the default
 
 # status_word (input 140) bits, as the map's description lists them
 READY, RUN_ENABLED, MOVING, IN_POSITION, TARGET_REACHED, FOLLOWING_ERROR, WARNING, FAULT_LATCHED, ACK, HALTED, \
-    JOGGING, MANUAL_MODE = (1 << i for i in range(12))
+    JOGGING, MANUAL_MODE, OFF_TARGET = (1 << i for i in range(13))
 BIT_NAMES = ["ready", "run_enabled", "moving", "in_position", "target_reached", "following_error", "warning",
-             "fault_latched", "ack", "halted", "jogging", "manual_mode"]
+             "fault_latched", "ack", "halted", "jogging", "manual_mode", "off_target"]
 # control_word (holding 50) bits
 START, HALT, JOG_PLUS, JOG_MINUS, RESET = (1 << i for i in range(5))
 MOVE_COMPLETE, MOVE_CUT_SHORT, MOVE_HALTED = 0, 1, 2

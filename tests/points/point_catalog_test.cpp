@@ -54,6 +54,7 @@ const std::map<std::string, std::string> kFormatFiles = {
     {"commission/commission_sequence.cpp", "epa-commission/1 keys"},
     {"app/tuning_command.cpp", "epa tuning show's labels"},
     {"app/faults_command.cpp", "the subcommand's own name, `epa faults`"},
+    {"web/json_api.hpp", "/api/records' keys (RecordKeys)"},
     {"web/json_api.cpp", "the loop statistics' cycle count, the recent-moves list and the fault history, other values than the points"},
 };
 

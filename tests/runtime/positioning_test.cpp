@@ -108,6 +108,41 @@ TEST(Positioning, AStartMovesSetsMovingThenInPositionAndTheAcknowledgeMirrorsSta
   }
 }
 
+// A move whose law leaves the piston standing outside the window (pp-ffidz: its compensation is
+// off inside l_c, so it stops where the dead band holds it) has ended there: moving clears after
+// standstill_time_s and off_target says why, so a client waiting for moving to clear is not left
+// waiting for ever (an integrator's report: status 7 for ten minutes). The next start clears it.
+TEST(Positioning, AMoveThatStandsOutsideItsWindowEndsOffTarget) {
+  Axis axis(121.0, ControllerKind::kPpFfidz);
+  axis.push(mode_command(Mode::kRun));
+  axis.cycles(10);
+  Command start = control_command(kControlStart);
+  start.value = 150.0;
+  start.window_mm = 0.05;  // narrower than where pp-ffidz stops on the printed model
+  axis.push(start);
+  axis.cycles(1);
+  ASSERT_TRUE(axis.snap().axis.moving);
+  int k = 1;
+  while (axis.snap().axis.moving && k < 10 * kCyclesPerSecond) axis.cycles(1), ++k;
+  const double stood_mm = axis.daq.plant().position_mm();
+  ASSERT_GT(std::abs(stood_mm - 150.0), 0.05) << "the law reached the narrow window: this test needs a wider miss";
+  EXPECT_LT(k, 4 * kCyclesPerSecond) << "moving cleared after " << k / 200.0 << " s";
+  EXPECT_TRUE(axis.snap().axis.off_target);
+  EXPECT_FALSE(axis.snap().axis.in_position);
+  EXPECT_FALSE(axis.snap().axis.target_reached);
+  axis.cycles(2 * kCyclesPerSecond);
+  EXPECT_NEAR(axis.daq.plant().position_mm(), stood_mm, 0.05) << "it really stands";
+  EXPECT_FALSE(axis.snap().axis.moving);
+  EXPECT_TRUE(axis.snap().axis.off_target);
+
+  axis.control(0);
+  axis.cycles(1);
+  axis.control(kControlStart, 100.0);  // a new start: a new move, not off target until it stands again
+  axis.cycles(1);
+  EXPECT_TRUE(axis.snap().axis.moving);
+  EXPECT_FALSE(axis.snap().axis.off_target);
+}
+
 TEST(Positioning, AStartOutsideRunIsRefused) {
   Axis axis(50.0);
   axis.control(kControlStart, 150.0);

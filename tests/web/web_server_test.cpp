@@ -180,7 +180,7 @@ TEST_F(WebServerTest, StatusCarriesTheStatusWordPackedAndBitByBit) {
   const std::map<std::string, bool> expected = {
       {"ready", true}, {"run_enabled", true}, {"moving", false}, {"in_position", true}, {"target_reached", true},
       {"following_error", false}, {"warning", false}, {"fault_latched", false}, {"ack", false}, {"halted", false},
-      {"jogging", false}, {"manual_mode", false}};
+      {"jogging", false}, {"manual_mode", false}, {"off_target", false}};
   ASSERT_EQ(s["status_bits"].size(), expected.size()) << s["status_bits"];
   for (const auto& [bit, on] : expected) EXPECT_EQ(s["status_bits"][bit], on) << bit;
 

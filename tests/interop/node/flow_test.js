@@ -32,7 +32,7 @@ const SOFT_MAX_MM = 300;
 const JOG_SPEED_MM_S = 20;  // [motion] jog_speed_mm_s default
 const JOG_KEEPALIVE_S = 1;  // [motion] jog_keepalive_s default
 const BIT_NAMES = ["ready", "run_enabled", "moving", "in_position", "target_reached", "following_error",
-  "warning", "fault_latched", "ack", "halted", "jogging", "manual_mode"];
+  "warning", "fault_latched", "ack", "halted", "jogging", "manual_mode", "off_target"];
 const S = Object.fromEntries(BIT_NAMES.map((n, i) => [n, 1 << i])); // status_word bits
 const CW = { start: 1, halt: 2, jog_plus: 4, jog_minus: 8, reset: 16 };  // control_word bits
 
