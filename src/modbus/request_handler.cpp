@@ -158,7 +158,11 @@ std::uint8_t RequestHandler::collect_register_writes(int address, int quantity, 
     if (hit.offset != 0 || e.address + e.width() > address + quantity) return kIllegalValue;  // half a 32-bit value
     std::uint16_t words[4] = {};
     for (int i = 0; i < e.width(); ++i) words[i] = static_cast<std::uint16_t>(be16(bytes + 2 * (a - address + i)));
-    out.push_back({&e, decode_value(e, words), e.type == DataType::kKey64 ? key_value(words) : 0});
+    const double value = decode_value(e, words);
+    // A subnormal float is what a client with the wrong word order writes (100.0 as CDAB reads
+    // 2.4e-41): within most ranges, and a setpoint of 0 mm. Nobody means one: refused, 03.
+    if (e.type == DataType::kFloat32 && std::fpclassify(static_cast<float>(value)) == FP_SUBNORMAL) return kIllegalValue;
+    out.push_back({&e, value, e.type == DataType::kKey64 ? key_value(words) : 0});
     a += e.width();
   }
   return 0;

@@ -222,6 +222,15 @@ TEST_F(Handler, HalfAFloatIsRefusedAndNothingIsQueued) {
   EXPECT_EQ(handler_->status(Session{}, 0).change_counter, 0u);
 }
 
+// 100.0f written with the words swapped (0x0000 0x42C8) decodes to 2.4e-41: inside the setpoint's
+// range, and it would send the axis to 0 mm. A subnormal float is refused instead.
+TEST_F(Handler, AWordSwappedFloatIsRefusedNotTakenAsATinyValue) {
+  EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x00, 0x00, 0x42, 0xC8}), 0x03);
+  EXPECT_TRUE(drain().empty());
+  EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x00, 0x00, 0x00, 0x00}), 0);  // 0.0 itself is a value
+  EXPECT_EQ(drain().size(), 1u);
+}
+
 TEST_F(Handler, ValueOutsideTheRangeIs03) {
   EXPECT_EQ(send({0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x44, 0x16, 0x00, 0x00}), 0x03);  // 600.0f > 500
   EXPECT_EQ(send({0x06, 0x00, 0x02, 0x00, 0x03}), 0x03);                                // mode 3
