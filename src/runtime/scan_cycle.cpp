@@ -11,6 +11,7 @@ namespace epa::runtime {
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kSpeedFilterS = 0.02;  // the measured speed's low-pass (a halt brakes from it)
+constexpr double kSoftLimitRecoverySlackMm = 1.0;  // outside the soft limits: how far back out a recovery may go (noise)
 double or_nan(const std::optional<double>& v) { return v ? *v : kNaN; }
 
 MotionConfig motion_config(const RuntimeConfig& c) {
@@ -86,6 +87,8 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
             motion_.hold(position_mm_);
           }
           if (c.mode == Mode::kExcite) heartbeat_changed_ns_ = now_ns;  // the client gets a full timeout from here
+          const bool outside = position_mm_ < config_.soft_min_mm || position_mm_ > config_.soft_max_mm;
+          soft_limit_recovery_mm_ = (c.mode == Mode::kRun || c.mode == Mode::kManual) && readings_ > 0 && outside ? position_mm_ : kNaN;
           mode_ = c.mode;
         }
         break;
@@ -281,7 +284,17 @@ FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
   }
   const bool moving = mode_ == Mode::kRun || mode_ == Mode::kManual || mode_ == Mode::kExcite;
   if (!moving) return FaultCode::kNone;
-  if (read_ok && (position_mm_ < config_.soft_min_mm || position_mm_ > config_.soft_max_mm)) return FaultCode::kSoftLimit;
+  if (read_ok && (position_mm_ < config_.soft_min_mm || position_mm_ > config_.soft_max_mm)) {
+    // Entered outside (a soft-limit fault, then reset): the axis may be brought back in, by a jog,
+    // the manual valve or a move; going 1 mm further out than the innermost point it reached since
+    // is the fault again. Crossing the limit from inside is the fault at once, as always.
+    if (std::isnan(soft_limit_recovery_mm_)) return FaultCode::kSoftLimit;
+    const bool above = position_mm_ > config_.soft_max_mm;
+    soft_limit_recovery_mm_ = above ? std::min(soft_limit_recovery_mm_, position_mm_) : std::max(soft_limit_recovery_mm_, position_mm_);
+    if (std::abs(position_mm_ - soft_limit_recovery_mm_) > kSoftLimitRecoverySlackMm) return FaultCode::kSoftLimit;
+  } else if (read_ok) {
+    soft_limit_recovery_mm_ = kNaN;  // inside: the limits hold from here
+  }
   if (config_.heartbeat_timeout_s > 0.0 &&
       static_cast<double>(now_ns - heartbeat_changed_ns_) > config_.heartbeat_timeout_s * 1e9)
     return FaultCode::kHeartbeatLost;

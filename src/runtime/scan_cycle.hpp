@@ -9,6 +9,7 @@
 // write, a run through the scan cycle reproduces `epa simulate` sample for sample.
 #include <atomic>
 #include <cstdint>
+#include <limits>
 
 #include "control/bumpless_transfer.hpp"
 #include "runtime/axis_motion.hpp"
@@ -122,7 +123,10 @@ class ScanCycle {
   bool saturated_ = false, io_ok_ = true;
   int consecutive_read_errors_ = 0, consecutive_write_errors_ = 0, consecutive_overruns_ = 0;
   std::int64_t following_error_since_ns_ = -1;
-  std::int64_t frozen_since_ns_ = -1;  // the reading has been bit-identical while driving since then
+  std::int64_t frozen_since_ns_ = -1;
+  // RUN or MANUAL entered with the piston outside the soft limits (after a soft-limit fault and its
+  // reset): the innermost position reached since, so it can be brought back; NaN otherwise.
+  double soft_limit_recovery_mm_ = std::numeric_limits<double>::quiet_NaN();  // the reading has been bit-identical while driving since then
   double previous_sensor_v_ = 0.0;
   std::uint32_t heartbeat_ = 0;
   std::int64_t heartbeat_changed_ns_ = 0;

@@ -214,6 +214,41 @@ TEST_F(Faults, FaultStaysLatchedUntilResetThenStop) {
   EXPECT_EQ(snap().faults, 1u);
 }
 
+// After a soft-limit fault and its reset the piston is still outside: RUN or MANUAL may bring it
+// back (an integrator found no way to, over Modbus: every enable faulted again at once). Driving
+// it further out is the fault again; once inside, crossing out is the fault at once as always.
+TEST_F(Faults, AnAxisLeftOutsideTheSoftLimitsCanBeBroughtBackButNotFurtherOut) {
+  RuntimeConfig c;
+  c.soft_max_mm = 300.0;
+  c.setpoint_max_mm = 300.0;
+  start(c);
+  daq_.sensor_v = 6.04;  // 302 mm: past the limit
+  cycles(1);
+  ASSERT_EQ(snap().fault, FaultCode::kSoftLimit);
+  ASSERT_TRUE(ch_.commands.try_push(reset_command()));
+  cycles(1);
+  ASSERT_EQ(snap().mode, Mode::kStop);
+  ASSERT_TRUE(ch_.commands.try_push(mode_command(Mode::kManual)));
+  cycles(5);
+  EXPECT_EQ(snap().mode, Mode::kManual) << "entering MANUAL outside the limit is not a fault";
+  daq_.sensor_v = 6.03;  // coming back: 301.5 mm
+  cycles(5);
+  daq_.sensor_v = 6.06;  // 303 mm: 1.5 mm further out than the innermost point reached
+  cycles(1);
+  EXPECT_EQ(snap().mode, Mode::kFault);
+  EXPECT_EQ(snap().fault, FaultCode::kSoftLimit);
+
+  ASSERT_TRUE(ch_.commands.try_push(reset_command()));
+  cycles(1);
+  ASSERT_TRUE(ch_.commands.try_push(mode_command(Mode::kRun)));
+  cycles(3);
+  EXPECT_EQ(snap().mode, Mode::kRun) << "entering RUN outside the limit holds there";
+  daq_.sensor_v = 5.9;  // 295 mm: back inside
+  cycles(3);
+  daq_.sensor_v = 6.01;  // 300.5 mm: crossing out from inside
+  expect_safe_after_one_cycle(FaultCode::kSoftLimit);
+}
+
 TEST_F(Faults, ResetWithTheCausePresentFaultsAgain) {
   start();
   daq_.sensor_v = 11.0;
