@@ -110,11 +110,13 @@ std::string export_markdown(const RegisterMap& map) {
 
 std::string export_csv(const RegisterMap& map) {
   std::ostringstream out;
-  out << "point,table,address,reference,type,word_order,scale,unit,access,min,max,default,persisted,description\n";
+  // unlock: yes where a write needs the unlock first (the Markdown's "rw (unlock)")
+  out << "point,table,address,reference,type,word_order,scale,unit,access,unlock,min,max,default,persisted,description\n";
   for (const auto& e : map.entries()) {
     out << e.point->name << ',' << to_string(e.table) << ',' << e.address << ',' << reference_alias(e.table, e.address) << ','
         << to_string(e.type) << ',' << word_order_text(e) << ',' << core::format_number(e.scale) << ',' << csv_field(e.unit) << ','
-        << (e.writable ? "rw" : "r") << ',' << (e.writable ? core::format_number(e.min) : "") << ','
+        << (e.writable ? "rw" : "r") << ',' << (e.writable && e.point->tuning() ? "yes" : "no") << ','
+        << (e.writable ? core::format_number(e.min) : "") << ','
         << (e.writable ? core::format_number(e.max) : "") << ','
         << (e.default_value ? core::format_number(*e.default_value) : "") << ',' << (e.persisted ? "yes" : "no") << ','
         << csv_field(e.description) << '\n';

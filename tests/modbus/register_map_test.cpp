@@ -155,7 +155,8 @@ TEST(RegisterExport, MarkdownAndCsvListEveryEntry) {
   ASSERT_TRUE(m.has_value());
   const auto md = export_markdown(*m), csv = export_csv(*m);
   EXPECT_NE(md.find("| setpoint_mm | holding | 0-1 | 40001 | float32 | ABCD |"), std::string::npos) << md.substr(0, 800);
-  EXPECT_NE(csv.find("setpoint_mm,holding,0,40001,float32,ABCD,1,mm,rw,0,500,0,yes,"), std::string::npos) << csv.substr(0, 400);
+  EXPECT_NE(csv.find("setpoint_mm,holding,0,40001,float32,ABCD,1,mm,rw,no,0,500,0,yes,"), std::string::npos) << csv.substr(0, 400);
+  EXPECT_NE(csv.find("record1_target_mm,holding,1000,41001,float32,ABCD,1,mm,rw,yes,"), std::string::npos) << "the unlock is said";
   const auto lines = std::count(csv.begin(), csv.end(), '\n');
   EXPECT_EQ(static_cast<std::size_t>(lines), m->entries().size() + 1);
 }
