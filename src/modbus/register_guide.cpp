@@ -92,7 +92,8 @@ void write_records(std::ostream& out, const RegisterMap& map) {
         << " | " << markdown_cell(points::point(f).description) << " |\n";
   }
   out << "\nRecords are tuning: write them after the unlock, " << where(map, P::kUnlock)
-      << ", or over HTTP with the token (`epa records`, `POST /api/points`). They are kept in the store and survive a restart. "
+      << ", on the same connection (the unlock ends with it: a tool that connects once per call, like mbpoll, cannot "
+         "edit records; it can still start them), or over HTTP with the token (`epa records`, `POST /api/points`). They are kept in the store and survive a restart. "
          "Select one with record_select, " << where(map, P::kRecordSelect) << ", then give a start edge.\n\n";
 }
 
@@ -116,15 +117,22 @@ void write_first_ten_minutes(std::ostream& out, const RegisterMap& map) {
          "255 are answered too). FC43/14 tells you what you reached: vendor, product and the firmware version.\n"
       << "2. **Word order.** Every 32-bit value of this map is ABCD unless its row says otherwise: the high word in the lower "
          "register, each word big-endian (IEEE 754 float, \"big-endian\", \"no word swap\"). Set your client so, per client:\n\n"
-      << "   | client | reading position_mm, " << where(map, P::kPosition) << " |\n   | --- | --- |\n"
-      << "   | mbpoll | `mbpoll -0 -B -t 3:float -r " << position << " -c 1 HOST`: `-B` is big-endian word order (without it mbpoll "
-         "assumes CDAB), `-0` makes `-r` the 0-based address |\n"
+      << "   | client | reading position_mm, " << where(map, P::kPosition) << " | writing setpoint_mm, "
+      << where(map, P::kSetpoint) << " |\n   | --- | --- | --- |\n"
+      << "   | mbpoll | `mbpoll -m tcp -a 1 -0 -1 -B -t 3:float -r " << position << " HOST`: `-B` is big-endian word order (without "
+         "it mbpoll assumes CDAB), `-0` makes `-r` the 0-based address, `-1` polls once | `mbpoll -m tcp -a 1 -0 -1 -B -t 4:float -r "
+      << setpoint << " HOST 150` (values after the host) |\n"
       << "   | pymodbus 3.0 | `r = client.read_input_registers(" << position << ", 2, slave=1)` then "
-         "`struct.unpack('>f', struct.pack('>HH', *r.registers))[0]` |\n"
-      << "   | Node modbus-serial | `const r = await client.readInputRegisters(" << position << ", 2)` then "
-         "`r.buffer.readFloatBE(0)` |\n"
-      << "   | an HMI / SCADA driver | data type REAL or FLOAT32, byte order ABCD / big-endian, word swap off; if it only "
-         "knows CDAB, give it a site map with `word_order` CDAB (see `registers/examples/legacy-hmi.csv`) |\n\n"
+         "`struct.unpack('>f', struct.pack('>HH', *r.registers))[0]`; with `BinaryPayloadDecoder` pass "
+         "`wordorder=Endian.Big` (its default is CDAB) | `client.write_registers(" << setpoint
+      << ", list(struct.unpack('>HH', struct.pack('>f', 150.0))), slave=1)` |\n"
+      << "   | Node modbus-serial | `(await client.readInputRegisters(" << position << ", 2)).buffer.readFloatBE(0)` | "
+         "`b.writeFloatBE(150)` into a 4-byte Buffer, then `client.writeRegisters(" << setpoint
+      << ", [b.readUInt16BE(0), b.readUInt16BE(2)])` |\n"
+      << "   | an HMI / SCADA driver | data type REAL or FLOAT32, byte order ABCD / big-endian / 1234, word swap off | the "
+         "same; if it only knows CDAB, give it a site map with `word_order` CDAB (`registers/examples/legacy-hmi.csv`) |\n\n"
+      << "   Check it on a value you know: 150.0 is the words `0x4316 0x0000`. A float written with its words swapped "
+         "(100.0 becomes 2.4e-41) is refused with exception 03, not taken as a tiny setpoint.\n"
       << "3. **Look.** Read the status word (input register " << status << "): bit 0 ready means the axis can be enabled; "
          "bit 7 means a fault is latched, and fault_code, " << where(map, P::kFaultCode) << ", says which.\n"
       << "4. **Enable.** Write 1 (RUN) to mode, holding register " << mode << ". The axis holds where the piston is "
@@ -133,13 +141,17 @@ void write_first_ten_minutes(std::ostream& out, const RegisterMap& map) {
          "record with record_select, then set control-word bit 0 (start): write 1 to holding " << control << ". Poll the "
          "status word until bit 8 (ack) is 1: the loop has taken the start. Write 0 to the control word; ack drops to 0. "
          "The move is done when bit 4 (target_reached) and bit 3 (in_position) are both 1; bit 2 (moving) is 1 meanwhile. "
-         "Writing a new setpoint in RUN also moves the axis, without the handshake.\n"
+         "If the law leaves the piston standing outside the window (a dead band, stiction), moving clears after "
+         "`[motion] standstill_time_s` and bit 12 (off_target) and bit 6 (warning) say so: wait for moving to clear, then "
+         "look at in_position, and bound the wait. Writing a new setpoint in RUN also moves the axis, without the "
+         "handshake.\n"
       << "6. **Halt.** Set bit 1 (value 2): the axis brakes and holds where it stops (bit 9 halted). Clear it again.\n"
       << "7. **Jog.** Mode 2 (MANUAL), then hold bit 2 (jog_plus, value 4) or bit 3 (jog_minus, value 8) set and write the "
          "control word (or the heartbeat) again at least every second: without that keep-alive the jog brakes. Clear the "
          "bit to stop.\n"
       << "8. **Faults.** A fault stops the axis and latches; bit 4 of the control word (value 16, an edge) or a 1 written to "
-         "reset clears it, back to STOP. The history keeps the newest faults with their time, mode, position, setpoint "
+         "reset clears it, back to STOP; after a soft-limit fault, MANUAL or RUN may bring the piston back inside (driving it "
+         "further out faults again). The history keeps the newest faults with their time, mode, position, setpoint "
          "and valve command, newest first: fault_history_count, " << where(map, P::kFaultHistoryCount)
       << ", counts them since the store was created, the entries follow it. `GET /api/faults` on the web port and `epa "
          "faults` show the same.\n"

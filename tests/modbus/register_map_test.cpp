@@ -199,7 +199,7 @@ TEST(RegisterExport, TheGuideNamesTheMapsOwnAddresses) {
   EXPECT_NE(md.find("| 0 | 0x1 | start | 16 (00017) |"), std::string::npos);
   EXPECT_NE(md.find("| 8 | 0x100 | ack | 24 (10025) |"), std::string::npos);
   EXPECT_NE(md.find("record N (1..32) starts at holding register 1000 + 8·(N-1)"), std::string::npos);
-  EXPECT_NE(md.find("`mbpoll -0 -B -t 3:float -r 0 -c 1 HOST`"), std::string::npos);
+  EXPECT_NE(md.find("`mbpoll -m tcp -a 1 -0 -1 -B -t 3:float -r 0 HOST`"), std::string::npos);
 
   auto small = RegisterMap::parse(kHeader + "position_mm,input,7,float32,ABCD,,mm,r,,,,no,\n"
                                             "setpoint_mm,holding,3,float32,ABCD,,mm,rw,0,500,,yes,\n", "small.csv");
