@@ -28,7 +28,6 @@ fi
 epa=$1
 src=$2
 artifacts=$3
-host=127.0.0.1
 token="panel-test-token-0123456789"
 
 command -v chromium >/dev/null || { echo "FAIL: chromium is not installed (scripts/install-deps.sh installs it)" >&2; exit 1; }
@@ -48,44 +47,12 @@ sed -i 's|</body>|<script src="/command_probe.js"></script>\n</body>|' "$tmp/web
 grep -q command_probe.js "$tmp/web/index.html" || abort "could not add the probe to the page's copy"
 
 # ---- the appliance ----
-start() {  # start <token or "">
-  modbus_port=$(free_port)
-  web_port=$(free_port)
-  cat >"$tmp/epa.toml" <<EOF2
-# written by tests/browser/command_panel_test.sh
-[modbus]
-address = "127.0.0.1"
-port = $modbus_port
-register_map = "$src/registers/epa.csv"
-
-[web]
-address = "127.0.0.1"
-port = $web_port
-static_dir = "$tmp/web"
-token = "$1"
-
-[log]
-status_interval_s = 0
-
-[limits]
-soft_max_mm = 450
-setpoint_max_mm = 440
-
-[recorder]
-directory = "$tmp/runs"
-EOF2
+start() {  # start <token or "">: a fresh store each time
   rm -f "$tmp/epa.db"
-  "$epa" serve --config "$tmp/epa.toml" --db "$tmp/epa.db" --mode run --setpoint 50 >>"$tmp/epa.log" 2>&1 &
-  pid=$!
-  url="http://$host:$web_port/"
-  echo "appliance pid $pid: web $url"
-  local deadline=$(( $(now_ms) + 10000 ))
-  while [ "$(now_ms)" -lt "$deadline" ]; do
-    kill -0 "$pid" 2>/dev/null || abort "the appliance exited during start-up"
-    api /api/status | grep -q '"mode"' && return 0
-    sleep 0.1
-  done
-  abort "the web server did not answer on $url within 10 s"
+  web_static_dir="$tmp/web" web_token=$1
+  start_appliance "$src/registers/epa.csv" "[limits]
+soft_max_mm = 450
+setpoint_max_mm = 440" --mode run --setpoint 50
 }
 
 api() { curl -s --max-time 2 "${url%/}$1" 2>/dev/null; }

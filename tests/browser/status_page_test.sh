@@ -67,43 +67,11 @@ sed -i 's|</body>|<script src="/layout_probe.js"></script>\n</body>|' "$tmp/web/
 grep -q layout_probe.js "$tmp/web/index.html" || abort "could not add the layout probe to the page's copy"
 
 # ---- start the appliance ----
-modbus_port=$(free_port)
-web_port=$(free_port)
-cat >"$tmp/epa.toml" <<EOF2
-# written by tests/browser/status_page_test.sh
-[modbus]
-address = "127.0.0.1"
-port = $modbus_port
-register_map = "$src/registers/epa.csv"
-
-[web]
-address = "127.0.0.1"
-port = $web_port
-static_dir = "$tmp/web"
-
-[log]
-status_interval_s = 0
-
-[limits]
+web_static_dir="$tmp/web"
+start_appliance "$src/registers/epa.csv" "[limits]
 soft_max_mm = 300
-setpoint_max_mm = 300
-
-[recorder]
-directory = "$tmp/runs"
-EOF2
-"$epa" serve --config "$tmp/epa.toml" --db "$tmp/epa.db" --mode run --setpoint 50 >"$tmp/epa.log" 2>&1 &
-pid=$!
-url="http://$host:$web_port/"
-echo "appliance pid $pid: web $url, modbus $host:$modbus_port"
-
-deadline=$(( $(now_ms) + 10000 ))
-ready=0
-while [ "$(now_ms)" -lt "$deadline" ]; do
-  kill -0 "$pid" 2>/dev/null || abort "the appliance exited during start-up"
-  if http_get "${url}api/status" | grep -q '"mode"'; then ready=1; break; fi
-  sleep 0.1
-done
-[ "$ready" -eq 1 ] || abort "the web server did not answer on $url within 10 s"
+setpoint_max_mm = 300" --mode run --setpoint 50
+modbus_port=$port
 
 # Let the piston reach 50 mm so that the trend has a story to show.
 sleep 2

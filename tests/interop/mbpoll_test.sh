@@ -39,39 +39,9 @@ near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d
 
 read_position() { mb -t 3:float -B -r 0 -c 1 "$host" 2>&1 | value_of 0; }
 
-# ---- start the appliance on a free loopback port ----
-port=$(free_port)
-cat >"$tmp/epa.toml" <<EOF
-# written by tests/interop/mbpoll_test.sh
-[modbus]
-address = "127.0.0.1"
-port = $port
-register_map = "$src/registers/epa.csv"
-unlock_key = "5e3a9c17d24b086f"
-
-[web]
-enabled = false
-
-[log]
-status_interval_s = 0
-
-[recorder]
-directory = "$tmp/runs"
-EOF
-"$epa" serve --config "$tmp/epa.toml" --db "$tmp/epa.db" --mode stop >"$tmp/epa.log" 2>&1 &
-pid=$!
-echo "appliance pid $pid on $host:$port (config $tmp/epa.toml)"
-
-# ---- readiness: poll with mbpoll until it answers, at most 10 s ----
-deadline=$(( $(now_ms) + 10000 ))
-ready=0
-while [ "$(now_ms)" -lt "$deadline" ]; do
-  kill -0 "$pid" 2>/dev/null || abort "the appliance exited during start-up"
-  if mbpoll -m tcp -a 1 -p "$port" -0 -1 -o 0.2 -t 3 -r 12 -c 1 "$host" >/dev/null 2>&1; then ready=1; break; fi
-  sleep 0.1
-done
-[ "$ready" -eq 1 ] || abort "the appliance did not answer Modbus requests on $host:$port within 10 s"
-echo "ready after $(( $(now_ms) - deadline + 10000 )) ms"
+# ---- start the appliance on a free loopback port (STOP), then one Modbus answer ----
+start_appliance "$src/registers/epa.csv"
+mbpoll -m tcp -a 1 -p "$port" -0 -1 -o 1 -t 3 -r 12 -c 1 "$host" >/dev/null 2>&1 || abort "the appliance did not answer a Modbus read"
 
 # ---- (1) the position float, ABCD (-B), input register 0-1: the simulated piston at 0 mm ----
 out=$(mb -t 3:float -B -r 0 -c 1 "$host" 2>&1)

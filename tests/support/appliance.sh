@@ -57,13 +57,27 @@ free_port() { python3 -c "import socket; s=socket.socket(); s.bind(('127.0.0.1',
 
 unlock_key="5e3a9c17d24b086f"  # [modbus] unlock_key of the test appliances (as tests/support/epa_appliance.py)
 
-# Starts `epa serve` (mode STOP, simulated plant) on a free loopback port: writes "$tmp/epa.toml"
-# with the register map $1, the tests' unlock key, no web server, and the TOML text $2 appended
-# (e.g. a [limits] section), logs to "$tmp/epa.log", and waits (at most 10 s) until it accepts TCP
-# connections. Sets `port` and `pid`; aborts when it exits or never listens.
+# start_appliance MAP [EXTRA_TOML] [SERVE_ARGS...]: starts `epa serve` (simulated plant; SERVE_ARGS
+# default to --mode stop) with the register map MAP on a free loopback port, the tests' unlock key
+# and the TOML text EXTRA_TOML appended (e.g. a [limits] section); writes "$tmp/epa.toml", appends
+# its log to "$tmp/epa.log" and waits (at most 10 s) until it accepts Modbus connections. Sets
+# `port` (Modbus) and `pid`. With `web_static_dir` set (and `web_token`, empty: commands off) the
+# web server runs too, on a free port, and is waited for by GET /api/status: sets `web_port` and
+# `url` (http://127.0.0.1:PORT/). Aborts when the appliance exits or never answers.
 start_appliance() {
   local map=$1 extra=${2:-}
+  shift $(( $# < 2 ? $# : 2 ))
+  [ $# -gt 0 ] || set -- --mode stop
   port=$(free_port)
+  local web="enabled = false"
+  if [ -n "${web_static_dir:-}" ]; then
+    web_port=$(free_port)
+    url="http://127.0.0.1:$web_port/"
+    web="address = \"127.0.0.1\"
+port = $web_port
+static_dir = \"$web_static_dir\"
+token = \"${web_token:-}\""
+  fi
   cat >"$tmp/epa.toml" <<CONFIG
 # written by tests/support/appliance.sh
 [modbus]
@@ -73,7 +87,7 @@ register_map = "$map"
 unlock_key = "$unlock_key"
 
 [web]
-enabled = false
+$web
 
 [log]
 status_interval_s = 0
@@ -82,14 +96,17 @@ status_interval_s = 0
 directory = "$tmp/runs"
 $extra
 CONFIG
-  "$epa" serve --config "$tmp/epa.toml" --db "$tmp/epa.db" --mode stop >"$tmp/epa.log" 2>&1 &
+  "$epa" serve --config "$tmp/epa.toml" --db "$tmp/epa.db" "$@" >>"$tmp/epa.log" 2>&1 &
   pid=$!
-  echo "appliance pid $pid on 127.0.0.1:$port (config $tmp/epa.toml)"
+  echo "appliance pid $pid: modbus 127.0.0.1:$port${web_port:+, web ${url:-}} (config $tmp/epa.toml)"
   local deadline=$(( $(now_ms) + 10000 ))
   while [ "$(now_ms)" -lt "$deadline" ]; do
     kill -0 "$pid" 2>/dev/null || abort "the appliance exited during start-up"
-    if (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null; then return 0; fi
+    if (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null; then
+      [ -z "${web_static_dir:-}" ] && return 0
+      curl -s --max-time 2 "${url}api/status" 2>/dev/null | grep -q '"mode"' && return 0
+    fi
     sleep 0.05
   done
-  abort "the appliance did not accept connections on 127.0.0.1:$port within 10 s"
+  abort "the appliance did not answer on 127.0.0.1:$port${web_port:+ and $url} within 10 s"
 }

@@ -28,40 +28,10 @@ source "$(dirname "$0")/../support/appliance.sh" promtool
 
 http_get() { curl -s --max-time 2 "$1" 2>/dev/null; }
 
-modbus_port=$(free_port)
-web_port=$(free_port)
-cat >"$tmp/epa.toml" <<EOF2
-# written by tests/web/metrics_promtool_test.sh
-[modbus]
-address = "127.0.0.1"
-port = $modbus_port
-register_map = "$src/registers/epa.csv"
-
-[web]
-address = "127.0.0.1"
-port = $web_port
-static_dir = "$src/web"
-
-[log]
-status_interval_s = 0
-
-[recorder]
-directory = "$tmp/runs"
-EOF2
-"$epa" serve --config "$tmp/epa.toml" --db "$tmp/epa.db" --mode run --setpoint 50 >"$tmp/epa.log" 2>&1 &
-pid=$!
-url="http://$host:$web_port"
-echo "appliance pid $pid: web $url, modbus $host:$modbus_port"
-
-# ---- readiness, then the first move finished (moves_total 1), at most 10 s each ----
-deadline=$(( $(now_ms) + 10000 ))
-ready=0
-while [ "$(now_ms)" -lt "$deadline" ]; do
-  kill -0 "$pid" 2>/dev/null || abort "the appliance exited during start-up"
-  if http_get "$url/api/status" | grep -q '"mode"'; then ready=1; break; fi
-  sleep 0.1
-done
-[ "$ready" -eq 1 ] || abort "the web server did not answer on $url within 10 s"
+web_static_dir="$src/web"
+start_appliance "$src/registers/epa.csv" "" --mode run --setpoint 50
+modbus_port=$port
+url=${url%/}
 mbpoll -m tcp -a 1 -p "$modbus_port" -0 -1 -o 1 -t 3 -r 0 -c 2 "$host" >/dev/null 2>&1 || fail "a Modbus read of input 0-1 was refused"
 mbpoll -m tcp -a 1 -p "$modbus_port" -0 -1 -o 1 -t 3 -r 199 -c 1 "$host" >/dev/null 2>&1 && fail "input 199 (unmapped) was answered"
 deadline=$(( $(now_ms) + 10000 ))
