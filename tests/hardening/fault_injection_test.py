@@ -31,7 +31,7 @@ import time
 import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from epa_appliance import UNIT, UNLOCK_ADDRESS, Appliance, key_words, f32_value, f32_words, free_port, u32_value, u32_words  # noqa: E402
+from epa_appliance import UNIT, UNLOCK_ADDRESS, Appliance, key_words, f32_value, f32_words, free_port, u32_value, u32_words, stop_process, wait_until  # noqa: E402
 
 
 class PlantServer:
@@ -60,22 +60,7 @@ class PlantServer:
         return {words[i]: words[i + 1] for i in range(0, len(words) - 1, 2)}
 
     def stop(self):
-        self.proc.terminate()
-        try:
-            self.proc.wait(timeout=5)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait(timeout=5)
-
-
-def wait_until(predicate, timeout_s, every_s=0.02):
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(every_s)
-    return predicate()
+        stop_process(self.proc)
 
 
 class Rig:

@@ -29,7 +29,7 @@ import urllib.error
 import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from epa_appliance import Appliance, free_port  # noqa: E402
+from epa_appliance import Appliance, free_port, stop_process  # noqa: E402
 
 TOKEN = "commissioning-test-token-0123"
 FAILURES = []
@@ -62,12 +62,7 @@ class PlantServer:
             raise RuntimeError(f"plant-server did not start: {open(self.log_path).read()}")
 
     def stop(self):
-        self.proc.terminate()
-        try:
-            self.proc.wait(timeout=5)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait(timeout=5)
+        stop_process(self.proc)
         self.log.close()
 
 

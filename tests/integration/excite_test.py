@@ -19,7 +19,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from epa_appliance import UNIT, Appliance, f32_value, f32_words, u32_value, u32_words, unlock  # noqa: E402
+from epa_appliance import UNIT, Appliance, Checks, f32_value, f32_words, u32_value, u32_words, unlock  # noqa: E402
 
 ILLEGAL_VALUE = 0x03
 CANNOT_APPLY = 0x04
@@ -37,12 +37,8 @@ def main():
     if len(sys.argv) != 3:
         sys.exit(f"usage: {sys.argv[0]} <epa binary> <source dir>")
     epa, src = sys.argv[1], sys.argv[2]
-    failures = []
-
-    def check(ok, what):
-        print(("PASS: " if ok else "FAIL: ") + what)
-        if not ok:
-            failures.append(what)
+    check = Checks()
+    failures = check.failures
 
     def refused(rr, code, what):
         check(rr.isError() and getattr(rr, "exception_code", None) == code, f"{what} -> exception {code:02X} ({rr})")

@@ -27,7 +27,7 @@ import time
 import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from epa_appliance import HOST, UNIT, Appliance, ModbusTcpClient, f32_value, f32_words, u32_value, u32_words  # noqa: E402
+from epa_appliance import HOST, UNIT, Appliance, Checks, ModbusTcpClient, f32_value, f32_words, u32_value, u32_words, wait_until  # noqa: E402
 
 SOFT_MAX_MM = 300.0
 MANUAL_V = 1.5
@@ -41,16 +41,6 @@ CONFIG = ("[limits]\n"
           "initial_position_mm = 100.0\n")
 MODES = {0: "stop", 1: "run", 2: "manual", 3: "fault", 4: "excite"}
 FAULT_HISTORY_ADDRESS, ENTRY_WORDS, ENTRIES = 200, 10, 8  # registers/epa.csv: input 200-281
-
-
-def wait_until(predicate, timeout_s, every_s=0.01):
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(every_s)
-    return predicate()
 
 
 class Rig:
@@ -139,13 +129,8 @@ def main():
     if len(sys.argv) != 3:
         sys.exit(f"usage: {sys.argv[0]} <epa binary> <source dir>")
     epa, src = sys.argv[1], sys.argv[2]
-    failures = []
-
-    def check(ok, what):
-        print(("PASS: " if ok else "FAIL: ") + what)
-        if not ok:
-            failures.append(what)
-        return ok
+    check = Checks()
+    failures = check.failures
 
     app = Appliance(epa, os.path.join(src, "registers", "epa.csv"), CONFIG, web_static_dir=os.path.join(src, "web"))
     rig = Rig(app)

@@ -23,7 +23,7 @@ import urllib.error
 import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from epa_appliance import UNIT, Appliance, f32_value, f32_words, pymodbus, unlock  # noqa: E402
+from epa_appliance import UNIT, Appliance, Checks, f32_value, f32_words, pymodbus, unlock  # noqa: E402
 
 TOKEN = "a-token-for-the-write-gate-test"
 ILLEGAL_VALUE = 0x03
@@ -48,12 +48,8 @@ def main():
     if len(sys.argv) != 3:
         sys.exit(f"usage: {sys.argv[0]} <epa binary> <source dir>")
     epa, src = sys.argv[1], sys.argv[2]
-    failures = []
-
-    def check(ok, what):
-        print(("PASS: " if ok else "FAIL: ") + what)
-        if not ok:
-            failures.append(what)
+    check = Checks()
+    failures = check.failures
 
     reg_map = os.path.join(src, "registers", "epa.csv")
     app = Appliance(epa, reg_map, "[limits]\nsetpoint_max_mm = 300.0\n", web_static_dir=os.path.join(src, "web"),

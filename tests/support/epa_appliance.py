@@ -74,6 +74,41 @@ def i16_value(word):
 
 
 # ---- the appliance as a child process ----
+def wait_until(predicate, timeout_s, every_s=0.01):
+    """Polls `predicate` until it returns something true (returned) or `timeout_s` has passed (its
+    last value is returned)."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(every_s)
+    return predicate()
+
+
+def stop_process(proc, grace_s=5.0):
+    """Stops a child by its PID: SIGTERM, SIGKILL after `grace_s`."""
+    proc.terminate()
+    try:
+        proc.wait(timeout=grace_s)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait(timeout=grace_s)
+
+
+class Checks:
+    """PASS/FAIL lines and the failures, for a test script's exit code."""
+
+    def __init__(self):
+        self.failures = []
+
+    def __call__(self, ok, what):
+        print(("PASS: " if ok else "FAIL: ") + what, flush=True)
+        if not ok:
+            self.failures.append(what)
+        return ok
+
+
 def free_port():
     with socket.socket() as s:
         s.bind((HOST, 0))
