@@ -54,7 +54,8 @@
 
   // Jog: held while the button is pressed. The bit is written once; while held a heartbeat every
   // 300 ms keeps the jog alive (the loop brakes a jog without one within [motion]
-  // jog_keepalive_s) without filling the audit trail, which records every control-word write.
+  // jog_keepalive_s). The heartbeat rather than the bit again: it is what a supervising client
+  // already sends, and it is never audited.
   function jogButton(id, name) {
     const button = $(id);
     let timer = null;
