@@ -9,7 +9,7 @@
 # test preset sets verify_asan_link_order=0; the runtime is still loaded and intercepts as usual.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/install-deps.sh
+scripts/install-deps.sh test
 start=$(date +%s)
 cmake --preset asan >/dev/null
 cmake --build --preset asan
