@@ -89,6 +89,7 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
           if (c.mode == Mode::kExcite) heartbeat_changed_ns_ = now_ns;  // the client gets a full timeout from here
           const bool outside = position_mm_ < config_.soft_min_mm || position_mm_ > config_.soft_max_mm;
           soft_limit_recovery_mm_ = (c.mode == Mode::kRun || c.mode == Mode::kManual) && readings_ > 0 && outside ? position_mm_ : kNaN;
+          if (mode_ == Mode::kManual) manual_valve_v_ = config_.safe_valve_v;  // it ends with MANUAL (read back so)
           mode_ = c.mode;
         }
         break;
@@ -330,6 +331,7 @@ void ScanCycle::enter_fault(FaultCode code) noexcept {
   if (moves_.active()) finish_move(MoveEnd::kFault);
   jog_law_ = profile_law_ = false;
   if (mode_ == Mode::kExcite) end_excitation(ExcitationEnd::kFault);
+  manual_valve_v_ = config_.safe_valve_v;  // a manual command ends with MANUAL: it reads back as the safe one
   mode_ = Mode::kFault;
   fault_ = code;
   ++faults_;

@@ -249,6 +249,29 @@ TEST_F(Faults, AnAxisLeftOutsideTheSoftLimitsCanBeBroughtBackButNotFurtherOut) {
   expect_safe_after_one_cycle(FaultCode::kSoftLimit);
 }
 
+// The manual valve command ends with MANUAL: after a fault or a mode change it reads back as the
+// safe command, not as the 1.5 V an HMI wrote before (an integrator read 1.5 V in STOP).
+TEST_F(Faults, TheManualValveCommandEndsWithManual) {
+  RuntimeConfig c;
+  c.soft_max_mm = 300.0;
+  c.setpoint_max_mm = 300.0;
+  start(c);
+  ASSERT_TRUE(ch_.commands.try_push(mode_command(Mode::kManual)));
+  ASSERT_TRUE(ch_.commands.try_push(manual_valve_command(1.5)));
+  cycles(2);
+  ASSERT_EQ(snap().manual_valve_v, 1.5);
+  ASSERT_TRUE(ch_.commands.try_push(mode_command(Mode::kStop)));
+  cycles(1);
+  EXPECT_EQ(snap().manual_valve_v, kSafeV) << "after MANUAL -> STOP";
+  ASSERT_TRUE(ch_.commands.try_push(mode_command(Mode::kManual)));
+  ASSERT_TRUE(ch_.commands.try_push(manual_valve_command(1.5)));
+  cycles(2);
+  daq_.sensor_v = 6.04;  // past the soft limit: a fault in MANUAL
+  cycles(1);
+  ASSERT_EQ(snap().mode, Mode::kFault);
+  EXPECT_EQ(snap().manual_valve_v, kSafeV) << "after a fault in MANUAL";
+}
+
 TEST_F(Faults, ResetWithTheCausePresentFaultsAgain) {
   start();
   daq_.sensor_v = 11.0;
