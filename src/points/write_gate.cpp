@@ -82,6 +82,14 @@ runtime::Snapshot WriteGate::with_unapplied(runtime::Snapshot s) const {
       case runtime::CommandKind::kSetpoint: s.setpoint_mm = c.value; break;
       case runtime::CommandKind::kMode:
         if (c.mode == runtime::Mode::kExcite && s.mode != runtime::Mode::kExcite) s.excitation_left_s = s.excitation.duration_s;  // all of it is left
+        if (c.mode != s.mode) {
+          // The motion bits as the loop will show them in the new mode, not the old one's (a read
+          // just after mode := MANUAL showed in_position and halted with manual_mode): nothing is
+          // moving, in position or off target yet; RUN and MANUAL start from a hold.
+          s.axis.moving = s.axis.in_position = s.axis.jogging = s.axis.off_target = false;
+          if (c.mode == runtime::Mode::kRun || c.mode == runtime::Mode::kManual) s.axis.target_reached = s.axis.halted = false;
+          if (s.mode == runtime::Mode::kManual || c.mode == runtime::Mode::kManual) s.manual_valve_v = loop_rules_.safe_valve_v;
+        }
         s.mode = c.mode;
         break;
       case runtime::CommandKind::kManualValve: s.manual_valve_v = c.value; break;

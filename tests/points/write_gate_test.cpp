@@ -216,6 +216,27 @@ TEST(WriteGate, AControlWordWrittenAgainAsItIsIsAKeepAliveNotAnAuditedChange) {
   EXPECT_EQ(queued, 5);  // every write still reaches the loop: it is the keep-alive
 }
 
+// A read right after a mode change shows the motion bits as the new mode will have them, not the
+// old mode's: RUN's in_position and a halt's halted must not read beside manual_mode.
+TEST(WriteGate, AModeChangeNotYetAppliedReadsWithTheNewModesMotionBits) {
+  const runtime::RuntimeConfig config;
+  runtime::LoopChannels channels(16);
+  WriteGate gate(limits_of(config), config, paper(), channels, nullptr);
+  runtime::Snapshot s;
+  s.mode = Mode::kRun;
+  s.axis.in_position = s.axis.halted = s.axis.target_reached = true;
+  s.manual_valve_v = 1.5;
+  channels.snapshot.publish(s);
+  const PointWrite manual[] = {{PointId::kMode, 2.0}};
+  ASSERT_TRUE(gate.submit(manual, kOperator).accepted());
+  const runtime::Snapshot seen = gate.snapshot();
+  EXPECT_EQ(seen.mode, Mode::kManual);
+  EXPECT_FALSE(seen.axis.in_position);
+  EXPECT_FALSE(seen.axis.halted);
+  EXPECT_FALSE(seen.axis.target_reached);
+  EXPECT_EQ(seen.manual_valve_v, config.safe_valve_v);
+}
+
 TEST(WriteGate, PpTrajIsRefusedOnAModelItCannotUseAndTakenOnOneItCan) {
   const runtime::RuntimeConfig config;
   runtime::LoopChannels channels(16);
