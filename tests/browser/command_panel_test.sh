@@ -21,21 +21,13 @@
 # Loopback only, bounded waits; the appliance is stopped by its PID.
 set -uo pipefail
 
-if [ $# -ne 3 ]; then
-  echo "usage: $0 <epa binary> <source dir> <artifacts dir>" >&2
-  exit 2
-fi
-epa=$1
-src=$2
+source "$(dirname "$0")/../support/appliance.sh" command-panel
+test_arguments 3 "<epa binary> <source dir> <artifacts dir>" "$@"
 artifacts=$3
 token="panel-test-token-0123456789"
-
-command -v chromium >/dev/null || { echo "FAIL: chromium is not installed (scripts/install-deps.sh installs it)" >&2; exit 1; }
-command -v curl >/dev/null || { echo "FAIL: curl is not installed" >&2; exit 1; }
-[ -x "$epa" ] || { echo "FAIL: $epa is not an executable" >&2; exit 1; }
+need chromium
+need curl
 mkdir -p "$artifacts"
-
-source "$(dirname "$0")/../support/appliance.sh" command-panel
 source "$(dirname "$0")/../support/chromium.sh"
 BROWSER_TIMEOUT_S=90
 

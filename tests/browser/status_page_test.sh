@@ -16,22 +16,14 @@
 # the version `epa --version` prints. The appliance is stopped by its PID.
 set -uo pipefail
 
-if [ $# -ne 3 ]; then
-  echo "usage: $0 <epa binary> <source dir> <artifacts dir>" >&2
-  exit 2
-fi
-epa=$1
-src=$2
+source "$(dirname "$0")/../support/appliance.sh" browser
+test_arguments 3 "<epa binary> <source dir> <artifacts dir>" "$@"
 artifacts=$3
 host=127.0.0.1
-
-command -v chromium >/dev/null || { echo "FAIL: chromium is not installed (scripts/install-deps.sh installs it)" >&2; exit 1; }
-command -v mbpoll >/dev/null || { echo "FAIL: mbpoll is not installed" >&2; exit 1; }
+need chromium
+need mbpoll
 command -v curl >/dev/null || command -v python3 >/dev/null || { echo "FAIL: need curl or python3" >&2; exit 1; }
-[ -x "$epa" ] || { echo "FAIL: $epa is not an executable" >&2; exit 1; }
 mkdir -p "$artifacts"
-
-source "$(dirname "$0")/../support/appliance.sh" browser
 source "$(dirname "$0")/../support/chromium.sh"
 
 http_get() { curl -s --max-time 2 "$1" 2>/dev/null; }

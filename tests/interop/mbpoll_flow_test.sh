@@ -16,19 +16,11 @@
 # fault history (count + newest entry). Each step prints its timing. Exit 0: all passed.
 set -uo pipefail
 
-if [ $# -ne 2 ]; then
-  echo "usage: $0 <epa binary> <source dir>" >&2
-  exit 2
-fi
-epa=$1
-src=$2
-host=127.0.0.1
-
-command -v mbpoll >/dev/null || { echo "FAIL: mbpoll is not installed (scripts/install-deps.sh installs it)" >&2; exit 1; }
-command -v python3 >/dev/null || { echo "FAIL: python3 is needed to pick a free port" >&2; exit 1; }
-[ -x "$epa" ] || { echo "FAIL: $epa is not an executable" >&2; exit 1; }
-
 source "$(dirname "$0")/../support/appliance.sh" mbpoll-flow
+test_arguments 2 "<epa binary> <source dir>" "$@"
+host=127.0.0.1
+need mbpoll
+need python3
 hb_pid=""
 stop_heartbeat() { [ -n "$hb_pid" ] && kill "$hb_pid" 2>/dev/null; [ -n "$hb_pid" ] && wait "$hb_pid" 2>/dev/null; hb_pid=""; }
 trap 'stop_heartbeat; cleanup' EXIT

@@ -13,20 +13,12 @@
 # passed; 1: a check failed (each failure says what was expected and what came back).
 set -uo pipefail
 
-if [ $# -ne 2 ]; then
-  echo "usage: $0 <epa binary> <source dir>" >&2
-  exit 2
-fi
-epa=$1
-src=$2
-host=127.0.0.1
-
-command -v mbpoll >/dev/null || { echo "FAIL: mbpoll is not installed (scripts/install-deps.sh installs it)" >&2; exit 1; }
-command -v python3 >/dev/null || { echo "FAIL: python3 is needed to pick a free port" >&2; exit 1; }
-[ -x "$epa" ] || { echo "FAIL: $epa is not an executable" >&2; exit 1; }
-[ -f "$src/registers/epa.csv" ] || { echo "FAIL: $src/registers/epa.csv not found" >&2; exit 1; }
-
 source "$(dirname "$0")/../support/appliance.sh" mbpoll
+test_arguments 2 "<epa binary> <source dir>" "$@"
+host=127.0.0.1
+need mbpoll
+need python3
+[ -f "$src/registers/epa.csv" ] || { echo "FAIL: $src/registers/epa.csv not found" >&2; exit 1; }
 
 # mbpoll against the appliance: TCP, unit 1, 0-based (PDU) addresses, one poll, 1 s timeout.
 mb() { mbpoll -m tcp -a 1 -p "$port" -0 -1 -o 1 "$@"; }

@@ -12,23 +12,15 @@
 # SIGKILL after 5 s) and expects exit status 0. Exit 0: all passed; 1: a step failed (named).
 set -uo pipefail
 
-if [ $# -ne 2 ]; then
-  echo "usage: $0 <epa binary> <source dir>" >&2
-  exit 2
-fi
-epa=$1
-src=$2
+source "$(dirname "$0")/../support/appliance.sh" modbus-serial
+test_arguments 2 "<epa binary> <source dir>" "$@"
 node_dir="$(cd "$(dirname "$0")" && pwd)/node"
-
-command -v node >/dev/null || { echo "FAIL: node is not installed (scripts/install-deps.sh installs nodejs and npm)" >&2; exit 1; }
-command -v python3 >/dev/null || { echo "FAIL: python3 is needed to pick a free port" >&2; exit 1; }
+need node nodejs
+need python3
 # No modules: `npm ci` could not reach the npm registry (install-deps said why). Skipped (ctest's
 # SKIP_RETURN_CODE 77), not passed: the summary lists it under "did not run".
 [ -f "$node_dir/node_modules/modbus-serial/package.json" ] \
   || { echo "SKIP: $node_dir/node_modules has no modbus-serial: scripts/install-deps.sh test could not install it (npm registry)" >&2; exit 77; }
-[ -x "$epa" ] || { echo "FAIL: $epa is not an executable" >&2; exit 1; }
-
-source "$(dirname "$0")/../support/appliance.sh" modbus-serial
 
 echo "node $(node --version), modbus-serial $(node -p "require('$node_dir/node_modules/modbus-serial/package.json').version")"
 start_appliance "$src/registers/epa.csv" "[limits]

@@ -53,6 +53,26 @@ abort() {  # a failure the later checks cannot recover from
   exit 1
 }
 
+# test_arguments COUNT USAGE "$@": the script's arguments, exactly COUNT of them, else "usage: $0
+# USAGE" and exit 2; sets `epa` (checked to be an executable) and `src` from the first two.
+test_arguments() {
+  local count=$1 usage=$2
+  shift 2
+  if [ $# -ne "$count" ]; then
+    echo "usage: $0 $usage" >&2
+    exit 2
+  fi
+  epa=$1
+  src=$2
+  [ -x "$epa" ] || { echo "FAIL: $epa is not an executable" >&2; exit 1; }
+}
+
+# need PROGRAM [PACKAGE]: PROGRAM on PATH, else FAIL naming the Debian package (default: PROGRAM)
+# that scripts/install-deps.sh installs.
+need() {
+  command -v "$1" >/dev/null || { echo "FAIL: $1 is not installed (package ${2:-$1}: scripts/install-deps.sh installs it)" >&2; exit 1; }
+}
+
 free_port() { python3 -c "import socket; s=socket.socket(); s.bind(('127.0.0.1',0)); print(s.getsockname()[1])"; }
 
 unlock_key="5e3a9c17d24b086f"  # [modbus] unlock_key of the test appliances (as tests/support/epa_appliance.py)

@@ -11,20 +11,12 @@
 # count. Fails when promtool is missing (it is not skipped). The appliance is stopped by its PID.
 set -uo pipefail
 
-if [ $# -ne 2 ]; then
-  echo "usage: $0 <epa binary> <source dir>" >&2
-  exit 2
-fi
-epa=$1
-src=$2
-host=127.0.0.1
-
-command -v promtool >/dev/null || { echo "FAIL: promtool is not installed (package prometheus; scripts/install-deps.sh installs it)" >&2; exit 1; }
-command -v curl >/dev/null || { echo "FAIL: curl is not installed (scripts/install-deps.sh installs it)" >&2; exit 1; }
-command -v mbpoll >/dev/null || { echo "FAIL: mbpoll is not installed (scripts/install-deps.sh installs it)" >&2; exit 1; }
-[ -x "$epa" ] || { echo "FAIL: $epa is not an executable" >&2; exit 1; }
-
 source "$(dirname "$0")/../support/appliance.sh" promtool
+test_arguments 2 "<epa binary> <source dir>" "$@"
+host=127.0.0.1
+need promtool prometheus
+need curl
+need mbpoll
 
 http_get() { curl -s --max-time 2 "$1" 2>/dev/null; }
 
