@@ -205,14 +205,4 @@ pass "(8) soft-limit latched ${t_fault} ms after valve 1.5 V, reset bit -> ready
 
 # ---- stop ----
 stop_heartbeat
-if kill -0 "$pid" 2>/dev/null; then
-  stop_appliance
-  status=$?
-  [ $status -eq 0 ] && pass "appliance stopped on SIGTERM with exit status 0" || fail "appliance stop: exit status $status after SIGTERM"
-else
-  fail "the appliance died during the test"
-  pid=""
-fi
-[ "$failed" -eq 0 ] || show_log
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish_test

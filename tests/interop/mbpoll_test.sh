@@ -154,19 +154,4 @@ else
 fi
 
 # ---- the appliance is still up and stops cleanly on SIGTERM ----
-if kill -0 "$pid" 2>/dev/null; then
-  stop_appliance
-  status=$?
-  if [ $status -eq 0 ]; then
-    pass "appliance stopped on SIGTERM with exit status 0"
-  else
-    fail "appliance stop: expected exit status 0 after SIGTERM, got $status"
-  fi
-else
-  fail "the appliance died during the test"
-  pid=""
-fi
-
-[ "$failed" -eq 0 ] || show_log
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish_test

@@ -32,15 +32,4 @@ timeout 100 node "$node_dir/flow_test.js" "$epa" "$src" 127.0.0.1 "$port"
 rc=$?
 if [ $rc -eq 0 ]; then pass "the modbus-serial flow"; else fail "the modbus-serial flow exited with status $rc"; fi
 
-if kill -0 "$pid" 2>/dev/null; then
-  stop_appliance
-  status=$?
-  if [ $status -eq 0 ]; then pass "appliance stopped on SIGTERM with exit status 0"; else fail "appliance stop: exit status $status after SIGTERM"; fi
-else
-  fail "the appliance died during the test"
-  pid=""
-fi
-
-[ "$failed" -eq 0 ] || show_log
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish_test

@@ -53,6 +53,23 @@ abort() {  # a failure the later checks cannot recover from
   exit 1
 }
 
+# finish_test: the appliance, still up, stops on SIGTERM with exit status 0 (a check of its own);
+# the log on any failure; "N passed, M failed"; returns 0 only when nothing failed (the script's
+# last command, so its exit status).
+finish_test() {
+  if kill -0 "$pid" 2>/dev/null; then
+    stop_appliance
+    local status=$?
+    if [ $status -eq 0 ]; then pass "appliance stopped on SIGTERM with exit status 0"; else fail "appliance stop: exit status $status after SIGTERM"; fi
+  else
+    fail "the appliance died during the test"
+    pid=""
+  fi
+  [ "$failed" -eq 0 ] || show_log
+  echo "$passed passed, $failed failed"
+  [ "$failed" -eq 0 ]
+}
+
 # test_arguments COUNT USAGE "$@": the script's arguments, exactly COUNT of them, else "usage: $0
 # USAGE" and exit 2; sets `epa` (checked to be an executable) and `src` from the first two.
 test_arguments() {
