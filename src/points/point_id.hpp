@@ -63,6 +63,11 @@ inline constexpr std::size_t index(PointId id) { return static_cast<std::size_t>
 inline constexpr PointId indexed_id(PointId first, std::size_t i) {
   return static_cast<PointId>(static_cast<std::size_t>(first) + i);
 }
+// The control-word bit a coil point stands for (kControlBit0 + bit), or -1 for any other point.
+inline constexpr int control_bit(PointId id) {
+  const std::size_t bit = index(id) - index(PointId::kControlBit0);  // wraps for ids below: not a bit
+  return bit < static_cast<std::size_t>(runtime::kControlBits) ? static_cast<int>(bit) : -1;
+}
 // kFaultCode0 + i and the like: the same arithmetic.
 inline constexpr PointId fault_history_id(PointId first, std::size_t i) { return indexed_id(first, i); }
 

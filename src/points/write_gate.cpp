@@ -221,9 +221,8 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
       case PointId::kExciteDuration: out.excitation.duration_s = w.value; break;
       default: {
         if (RecordField f; record_field(w.id, f)) continue;  // the gate's own: taken above
-        const std::size_t bit = index(w.id) - index(PointId::kControlBit0);
-        if (bit >= static_cast<std::size_t>(runtime::kControlBits))
-          return refuse(Refusal::kNotWritable, quoted(w.id) + " has no command behind it");
+        const int bit = control_bit(w.id);
+        if (bit < 0) return refuse(Refusal::kNotWritable, quoted(w.id) + " has no command behind it");
         const auto mask = static_cast<std::uint16_t>(1u << bit);
         control(static_cast<std::uint16_t>(w.value != 0.0 ? out.control_word | mask : out.control_word & ~mask), c);
         break;
@@ -328,8 +327,7 @@ GateResult WriteGate::submit(std::span<const PointWrite> writes, const Requester
     core::AuditEntry e{time_ms, who.source, std::string(p.name), p.value(ctx), w.value};
     // The control word (or a bit of it) written again as it was is a held jog's keep-alive, several
     // a second: no change, so not in the audit trail and the store.
-    const bool control = w.id == PointId::kControlWord ||
-                         index(w.id) - index(PointId::kControlBit0) < static_cast<std::size_t>(runtime::kControlBits);
+    const bool control = w.id == PointId::kControlWord || control_bit(w.id) >= 0;
     if (control && e.old_value == e.new_value) continue;
     std::uint64_t sequence = first + d.commands.size() - 1;  // a tuning point: the tuning command, last
     if (excitation_point(w.id)) sequence = first;            // an excitation point: the excitation command, first
