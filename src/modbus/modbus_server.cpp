@@ -13,6 +13,7 @@
 #include <cstring>
 #include <vector>
 
+#include "core/listen_backlog.hpp"
 #include "runtime/clock.hpp"
 
 namespace epa::modbus {
@@ -76,7 +77,7 @@ core::Result<std::unique_ptr<ModbusServer>> ModbusServer::start(const ServerConf
   if (!impl->ctx) return core::invalid_argument("modbus: cannot listen on " + where + ": " + modbus_strerror(errno));
   impl->image = new_register_image(map);  // bit tables padded to 16: the reserved bits read 0
   if (!impl->image) return core::io_error("modbus: cannot allocate the register image");
-  impl->listener = modbus_tcp_listen(impl->ctx, 64);
+  impl->listener = modbus_tcp_listen(impl->ctx, core::kListenBacklog);
   if (impl->listener < 0) return core::io_error("modbus: cannot listen on " + where + ": " + modbus_strerror(errno));
   fcntl(impl->listener, F_SETFL, O_NONBLOCK);
   sockaddr_in addr{};

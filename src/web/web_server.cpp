@@ -1,6 +1,7 @@
 #include "web/web_server.hpp"
 
 #include <httplib.h>
+#include <sys/socket.h>
 
 #include <atomic>
 #include <chrono>
@@ -12,6 +13,7 @@
 #include <thread>
 
 #include "core/address_backoff.hpp"
+#include "core/listen_backlog.hpp"
 #include "runtime/clock.hpp"
 #include "web/command_body.hpp"
 #include "web/commission_port.hpp"
@@ -353,6 +355,13 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
     return new ElasticTaskQueue(kIdleWorkers, static_cast<std::size_t>(threads), std::chrono::seconds(5));
   };
   s.set_payload_max_length(config.max_body_bytes);  // timeouts and keep-alive: RequestLimits
+  // Debian's libcpp-httplib is built with a listen queue of 5; the hook that sets the listening
+  // socket's options is where its descriptor can be seen, to listen again with the larger queue.
+  auto listening_socket = std::make_shared<socket_t>(INVALID_SOCKET);
+  s.set_socket_options([listening_socket](socket_t sock) {
+    httplib::default_socket_options(sock);
+    *listening_socket = sock;
+  });
   impl->routes();
 
   if (config.port == 0) {
@@ -364,6 +373,8 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
                             " (in use, or not an address of this machine?)");
     impl->port = config.port;
   }
+  if (*listening_socket == INVALID_SOCKET || ::listen(*listening_socket, core::kListenBacklog) != 0)
+    return core::io_error("web: cannot enlarge the listen queue of " + config.address + ":" + std::to_string(impl->port));
   Impl* p = impl.get();
   p->sampler = std::thread([p] { p->sample_until_stopped(); });
   p->listener = std::thread([p] {
