@@ -3,12 +3,15 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <sys/epoll.h>
+#include <sys/eventfd.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <string>
 
@@ -52,20 +55,8 @@ class DeadlineSocketStream final : public httplib::Stream {
  public:
   DeadlineSocketStream(int fd, const RequestLimits& limits) : fd_(fd), limits_(limits) {}
 
-  // Waits up to `wait` for the next request's first byte, in slices so a stopping server is seen.
-  template <typename Stopping>
-  bool wait_for_request(std::chrono::milliseconds wait, Stopping stopping) const {
-    if (pos_ < end_) return true;
-    const auto until = Clock::now() + wait;
-    while (!stopping()) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - Clock::now());
-      if (left.count() <= 0) return false;
-      if (poll_for(fd_, POLLIN, std::min(left, std::chrono::milliseconds(100)))) return true;
-    }
-    return false;
-  }
-
   Cut cut() const { return cut_; }
+  bool has_buffered() const { return pos_ < end_; }
 
   bool is_readable() const override { return pos_ < end_ || poll_for(fd_, POLLIN, limits_.read_timeout); }
   bool is_writable() const override { return cut_ == Cut::kNone && poll_for(fd_, POLLOUT, limits_.write_timeout); }
@@ -163,24 +154,144 @@ class DeadlineSocketStream final : public httplib::Stream {
 
 }  // namespace
 
+DeadlineHttpServer::DeadlineHttpServer(const RequestLimits& limits) : limits_(limits) {
+  epoll_fd_ = ::epoll_create1(EPOLL_CLOEXEC);
+  wake_fd_ = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+  if (epoll_fd_ >= 0 && wake_fd_ >= 0) {
+    epoll_event ev{};
+    ev.events = EPOLLIN;
+    ev.data.fd = wake_fd_;
+    ::epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, wake_fd_, &ev);
+    parker_ = std::thread([this] { park_loop(); });
+  } else {
+    parking_ = false;  // no epoll: every connection keeps its worker, as httplib does
+  }
+}
+
+DeadlineHttpServer::~DeadlineHttpServer() {
+  stop_parking();
+  if (epoll_fd_ >= 0) ::close(epoll_fd_);
+  if (wake_fd_ >= 0) ::close(wake_fd_);
+}
+
+void DeadlineHttpServer::set_task_queue(httplib::TaskQueue* queue) {
+  std::lock_guard lock(mutex_);
+  queue_ = queue;
+}
+
+std::size_t DeadlineHttpServer::parked() const {
+  std::lock_guard lock(mutex_);
+  return parked_.size();
+}
+
+void DeadlineHttpServer::stop_parking() {
+  {
+    std::lock_guard lock(mutex_);
+    if (!parking_ && !parker_.joinable()) return;
+    parking_ = false;
+    queue_ = nullptr;
+  }
+  const std::uint64_t one = 1;
+  if (wake_fd_ >= 0) (void)!::write(wake_fd_, &one, sizeof one);
+  if (parker_.joinable()) parker_.join();
+  std::lock_guard lock(mutex_);
+  for (const auto& [sock, p] : parked_) ::close(sock);
+  parked_.clear();
+}
+
+void DeadlineHttpServer::park(socket_t sock, std::size_t requests_left, std::chrono::milliseconds wait) {
+  std::unique_lock lock(mutex_);
+  if (!parking_ || !queue_) {
+    lock.unlock();
+    ::shutdown(sock, SHUT_RDWR);
+    ::close(sock);
+    return;
+  }
+  parked_[sock] = {Clock::now() + wait, requests_left};
+  epoll_event ev{};
+  ev.events = EPOLLIN | EPOLLRDHUP | EPOLLONESHOT;
+  ev.data.fd = sock;
+  if (::epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, sock, &ev) != 0) {
+    parked_.erase(sock);
+    lock.unlock();
+    ::close(sock);
+    return;
+  }
+  lock.unlock();
+  const std::uint64_t one = 1;  // the loop's next timeout may be this one's
+  (void)!::write(wake_fd_, &one, sizeof one);
+}
+
+void DeadlineHttpServer::park_loop() {
+  std::array<epoll_event, 64> events{};
+  for (;;) {
+    int timeout_ms = 1000;
+    {
+      std::lock_guard lock(mutex_);
+      if (!parking_) return;
+      const auto now = Clock::now();
+      for (auto it = parked_.begin(); it != parked_.end();) {  // waits that ended: closed unanswered
+        if (it->second.until <= now) {
+          ::epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, it->first, nullptr);
+          ::close(it->first);
+          it = parked_.erase(it);
+        } else {
+          const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(it->second.until - now).count() + 1;
+          timeout_ms = static_cast<int>(std::min<long long>(timeout_ms, left));
+          ++it;
+        }
+      }
+    }
+    const int n = ::epoll_wait(epoll_fd_, events.data(), static_cast<int>(events.size()), timeout_ms);
+    if (n < 0 && errno != EINTR) return;
+    for (int i = 0; i < n; ++i) {
+      const int fd = events[static_cast<std::size_t>(i)].data.fd;
+      if (fd == wake_fd_) {
+        std::uint64_t count = 0;
+        (void)!::read(wake_fd_, &count, sizeof count);
+        continue;
+      }
+      std::lock_guard lock(mutex_);
+      const auto it = parked_.find(fd);
+      if (it == parked_.end()) continue;
+      const std::size_t left = it->second.requests_left;
+      parked_.erase(it);
+      ::epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, fd, nullptr);
+      if (!parking_ || !queue_) {
+        ::close(fd);
+        continue;
+      }
+      queue_->enqueue([this, fd, left] { serve(fd, left, false); });  // a byte (or the peer's end) came
+    }
+  }
+}
+
 bool DeadlineHttpServer::process_and_close_socket(socket_t sock) {
+  serve(sock, limits_.keep_alive_max_requests, true);
+  return true;
+}
+
+void DeadlineHttpServer::serve(socket_t sock, std::size_t requests_left, bool first) {
   DeadlineSocketStream stream(sock, limits_);
-  bool served = false;
-  for (std::size_t left = limits_.keep_alive_max_requests; left > 0; --left) {
-    const auto stopping = [this] { return svr_sock_ == INVALID_SOCKET; };
-    if (stopping() || !stream.wait_for_request(limits_.keep_alive_timeout, stopping)) break;
+  const auto stopping = [this] { return svr_sock_ == INVALID_SOCKET; };
+  for (std::size_t left = requests_left; left > 0; --left) {
+    if (stopping()) break;
+    if (!stream.has_buffered() && !poll_for(sock, POLLIN, std::chrono::milliseconds(0))) {
+      // Silent: wait on the parker rather than on this worker.
+      park(sock, left, first ? limits_.read_timeout : limits_.keep_alive_timeout);
+      return;
+    }
+    first = false;
     bool connection_closed = false;
-    served = process_request(stream, left == 1, connection_closed, nullptr);
+    const bool served = process_request(stream, left == 1, connection_closed, nullptr);
     if (stream.cut() != Cut::kNone) {
       stream.answer_cut();
-      served = false;
       break;
     }
     if (!served || connection_closed) break;
   }
   ::shutdown(sock, SHUT_RDWR);
   ::close(sock);
-  return served;
 }
 
 }  // namespace epa::web

@@ -9,6 +9,9 @@
 
 #include <chrono>
 #include <cstddef>
+#include <map>
+#include <mutex>
+#include <thread>
 
 namespace epa::web {
 
@@ -21,15 +24,41 @@ struct RequestLimits {
   std::size_t max_request_bytes = 64 * 1024;           // head and body; a larger request is cut, not read
 };
 
+// A connection with nothing to read (just accepted, or kept alive between requests) does not hold a
+// worker: it is parked on one epoll thread until its next byte arrives, then handed to a worker
+// again, or closed when its wait (read_timeout, keep_alive_timeout) ends. So 600 silent
+// connections cost 600 descriptors, not 600 workers, and a poll behind them is served at once.
 class DeadlineHttpServer final : public httplib::Server {
  public:
-  explicit DeadlineHttpServer(const RequestLimits& limits) : limits_(limits) {}
+  explicit DeadlineHttpServer(const RequestLimits& limits);
+  ~DeadlineHttpServer() override;
+
+  // The queue httplib creates for its workers (from new_task_queue): where woken connections go.
+  void set_task_queue(httplib::TaskQueue* queue);
+  // Ends the parking: every parked connection is closed, and later ones are closed at once. Call
+  // before stop(), while the task queue still exists.
+  void stop_parking();
+  std::size_t parked() const;
 
  private:
   // httplib calls this (a private virtual of httplib::Server) on a worker for each accepted socket.
   bool process_and_close_socket(socket_t sock) override;
+  // Serves requests on `sock` while they come without a wait; parks it when it falls silent.
+  void serve(socket_t sock, std::size_t requests_left, bool first);
+  void park(socket_t sock, std::size_t requests_left, std::chrono::milliseconds wait);
+  void park_loop();
 
+  struct Parked {
+    std::chrono::steady_clock::time_point until;
+    std::size_t requests_left = 0;
+  };
   RequestLimits limits_;
+  int epoll_fd_ = -1, wake_fd_ = -1;
+  mutable std::mutex mutex_;
+  std::map<socket_t, Parked> parked_;
+  httplib::TaskQueue* queue_ = nullptr;
+  bool parking_ = true;
+  std::thread parker_;
 };
 
 }  // namespace epa::web

@@ -351,8 +351,10 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
   }
   auto& s = impl->server;
   const int threads = config.worker_threads;
-  s.new_task_queue = [threads] {
-    return new ElasticTaskQueue(kIdleWorkers, static_cast<std::size_t>(threads), std::chrono::seconds(5));
+  s.new_task_queue = [threads, &s] {
+    auto* queue = new ElasticTaskQueue(kIdleWorkers, static_cast<std::size_t>(threads), std::chrono::seconds(5));
+    s.set_task_queue(queue);  // where parked connections go back to when they speak
+    return queue;
   };
   s.set_payload_max_length(config.max_body_bytes);  // timeouts and keep-alive: RequestLimits
   // Debian's libcpp-httplib is built with a listen queue of 5; the hook that sets the listening
@@ -398,6 +400,7 @@ void WebServer::stop() {
   if (impl_->listener.joinable()) {
     // listen_after_bind may not have reached its loop yet, and a stop() before that is lost.
     while (!impl_->server.is_running() && !impl_->listen_returned.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    impl_->server.stop_parking();  // while httplib's task queue still exists
     impl_->server.stop();
     impl_->listener.join();
   }
