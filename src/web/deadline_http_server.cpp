@@ -162,9 +162,10 @@ DeadlineHttpServer::DeadlineHttpServer(const RequestLimits& limits) : limits_(li
     ev.events = EPOLLIN;
     ev.data.fd = wake_fd_;
     ::epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, wake_fd_, &ev);
+    epoll_ok_ = true;
     parker_ = std::thread([this] { park_loop(); });
   } else {
-    parking_ = false;  // no epoll: every connection keeps its worker, as httplib does
+    parking_ = false;  // no epoll: a silent connection keeps its worker (serve)
   }
 }
 
@@ -276,10 +277,13 @@ void DeadlineHttpServer::serve(socket_t sock, std::size_t requests_left, bool fi
   const auto stopping = [this] { return svr_sock_ == INVALID_SOCKET; };
   for (std::size_t left = requests_left; left > 0; --left) {
     if (stopping()) break;
+    const auto wait = first ? limits_.read_timeout : limits_.keep_alive_timeout;
     if (!stream.has_buffered() && !poll_for(sock, POLLIN, std::chrono::milliseconds(0))) {
-      // Silent: wait on the parker rather than on this worker.
-      park(sock, left, first ? limits_.read_timeout : limits_.keep_alive_timeout);
-      return;
+      if (epoll_ok_) {  // silent: wait on the parker rather than on this worker
+        park(sock, left, wait);
+        return;
+      }
+      if (!poll_for(sock, POLLIN, wait)) break;  // no epoll on this system: wait here, as httplib does
     }
     first = false;
     bool connection_closed = false;

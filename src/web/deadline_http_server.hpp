@@ -54,6 +54,7 @@ class DeadlineHttpServer final : public httplib::Server {
   };
   RequestLimits limits_;
   int epoll_fd_ = -1, wake_fd_ = -1;
+  bool epoll_ok_ = false;  // the parker runs; else a silent connection waits on its worker
   mutable std::mutex mutex_;
   std::map<socket_t, Parked> parked_;
   httplib::TaskQueue* queue_ = nullptr;
