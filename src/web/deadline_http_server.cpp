@@ -180,11 +180,6 @@ void DeadlineHttpServer::set_task_queue(httplib::TaskQueue* queue) {
   queue_ = queue;
 }
 
-std::size_t DeadlineHttpServer::parked() const {
-  std::lock_guard lock(mutex_);
-  return parked_.size();
-}
-
 void DeadlineHttpServer::stop_parking() {
   {
     std::lock_guard lock(mutex_);

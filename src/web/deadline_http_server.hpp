@@ -38,7 +38,6 @@ class DeadlineHttpServer final : public httplib::Server {
   // Ends the parking: every parked connection is closed, and later ones are closed at once. Call
   // before stop(), while the task queue still exists.
   void stop_parking();
-  std::size_t parked() const;
 
  private:
   // httplib calls this (a private virtual of httplib::Server) on a worker for each accepted socket.
@@ -55,7 +54,7 @@ class DeadlineHttpServer final : public httplib::Server {
   RequestLimits limits_;
   int epoll_fd_ = -1, wake_fd_ = -1;
   bool epoll_ok_ = false;  // the parker runs; else a silent connection waits on its worker
-  mutable std::mutex mutex_;
+  std::mutex mutex_;
   std::map<socket_t, Parked> parked_;
   httplib::TaskQueue* queue_ = nullptr;
   bool parking_ = true;
