@@ -79,7 +79,7 @@ ControllerOutput controller_step(const ControllerParams& p, ControllerState& sta
     finite = std::isfinite(u);
     if (!finite) state.trajectory = before;  // overflow of a diverging loop: do not poison the state
     valve = t.holding   ? 0.0
-            : t.arrived ? creeping_idz_command(p.dead_zone(), u, p.trajectory().creep_margin_v)
+            : t.arrived ? creeping_idz_command(p.dead_zone(), u, t.creep_margin_v)
                         : smooth_idz_command(p.dead_zone(), u, p.trajectory().idz_ramp);
   } else {
     const RstState before = state.rst;

@@ -71,6 +71,7 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   if (!(c.error_filter_s >= 0.0) || !std::isfinite(c.error_filter_s)) return field_error("error_filter_s", c.error_filter_s, ">= 0 s");
   if (!(c.creep_margin_v >= 0.0) || !std::isfinite(c.creep_margin_v)) return field_error("creep_margin_v", c.creep_margin_v, ">= 0 V");
   if (!(c.idz_ramp >= 0.0) || !std::isfinite(c.idz_ramp)) return field_error("idz_ramp", c.idz_ramp, ">= 0");
+  if (!(c.creep_blend_s >= 0.0) || !std::isfinite(c.creep_blend_s)) return field_error("creep_blend_s", c.creep_blend_s, ">= 0 s");
   for (std::size_t i = 0; i < A.size(); ++i)
     if (!std::isfinite(A[i])) return core::invalid_argument("pp-traj: the model's A[" + std::to_string(i) + "] is not finite");
   for (std::size_t i = 0; i < B.size(); ++i)
@@ -103,6 +104,7 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   p.filter_alpha = c.error_filter_s > 0.0 ? 1.0 - std::exp(-Ts / c.error_filter_s) : 1.0;
   p.idz_ramp = c.idz_ramp;
   p.creep_margin_v = c.creep_margin_v;
+  p.creep_margin_step_v = c.creep_margin_v / std::max(1.0, std::round(c.creep_blend_s / Ts));
   p.integrator_limit = std::max(dz.m_r * (valve_limit_v - dz.b_r), dz.m_l * (valve_limit_v + dz.b_l));
   return p;
 }
@@ -144,10 +146,15 @@ TrajectoryOutput trajectory_step(const TrajectoryParams& p, TrajectoryState& s, 
   s.feedback_stage1_v += p.feedback_filter_alpha * (e - s.feedback_stage1_v);
   s.feedback_stage2_v += p.feedback_filter_alpha * (s.feedback_stage1_v - s.feedback_stage2_v);
   const double u_fb = p.proportional_gain * s.feedback_stage2_v;
+  // The creeping inverse takes over from NG-IDZ gradually: a margin that jumped at arrival would
+  // step the drive by up to the margin's worth, and the printed B answers a step of its drive with
+  // a spike at the Nyquist rate (NOTES.md), on a plant whose dead band or gain is not the model's.
+  s.creep_margin_v = arrived ? std::min(p.creep_margin_v, s.creep_margin_v + p.creep_margin_step_v) : 0.0;
   TrajectoryOutput out;
   out.u = u_ff + u_fb + s.integral;
   out.holding = s.holding;
   out.arrived = arrived;
+  out.creep_margin_v = s.creep_margin_v;
   return out;
 }
 

@@ -18,7 +18,8 @@
 //          (a wrong gain, a wrong break point, a load) without winding up during the move
 //   valve  while moving: u_d through the inverse dead zone (idz_ramp 0: NG-IDZ, exact on the
 //          model); once arrived: creeping_idz_command, which cannot bang-bang between the break
-//          points when they lie nearer than the model's.
+//          points when they lie nearer than the model's. Its margin grows from 0 (where it equals
+//          NG-IDZ) over creep_blend_s, so the valve does not step at arrival.
 // Once arrived and within half of hold_band_v the valve is held at 0 V (inside the dead band: the
 // piston stays), so sensor noise cannot make it chatter; it corrects again when the filtered error
 // exceeds hold_band_v.
@@ -47,6 +48,7 @@ struct TrajectoryConfig {
   double error_filter_s = 0.05;       // time constant of the error filter the integrator and hold read, s
   double idz_ramp = 0.0;              // u over which the inverse dead zone's break-point jump is spread while moving
   double creep_margin_v = 0.2;        // once arrived, the jump stops this short of each break point (creeping_idz_command)
+  double creep_blend_s = 0.1;         // over which that margin grows from 0 after arrival, s (0: at once)
 };
 
 // Validated parameters with everything precomputed for the loop.
@@ -60,6 +62,7 @@ struct TrajectoryParams {
   double filter_alpha = 1.0;  // per-sample weight of the error filter
   double idz_ramp = 0.0;
   double creep_margin_v = 0.2;
+  double creep_margin_step_v = 0.2;  // per sample after arrival, until creep_margin_v
   double integrator_limit = 0.0;  // |u_i| bound: what the valve limit can deliver
 };
 
@@ -69,6 +72,7 @@ struct TrajectoryState {
   double filtered_error_v = 0.0;
   double feedback_stage1_v = 0.0, feedback_stage2_v = 0.0;  // the feedback's low-pass
   double integral = 0.0;
+  double creep_margin_v = 0.0;  // the creeping inverse's margin now: 0 while moving, growing after arrival
   bool holding = false;
 };
 
@@ -96,6 +100,7 @@ struct TrajectoryOutput {
   double u = 0.0;         // u_d before the inverse dead zone
   bool holding = false;   // valve to be held at 0 V
   bool arrived = false;   // the profile is at the target: correct gently (creeping_idz_command)
+  double creep_margin_v = 0.0;  // with this margin (0: NG-IDZ, so the valve does not step at arrival)
 };
 
 // One sample; `saturated_last` is whether the previous valve command hit its limit (anti-windup).

@@ -10,7 +10,7 @@ namespace {
 
 // One table of keys, so the JSON writer, the reader and the points agree.
 using Member = double TrajectorySettings::*;
-constexpr std::array<std::pair<const char*, Member>, 12> kKeys = {{
+constexpr std::array<std::pair<const char*, Member>, 13> kKeys = {{
     {"speed_fraction", &TrajectorySettings::speed_fraction},
     {"accel_mm_s2", &TrajectorySettings::accel_mm_s2},
     {"accel_per_distance_per_s2", &TrajectorySettings::accel_per_distance_per_s2},
@@ -23,6 +23,7 @@ constexpr std::array<std::pair<const char*, Member>, 12> kKeys = {{
     {"error_filter_s", &TrajectorySettings::error_filter_s},
     {"idz_ramp_v", &TrajectorySettings::idz_ramp_v},
     {"creep_margin_v", &TrajectorySettings::creep_margin_v},
+    {"creep_blend_s", &TrajectorySettings::creep_blend_s},
 }};
 
 }  // namespace
@@ -41,6 +42,7 @@ control::TrajectoryConfig to_trajectory_config(const TrajectorySettings& s, doub
   c.error_filter_s = s.error_filter_s;
   c.idz_ramp = s.idz_ramp_v;
   c.creep_margin_v = s.creep_margin_v;
+  c.creep_blend_s = s.creep_blend_s;
   return c;
 }
 

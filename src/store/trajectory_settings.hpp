@@ -29,6 +29,7 @@ struct TrajectorySettings {
   double error_filter_s = kTrajectoryDefaults.error_filter_s;
   double idz_ramp_v = kTrajectoryDefaults.idz_ramp;
   double creep_margin_v = kTrajectoryDefaults.creep_margin_v;
+  double creep_blend_s = kTrajectoryDefaults.creep_blend_s;
 
   bool operator==(const TrajectorySettings&) const = default;
 };

@@ -2,8 +2,10 @@
 // run (issue 17's acceptance), with sensor noise, and on plants its model gets wrong.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "control/paper_controller.hpp"
 #include "core/paper_reference.hpp"
@@ -62,8 +64,8 @@ TEST(PpTraj, WithSensorNoiseItStaysWithinTheNoiseAndHoldsTheValve) {
 }
 
 // Issue 17's robustness cases. Asserted in all of them: no divergence, no chatter, e_ss within
-// 0.15 mm, settled within 3 s (10 s with the delay). The overshoot limit (30 %) is not met by every
-// short move: the README's robustness table gives the figures.
+// 0.15 mm, settled within 3 s (10 s with the delay). The overshoot limit (30 %) is asserted in the
+// next test, for every case but the 20 ms valve lag, whose short moves still exceed it (README).
 TEST(PpTraj, OnPlantsItsModelGetsWrongItHoldsTheTargetWithoutChatterAndSettlesInTime) {
   struct Case {
     const char* name;
@@ -87,6 +89,60 @@ TEST(PpTraj, OnPlantsItsModelGetsWrongItHoldsTheTargetWithoutChatterAndSettlesIn
       EXPECT_LE(*traj.metrics.settling_s, c.line.delay_samples > 0 ? 10.0 : 3.0);
     }
   }
+}
+
+// Overshoot within issue 17's 30 % on plants whose gain, dead band or timing the model gets
+// wrong. Short moves were the hard ones: the creeping inverse dead zone used to take over at
+// arrival in one sample, which stepped the drive of such a plant, and the printed B answers a
+// step of its drive with a spike (gain x1.2 at 25 mm: 30.6 %, dead band 0.1 V narrower: 40.2 %).
+TEST(PpTraj, OnPlantsItsModelGetsWrongShortAndLongMovesOvershootAtMost30Percent) {
+  struct Case {
+    const char* name;
+    ModelPerturbation plant;
+    ValveLineOptions line;
+  };
+  const Case cases[] = {{"gain x0.8", {.gain_factor = 0.8}, {}},
+                        {"gain x1.2", {.gain_factor = 1.2}, {}},
+                        {"dead band 0.1 V wider", {.dead_band_widening_v = 0.1}, {}},
+                        {"dead band 0.1 V narrower", {.dead_band_widening_v = -0.1}, {}},
+                        {"1 sample delay", {}, {.delay_samples = 1}}};
+  for (const auto& c : cases) {
+    for (double step : kSteps) {
+      SCOPED_TRACE(std::string(c.name) + ", step " + std::to_string(step) + " mm");
+      const StepRun traj = run(ControllerKind::kPpTraj, step, c.plant, c.line);
+      ASSERT_TRUE(traj.metrics.overshoot_pct.has_value());
+      EXPECT_LE(*traj.metrics.overshoot_pct, 30.0);
+    }
+  }
+}
+
+// Once arrived, the creeping inverse's margin grows from 0 (NG-IDZ, the command used while
+// moving) to creep_margin_v over creep_blend_s; a new move starts again from NG-IDZ.
+TEST(PpTraj, TheCreepingMarginBlendsInAfterArrivalAndEndsWithTheNextMove) {
+  auto config = control::paper_controller_config(ControllerKind::kPpTraj);
+  config.trajectory.creep_margin_v = 0.2;
+  config.trajectory.creep_blend_s = 0.05;  // 10 samples at 5 ms
+  auto p = control::ControllerParams::make(config);
+  ASSERT_TRUE(p.has_value());
+  control::TrajectoryState s;
+  const double y_v = 2.0;
+  control::trajectory_reset(p->trajectory(), s, y_v);
+  double last = 0.0;
+  for (int k = 1; k <= 15; ++k) {
+    const auto out = control::trajectory_step(p->trajectory(), s, y_v, y_v, 0);  // at rest on the target
+    ASSERT_TRUE(out.arrived);
+    EXPECT_NEAR(out.creep_margin_v, std::min(0.2, 0.02 * k), 1e-12) << k;
+    EXPECT_GE(out.creep_margin_v, last);
+    last = out.creep_margin_v;
+  }
+  const auto moving = control::trajectory_step(p->trajectory(), s, y_v + 1.0, y_v, 0);  // a new setpoint 50 mm on
+  EXPECT_FALSE(moving.arrived);
+  EXPECT_EQ(moving.creep_margin_v, 0.0);
+
+  config.trajectory.creep_blend_s = -1.0;
+  auto bad = control::ControllerParams::make(config);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("creep_blend_s"), std::string::npos) << bad.error().message;
 }
 
 TEST(PpTraj, ANonFiniteReadingGivesTheSafeCommandAndKeepsTheState) {
