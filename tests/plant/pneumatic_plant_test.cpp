@@ -279,36 +279,6 @@ TEST(PneumaticPlant, StictionHoldsAForceBelowBreakaway) {
   EXPECT_LT(moved_mm(-1.1 * params.static_friction_n), 0.0);
 }
 
-// A sliding piston pushed along its motion by less than the sliding friction stops within the
-// distance Coulomb friction alone allows, v0^2 / (2 (Fc - F) / m), and stays. (The friction's sign
-// used to follow each RK4 stage's velocity: stages either side of v = 0 cancelled the friction,
-// and such a piston crept on at about 1 mm/s for ever.)
-TEST(PneumaticPlant, APistonPushedBelowSlidingFrictionStopsAndStays) {
-  const PneumaticParams params;
-  const double Aa = area_m2(params.bore_mm), Ab = Aa - area_m2(params.rod_mm), Ar = area_m2(params.rod_mm);
-  const double patm = params.atmospheric_pressure_bar * kBar, pb = 3.0 * kBar;
-  for (const double v0_mps : {0.0002, 0.0005, 0.001, 0.002, 0.005, -0.0005, -0.005}) {
-    const double sign = v0_mps > 0.0 ? 1.0 : -1.0, force_n = sign * 0.5 * params.coulomb_friction_n;
-    auto plant = make_plant(params, {.initial_position_mm = 250.0});
-    auto s = plant.state();
-    s.pressure_b_pa = pb;
-    s.pressure_a_pa = (force_n + pb * Ab + patm * Ar) / Aa;
-    s.velocity_mps = v0_mps;
-    plant.set_state(s);
-    // Coulomb's stopping distance, and the stop located only to the end of its sub-step h: the
-    // stages past v = 0 carry it back by at most h^2 (Fs + |F|) / m.
-    const double h_s = plant.Ts() / plant.substeps();
-    const double bound_mm = 1e3 * v0_mps * v0_mps / (2.0 * (params.coulomb_friction_n - std::abs(force_n)) / params.piston_mass_kg) +
-                            1e3 * h_s * h_s * (params.static_friction_n + std::abs(force_n)) / params.piston_mass_kg;
-    for (int k = 0; k < 20; ++k) plant.step(0.0);  // 0.1 s: stopped long since
-    EXPECT_EQ(plant.velocity_mps(), 0.0) << "v0 " << v0_mps << " m/s";
-    const double stopped_mm = plant.position_mm();
-    EXPECT_LE(std::abs(stopped_mm - 250.0), bound_mm * 1.01) << "v0 " << v0_mps << " m/s";
-    for (int k = 0; k < 400; ++k) plant.step(0.0);  // 2 s more
-    EXPECT_EQ(plant.position_mm(), stopped_mm) << "v0 " << v0_mps << " m/s: crept " << plant.position_mm() - stopped_mm << " mm in 2 s";
-  }
-}
-
 TEST(PneumaticPlant, ChamberPressuresStayBetweenAtmosphereAndSupply) {
   const PneumaticParams params;
   const double patm = params.atmospheric_pressure_bar * kBar, psupply = patm + params.supply_pressure_bar * kBar;
