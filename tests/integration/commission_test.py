@@ -135,7 +135,11 @@ def main():
         f.write('schema = "epa-pneumatic/1"\n[valve]\norifice_area_mm2 = 3.2\noverlap_pos_v = 1.4\noverlap_neg_v = -1.5\n')
     plant = PlantServer(epa, physics, folder)
     app = Appliance(epa, os.path.join(src, "registers", "epa.csv"),
-                    f'[hal]\nbackend = "modbus-io"\n[hal.modbus_io]\nport = {plant.port}\n',
+                    # 20 ms per request, not the rig default of 2 ms: this machine is a virtual one whose
+                    # scheduling stalls of 5-10 ms (2026-11-26: 18-42 overruns in a test, p99 wake-up
+                    # 73 us) otherwise fault the axis with io-errors mid-test; what is tested here is
+                    # the commissioning, and the fault injection test keeps the strict timing.
+                    f'[hal]\nbackend = "modbus-io"\n[hal.modbus_io]\nport = {plant.port}\nresponse_timeout_ms = 20\n',
                     web_static_dir=os.path.join(src, "web"), web_extra=f'token = "{TOKEN}"\n')
     try:
         # The paper's laws have no integral action: on this rig they end 1-4 mm short (friction, a dead
