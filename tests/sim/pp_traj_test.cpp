@@ -63,22 +63,24 @@ TEST(PpTraj, WithSensorNoiseItStaysWithinTheNoiseAndHoldsTheValve) {
   }
 }
 
+// Issue 17's robustness cases: the plant differs, the controller keeps the printed model.
+struct RobustnessCase {
+  const char* name;
+  ModelPerturbation plant;
+  ValveLineOptions line;
+};
+const RobustnessCase kRobustnessCases[] = {{"gain x0.8", {.gain_factor = 0.8}, {}},
+                                           {"gain x1.2", {.gain_factor = 1.2}, {}},
+                                           {"dead band 0.1 V wider", {.dead_band_widening_v = 0.1}, {}},
+                                           {"dead band 0.1 V narrower", {.dead_band_widening_v = -0.1}, {}},
+                                           {"20 ms valve lag", {}, {.lag_s = 0.02}},
+                                           {"1 sample delay", {}, {.delay_samples = 1}}};
+
 // Issue 17's robustness cases. Asserted in all of them: no divergence, no chatter, e_ss within
 // 0.15 mm, settled within 3 s (10 s with the delay). The overshoot limit (30 %) is asserted in the
 // next test, for every case but the 20 ms valve lag, whose short moves still exceed it (README).
 TEST(PpTraj, OnPlantsItsModelGetsWrongItHoldsTheTargetWithoutChatterAndSettlesInTime) {
-  struct Case {
-    const char* name;
-    ModelPerturbation plant;
-    ValveLineOptions line;
-  };
-  const Case cases[] = {{"gain x0.8", {.gain_factor = 0.8}, {}},
-                        {"gain x1.2", {.gain_factor = 1.2}, {}},
-                        {"dead band 0.1 V wider", {.dead_band_widening_v = 0.1}, {}},
-                        {"dead band 0.1 V narrower", {.dead_band_widening_v = -0.1}, {}},
-                        {"20 ms valve lag", {}, {.lag_s = 0.02}},
-                        {"1 sample delay", {}, {.delay_samples = 1}}};
-  for (const auto& c : cases) {
+  for (const auto& c : kRobustnessCases) {
     for (double step : kSteps) {
       SCOPED_TRACE(std::string(c.name) + ", step " + std::to_string(step) + " mm");
       const StepRun traj = run(ControllerKind::kPpTraj, step, c.plant, c.line);
@@ -96,17 +98,8 @@ TEST(PpTraj, OnPlantsItsModelGetsWrongItHoldsTheTargetWithoutChatterAndSettlesIn
 // arrival in one sample, which stepped the drive of such a plant, and the printed B answers a
 // step of its drive with a spike (gain x1.2 at 25 mm: 30.6 %, dead band 0.1 V narrower: 40.2 %).
 TEST(PpTraj, OnPlantsItsModelGetsWrongShortAndLongMovesOvershootAtMost30Percent) {
-  struct Case {
-    const char* name;
-    ModelPerturbation plant;
-    ValveLineOptions line;
-  };
-  const Case cases[] = {{"gain x0.8", {.gain_factor = 0.8}, {}},
-                        {"gain x1.2", {.gain_factor = 1.2}, {}},
-                        {"dead band 0.1 V wider", {.dead_band_widening_v = 0.1}, {}},
-                        {"dead band 0.1 V narrower", {.dead_band_widening_v = -0.1}, {}},
-                        {"1 sample delay", {}, {.delay_samples = 1}}};
-  for (const auto& c : cases) {
+  for (const auto& c : kRobustnessCases) {
+    if (c.line.lag_s > 0.0) continue;  // its short moves still exceed 30 % (README)
     for (double step : kSteps) {
       SCOPED_TRACE(std::string(c.name) + ", step " + std::to_string(step) + " mm");
       const StepRun traj = run(ControllerKind::kPpTraj, step, c.plant, c.line);
