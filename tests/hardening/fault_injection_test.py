@@ -31,6 +31,7 @@ import time
 import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from stall_monitor import StallMonitor  # noqa: E402
 from epa_appliance import UNIT, UNLOCK_ADDRESS, Appliance, key_words, f32_value, f32_words, free_port, u32_value, u32_words, stop_process, wait_until  # noqa: E402
 
 
@@ -164,40 +165,66 @@ def check(failures, ok, text):
     return ok
 
 
-def run_faults(rig, failures, rows):
+def one_fault(rig, target, name, command, undo, code, sensor):
+    """Injects one fault while the piston moves: (its failures, its row)."""
+    failures = []
+    rig.plant.command("sensor normal")
+    if rig.fault_code():  # left by a check that failed (counted there): each check starts from a reset axis
+        rig.reset()
+    if not check(failures, rig.move_to(target), f"{name}: the piston did not reach {target} mm before the fault"):
+        return failures, None
+    rig.write(0, f32_words(target + (60.0 if target < 250 else -60.0), "ABCD"))  # moving when the fault comes
+    time.sleep(0.15)
+    t0 = time.monotonic()
+    if command:
+        rig.plant.command(command)
+    else:
+        rig.beating.clear()
+    got = wait_until(lambda: rig.fault_code() == code, 3.0)
+    detect_ms = (time.monotonic() - t0) * 1000
+    check(failures, got, f"{name}: fault code {rig.fault_code()} instead of {code}")
+    page = rig.page()
+    check(failures, page["mode"] == "fault" and page["fault"] == CODE_NAMES[code],
+          f"{name}: the page shows mode {page['mode']}, fault {page['fault']}")
+    # The valve at the module: 0 V (the appliance's safe command, or the module's watchdog).
+    safe = wait_until(lambda: float(rig.plant.status()["valve"]) == 0.0, 0.5)
+    check(failures, safe, f"{name}: the module's valve is {rig.plant.status()['valve']} V, not 0 V")
+    steps = int(rig.plant.status()["steps_to_safe"]) if sensor else None
+    if sensor:
+        check(failures, 0 <= steps <= 3, f"{name}: the valve was safe {steps} module steps after the fault, not within a cycle")
+    if undo:
+        rig.plant.command(undo)
+    rig.beating.set()
+    time.sleep(0.3)  # the cause is gone
+    recovered = check(failures, rig.reset(), f"{name}: reset did not return to STOP (mode {rig.mode()}, fault {rig.fault_code()})")
+    recovered = recovered and check(failures, rig.move_to(target), f"{name}: the piston did not move again after the reset")
+    return failures, (f"{name:32} -> {CODE_NAMES[code]:20} in {detect_ms:5.0f} ms; valve 0 V at the module"
+                      + (f" {steps} step(s) after the fault" if sensor else "") + ("; recovered after reset" if recovered else ""))
+
+
+def with_one_retry_on_stall(rig, monitor, name, attempt):
+    """Runs attempt() -> (failures, row); when it failed while the machine stalled (StallMonitor),
+    says so, resets the axis and runs it once more. A failure without a stall stands."""
+    t0 = time.monotonic()
+    failures, row = attempt()
+    stalls = monitor.stalls_since(t0)
+    if failures and stalls:
+        print(f"RETRY: {name}: {'; '.join(failures)} -- with {StallMonitor.describe(stalls)}: run once more", flush=True)
+        rig.beating.set()
+        rig.reset()
+        failures, row = attempt()
+        row = row and row + f" (second run: the first met {StallMonitor.describe(stalls)})"
+    return failures, row
+
+
+def run_faults(rig, monitor, failures, rows):
     target = 150.0
     for name, command, undo, code, sensor in FAULTS:
         target = 400.0 - target  # 250, 150, 250, ...
-        rig.plant.command("sensor normal")
-        if not check(failures, rig.move_to(target), f"{name}: the piston did not reach {target} mm before the fault"):
-            continue
-        rig.write(0, f32_words(target + (60.0 if target < 250 else -60.0), "ABCD"))  # moving when the fault comes
-        time.sleep(0.15)
-        t0 = time.monotonic()
-        if command:
-            rig.plant.command(command)
-        else:
-            rig.beating.clear()
-        got = wait_until(lambda: rig.fault_code() == code, 3.0)
-        detect_ms = (time.monotonic() - t0) * 1000
-        check(failures, got, f"{name}: fault code {rig.fault_code()} instead of {code}")
-        page = rig.page()
-        check(failures, page["mode"] == "fault" and page["fault"] == CODE_NAMES[code],
-              f"{name}: the page shows mode {page['mode']}, fault {page['fault']}")
-        # The valve at the module: 0 V (the appliance's safe command, or the module's watchdog).
-        safe = wait_until(lambda: float(rig.plant.status()["valve"]) == 0.0, 0.5)
-        check(failures, safe, f"{name}: the module's valve is {rig.plant.status()['valve']} V, not 0 V")
-        steps = int(rig.plant.status()["steps_to_safe"]) if sensor else None
-        if sensor:
-            check(failures, 0 <= steps <= 3, f"{name}: the valve was safe {steps} module steps after the fault, not within a cycle")
-        if undo:
-            rig.plant.command(undo)
-        rig.beating.set()
-        time.sleep(0.3)  # the cause is gone
-        recovered = check(failures, rig.reset(), f"{name}: reset did not return to STOP (mode {rig.mode()}, fault {rig.fault_code()})")
-        recovered = recovered and check(failures, rig.move_to(target), f"{name}: the piston did not move again after the reset")
-        rows.append(f"{name:32} -> {CODE_NAMES[code]:20} in {detect_ms:5.0f} ms; valve 0 V at the module"
-                    + (f" {steps} step(s) after the fault" if sensor else "") + ("; recovered after reset" if recovered else ""))
+        found, row = with_one_retry_on_stall(rig, monitor, name, lambda: one_fault(rig, target, name, command, undo, code, sensor))
+        failures.extend(found)
+        if row:
+            rows.append(row)
 
 
 def fill(path):
@@ -255,6 +282,29 @@ def struct_f32(x):
     return struct.unpack(">f", struct.pack(">f", x))[0]
 
 
+def sigkill_and_restart(rig, written):
+    """SIGKILL while moving: the module's watchdog centres the valve; a restart runs the saved tuning
+    in STOP and moves the piston again. (its failures, its row)"""
+    failures = []
+    rig.move_to(200.0)
+    rig.write(0, f32_words(300.0, "ABCD"))
+    time.sleep(0.1)
+    rig.app.kill()
+    t0 = time.monotonic()
+    safe = wait_until(lambda: rig.plant.status()["watchdog"] == "tripped" and float(rig.plant.status()["valve"]) == 0.0, 1.0)
+    check(failures, safe, "SIGKILL: the module's watchdog did not centre the valve")
+    kill_ms = (time.monotonic() - t0) * 1000
+    rig.app.start()
+    with rig.lock:
+        m_r = f32_value(rig.c().read_holding_registers(20, 2, slave=UNIT).registers, "ABCD")
+    if written:
+        check(failures, m_r == written[-1], f"SIGKILL: after restart m_r is {m_r}, not the last saved {written[-1]}")
+    check(failures, rig.mode() == 0, "SIGKILL: the restarted appliance is not in STOP")
+    recovered = check(failures, rig.move_to(120.0), "SIGKILL: the restarted appliance does not move the piston")
+    return failures, (f"{'SIGKILL and restart':32} -> module watchdog centred the valve in {kill_ms:.0f} ms; restarted in STOP "
+                      f"with the saved tuning{'; moves again' if recovered else ''}")
+
+
 def main():
     if len(sys.argv) != 4:
         sys.exit(f"usage: {sys.argv[0]} <epa binary> <source dir> <erofs shim>")
@@ -263,30 +313,19 @@ def main():
     mount = tempfile.mkdtemp(prefix="epa-disk.")
     mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", mount], capture_output=True).returncode == 0
     rig = None
+    monitor = StallMonitor()
     try:
         rig = Rig(epa, src, shim, mount if mounted else None)
-        run_faults(rig, failures, rows)
+        run_faults(rig, monitor, failures, rows)
+        if rig.fault_code():
+            rig.reset()
         check(failures, rig.move_to(200.0), "disk: the piston did not reach 200 mm")
         if not mounted:
             rows.append("disk full: SKIPPED (mounting a small tmpfs needs root)")
         written = run_disk(rig, mount if mounted else None, failures, rows)
-        # SIGKILL: the module's watchdog centres the valve; a restart runs the saved tuning.
-        rig.write(0, f32_words(300.0, "ABCD"))
-        time.sleep(0.1)
-        rig.app.kill()
-        t0 = time.monotonic()
-        safe = wait_until(lambda: rig.plant.status()["watchdog"] == "tripped" and float(rig.plant.status()["valve"]) == 0.0, 1.0)
-        check(failures, safe, "SIGKILL: the module's watchdog did not centre the valve")
-        kill_ms = (time.monotonic() - t0) * 1000
-        rig.app.start()
-        with rig.lock:
-            m_r = f32_value(rig.c().read_holding_registers(20, 2, slave=UNIT).registers, "ABCD")
-        if written:
-            check(failures, m_r == written[-1], f"SIGKILL: after restart m_r is {m_r}, not the last saved {written[-1]}")
-        check(failures, rig.mode() == 0, "SIGKILL: the restarted appliance is not in STOP")
-        recovered = check(failures, rig.move_to(120.0), "SIGKILL: the restarted appliance does not move the piston")
-        rows.append(f"{'SIGKILL and restart':32} -> module watchdog centred the valve in {kill_ms:.0f} ms; restarted in STOP "
-                    f"with the saved tuning{'; moves again' if recovered else ''}")
+        found, row = with_one_retry_on_stall(rig, monitor, "SIGKILL", lambda: sigkill_and_restart(rig, written))
+        failures.extend(found)
+        rows.append(row)
         if written:
             rig.app.stop()
             import sqlite3
@@ -302,6 +341,7 @@ def main():
     except Exception as e:  # noqa: BLE001 -- report with the logs
         failures.append(f"{type(e).__name__}: {e}\n{rig.app.log_text()[-3000:] if rig else ''}")
     finally:
+        monitor.stop()
         if rig:
             rig.close()
         if mounted:
