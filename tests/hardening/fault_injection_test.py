@@ -141,8 +141,7 @@ class Rig:
         except Exception as e:  # noqa: BLE001 -- the appliance may be the problem
             axis = f"the appliance does not answer ({e})"
         try:
-            page = self.page()
-            counters = f"io_errors {page.get('io_errors')}, faults {page.get('faults')}"
+            counters = " ".join(f"{k} {v}" for k, v in self.page()["counters"].items() if k.endswith(("errors", "faults")))
         except Exception:  # noqa: BLE001
             counters = "no page"
         module = " ".join(f"{k} {v}" for k, v in self.plant.status().items())
