@@ -156,6 +156,11 @@ class Rig:
         log = [line[-160:] for line in self.app.log_text().splitlines() if "FAULT" in line or " -> " in line][-4:]
         return f"[{axis}; {counters}; module: {module}; log: {' | '.join(log)}]"
 
+    def clear_fault(self):
+        """Resets a fault left by a check that failed (counted there), so the next starts clean."""
+        if self.fault_code():
+            self.reset()
+
     def reset(self):
         self.write(8, [1])
         return wait_until(lambda: self.mode() == 0 and self.fault_code() == 0, 2.0)
@@ -191,8 +196,7 @@ def one_fault(rig, target, name, command, undo, code, sensor):
     """Injects one fault while the piston moves: (its failures, its row)."""
     failures = []
     rig.plant.command("sensor normal")
-    if rig.fault_code():  # left by a check that failed (counted there): each check starts from a reset axis
-        rig.reset()
+    rig.clear_fault()
     reached = rig.move_to(target)
     if not check(failures, reached, "" if reached else f"{name}: the piston did not reach {target} mm before the fault {rig.state()}"):
         return failures, None
@@ -230,22 +234,27 @@ def one_fault(rig, target, name, command, undo, code, sensor):
 INCONCLUSIVE = []  # checks that failed twice on a machine too stalled for a real-time verdict
 
 
-def with_one_retry_on_stall(rig, monitor, name, attempt):
-    """Runs attempt() -> (failures, row). When it failed while the machine stalled (StallMonitor),
-    says so, resets the axis and runs it once more; failing again on a machine as stalled, the
-    check has no verdict (INCONCLUSIVE). A failure on a machine that did not stall stands."""
-    t0 = time.monotonic()
-    failures, row = attempt()
-    if failures and monitor.unfit_since(t0):
-        print(f"RETRY: {name}: {'; '.join(failures)} -- with {monitor.describe(t0)}: run once more", flush=True)
+def judged(rig, monitor, name, attempt):
+    """attempt() -> (failures, row) under the stall rule (StallMonitor.judged), the axis reset
+    before a second run: (failures, row); a check without a verdict goes to INCONCLUSIVE."""
+    rows = []
+
+    def run():
+        failures, row = attempt()
+        rows.append(row)
+        return failures
+
+    def fresh_axis():
         rig.beating.set()
         rig.reset()
-        t1 = time.monotonic()
-        failures, row = attempt()
-        if failures and monitor.unfit_since(t1):
-            INCONCLUSIVE.append(f"{name}: {'; '.join(failures)} -- again with {monitor.describe(t1)}")
-            return [], f"{name:32} -> no verdict: the machine stalled in both runs"
-        row = row and row + " (second run: the first met a stalled machine)"
+
+    failures, no_verdict = monitor.judged(name, run, fresh_axis)
+    if no_verdict:
+        INCONCLUSIVE.append(no_verdict)
+        return [], f"{name:32} -> no verdict: the machine stalled in both runs"
+    row = rows[-1]
+    if len(rows) == 2 and row:
+        row += " (second run: the first met a stalled machine)"
     return failures, row
 
 
@@ -253,7 +262,7 @@ def run_faults(rig, monitor, failures, rows):
     target = 150.0
     for name, command, undo, code, sensor in FAULTS:
         target = 400.0 - target  # 250, 150, 250, ...
-        found, row = with_one_retry_on_stall(rig, monitor, name, lambda: one_fault(rig, target, name, command, undo, code, sensor))
+        found, row = judged(rig, monitor, name, lambda: one_fault(rig, target, name, command, undo, code, sensor))
         failures.extend(found)
         if row:
             rows.append(row)
@@ -351,13 +360,12 @@ def main():
     try:
         rig = Rig(epa, src, shim, mount if mounted else None)
         run_faults(rig, monitor, failures, rows)
-        if rig.fault_code():
-            rig.reset()
+        rig.clear_fault()
         check(failures, rig.move_to(200.0), "disk: the piston did not reach 200 mm")
         if not mounted:
             rows.append("disk full: SKIPPED (mounting a small tmpfs needs root)")
         written = run_disk(rig, mount if mounted else None, failures, rows)
-        found, row = with_one_retry_on_stall(rig, monitor, "SIGKILL", lambda: sigkill_and_restart(rig, written))
+        found, row = judged(rig, monitor, "SIGKILL", lambda: sigkill_and_restart(rig, written))
         failures.extend(found)
         rows.append(row)
         if written:

@@ -223,23 +223,21 @@ def run_once(epa, src):
 def main():
     epa, src = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     monitor = StallMonitor()
-    verdict = None
-    try:
-        t0 = time.monotonic()
+    t0 = time.monotonic()
+
+    def run():
+        FAILURES.clear()
         run_once(epa, src)
-        print(f"      the machine during the run: {monitor.describe(t0)}")
-        if FAILURES and monitor.unfit_since(t0):
-            # The axis is right to fault when its module falls silent; a stalled machine silences
-            # the simulated one. Such a run proves nothing either way: run once more.
-            print(f"RETRY: {len(FAILURES)} failure(s) on a stalled machine: the whole test once more", flush=True)
-            FAILURES.clear()
-            t1 = time.monotonic()
-            run_once(epa, src)
-            print(f"      the machine during the second run: {monitor.describe(t1)}")
-            if FAILURES and monitor.unfit_since(t1):
-                verdict = f"NO VERDICT: {len(FAILURES)} failure(s) again on a stalled machine: it could not run the loop in real time"
+        return list(FAILURES)
+
+    try:
+        # The axis is right to fault when its module falls silent; a stalled machine silences the
+        # simulated one, and such a run proves nothing either way.
+        _, no_verdict = monitor.judged("the whole test", run)
+        print(f"      the machine during the test: {monitor.describe(t0)}")
     finally:
         monitor.stop()
+    verdict = no_verdict and f"NO VERDICT: {no_verdict}: it could not run the loop in real time"
     if verdict:
         print(verdict)
         sys.exit(SKIP_RETURN_CODE)

@@ -83,15 +83,18 @@ class StallMonitor:
         self._drain()
         return [s for s in self.stalls if s[0] >= t0]
 
+    @staticmethod
+    def _share(stalls, t0):
+        return min(1.0, sum(late for _, late in stalls) / max(time.monotonic() - t0, 1e-3))
+
     def stalled_share(self, t0):
         """The share of the time since monotonic t0 that the machine was seen stalled (0..1)."""
-        elapsed = max(time.monotonic() - t0, 1e-3)
-        return min(1.0, sum(late for _, late in self.stalls_since(t0)) / elapsed)
+        return self._share(self.stalls_since(t0), t0)
 
     def unfit_since(self, t0):
         """Whether the machine stalled too much since t0 for a real-time result to mean anything."""
         stalls = self.stalls_since(t0)
-        return self.stalled_share(t0) >= UNFIT_SHARE or any(late >= UNFIT_STALL_S for _, late in stalls)
+        return self._share(stalls, t0) >= UNFIT_SHARE or any(late >= UNFIT_STALL_S for _, late in stalls)
 
     def describe(self, t0):
         stalls = self.stalls_since(t0)
@@ -100,7 +103,25 @@ class StallMonitor:
             return "no stall of the machine" + how
         worst = max(late for _, late in stalls)
         return (f"{len(stalls)} stall(s) of the machine of >= {self.threshold_ms:.0f} ms, the longest {worst * 1000:.0f} ms, "
-                f"{100 * self.stalled_share(t0):.1f} % of the time" + how)
+                f"{100 * self._share(stalls, t0):.1f} % of the time" + how)
+
+    def judged(self, name, attempt, before_retry=None):
+        """The rule every real-time test here follows. attempt() returns its failures (a list of
+        texts). When it failed on a machine unfit meanwhile, prints `RETRY:`, calls before_retry()
+        and runs it once more. Returns (failures, no_verdict): no_verdict is the reason when the
+        second run failed on a machine as unfit (its failures then mean nothing), else None."""
+        t0 = time.monotonic()
+        failures = attempt()
+        if not failures or not self.unfit_since(t0):
+            return failures, None
+        print(f"RETRY: {name}: {'; '.join(failures)} -- with {self.describe(t0)}: run once more", flush=True)
+        if before_retry:
+            before_retry()
+        t1 = time.monotonic()
+        failures = attempt()
+        if failures and self.unfit_since(t1):
+            return failures, f"{name}: {'; '.join(failures)} -- again with {self.describe(t1)}"
+        return failures, None
 
     def stop(self):
         """Ends the watchers; what they saw stays readable."""
