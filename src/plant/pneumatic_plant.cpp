@@ -177,9 +177,10 @@ PneumaticPlant::Deriv PneumaticPlant::derivative(const State& s, double u, bool 
   d.pb = n_ / Vb * (RT_ * mdot_b + pb * area_b_m2_ * v);
   if (held) return d;  // x and v stay put
   d.x = v;
-  // Friction opposes the motion; at v = 0 (breaking away) it opposes the net force.
-  const double sgn = v > 0.0 ? 1.0 : v < 0.0 ? -1.0 : direction;
-  const double friction = sgn * (Fc_ + (Fs_ - Fc_) * std::exp(-(v / vs_) * (v / vs_))) + b_ * v;
+  // Friction opposes the motion the sub-step started with (at v = 0, breaking away: the net
+  // force). Not the sign of this stage's velocity: stages either side of v = 0 would cancel it
+  // in the RK4 sum, and a piston pushed by less than the sliding friction would creep on.
+  const double friction = direction * (Fc_ + (Fs_ - Fc_) * std::exp(-(v / vs_) * (v / vs_))) + b_ * v;
   d.v = (pressure_force_n(pa, pb) - friction) / mass_kg_;
   return d;
 }
@@ -188,8 +189,9 @@ void PneumaticPlant::substep(double u) noexcept {
   State& s = state_;
   const double force = pressure_force_n(s.pressure_a_pa, s.pressure_b_pa);
   const bool held = s.velocity_mps == 0.0 && is_held(s.position_m, force);
-  const double direction = force >= 0.0 ? 1.0 : -1.0;
   const double v0 = s.velocity_mps;
+  // The direction of motion over this sub-step: the velocity's, or at rest the net force's.
+  const double direction = v0 != 0.0 ? (v0 > 0.0 ? 1.0 : -1.0) : (force >= 0.0 ? 1.0 : -1.0);
 
   // Classic RK4 on (spool, pa, pb, x, v); the mode (held, friction direction at v = 0) is frozen
   // over the sub-step and revisited after it.
@@ -215,8 +217,7 @@ void PneumaticPlant::substep(double u) noexcept {
   s.velocity_mps += h / 6 * (k1.v + 2 * k2.v + 2 * k3.v + k4.v);
 
   // Events, resolved at the end of the sub-step.
-  const double dir0 = v0 != 0.0 ? (v0 > 0.0 ? 1.0 : -1.0) : direction;
-  if (s.velocity_mps * dir0 <= 0.0) s.velocity_mps = 0.0;  // reversal (or stop): the stick test decides next
+  if (s.velocity_mps * direction <= 0.0) s.velocity_mps = 0.0;  // reversal (or stop): the stick test decides next
   if (s.position_m <= 0.0) {
     s.position_m = 0.0;  // inelastic end stops: the piston never leaves the stroke
     s.velocity_mps = std::max(s.velocity_mps, 0.0);

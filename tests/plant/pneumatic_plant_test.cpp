@@ -279,6 +279,42 @@ TEST(PneumaticPlant, StictionHoldsAForceBelowBreakaway) {
   EXPECT_LT(moved_mm(-1.1 * params.static_friction_n), 0.0);
 }
 
+// A sliding piston pushed by less than the sliding friction decelerates and sticks: it must stop
+// within the distance Coulomb friction alone would stop it in (Stribeck only adds friction at low
+// speed), plus what one sub-step can carry it for the stop event, and then stay put. The friction's sign
+// is the direction of motion for the whole sub-step: taken from each RK4 stage's velocity, stages
+// either side of v = 0 cancel it and such a piston creeps on.
+TEST(PneumaticPlant, APistonPushedBelowSlidingFrictionStopsAndStays) {
+  const PneumaticParams params;
+  const double Aa = area_m2(params.bore_mm), Ab = Aa - area_m2(params.rod_mm), Ar = area_m2(params.rod_mm);
+  const double patm = params.atmospheric_pressure_bar * kBar, pb = 3.0 * kBar;
+  const double push_n = 0.5 * params.coulomb_friction_n;
+  const double substep_s = 0.005 / 50.0;
+  for (double v0_mm_s : {0.2, 0.5, 1.0, 2.0, 5.0, -1.0, -5.0}) {
+    const double dir = v0_mm_s > 0 ? 1.0 : -1.0;
+    auto plant = make_plant(params, {.initial_position_mm = 250.0});
+    auto s = plant.state();
+    s.pressure_b_pa = pb;
+    s.pressure_a_pa = (dir * push_n + pb * Ab + patm * Ar) / Aa;
+    s.velocity_mps = v0_mm_s * 1e-3;
+    plant.set_state(s);
+    const double v0 = std::abs(v0_mm_s) * 1e-3;
+    const double coulomb_stop_mm = 1e3 * params.piston_mass_kg * v0 * v0 / (2.0 * (params.coulomb_friction_n - push_n));
+    // The stop is an event located to the sub-step: within it the piston can travel at its start
+    // speed and then on past v = 0 under the full friction before the event sets v to 0.
+    const double max_decel_m_s2 = (params.static_friction_n + push_n) / params.piston_mass_kg;
+    const double bound_mm = coulomb_stop_mm + 1e3 * (v0 * substep_s + 0.5 * max_decel_m_s2 * substep_s * substep_s);
+    plant.step(0.0);
+    const double stopped_at_mm = plant.position_mm();
+    for (int k = 0; k < 400; ++k) plant.step(0.0);  // 2 s, valve centred
+    const double moved_mm = std::abs(plant.position_mm() - 250.0);
+    RecordProperty("moved_mm_at_" + figure(v0_mm_s) + "_mm_s", figure(moved_mm));
+    EXPECT_LE(moved_mm, bound_mm) << "start speed " << v0_mm_s << " mm/s";
+    EXPECT_EQ(plant.velocity_mps(), 0.0) << "start speed " << v0_mm_s << " mm/s";
+    EXPECT_EQ(plant.position_mm(), stopped_at_mm) << "start speed " << v0_mm_s << " mm/s: it crept after stopping";
+  }
+}
+
 TEST(PneumaticPlant, ChamberPressuresStayBetweenAtmosphereAndSupply) {
   const PneumaticParams params;
   const double patm = params.atmospheric_pressure_bar * kBar, psupply = patm + params.supply_pressure_bar * kBar;
