@@ -26,7 +26,7 @@ core::Status read_number(const nlohmann::json& j, const char* key, double& out, 
 }
 
 nlohmann::json limits_json(const MoveLimits& l) {
-  return {{"ess_mm", l.ess_mm}, {"overshoot_pct", l.overshoot_pct}, {"settling_s", l.settling_s}};
+  return {{"ess_mm", l.ess_mm}, {"overshoot_pct", l.overshoot_pct}, {"overshoot_mm", l.overshoot_mm}, {"settling_s", l.settling_s}};
 }
 
 }  // namespace
@@ -40,9 +40,11 @@ core::Status CommissionSpec::validate(double lo_mm, double hi_mm) const {
                  in_range("observer_pole", observer_pole, 0.0, 0.95), in_range("move_hold_s", move_hold_s, 3.0, 60.0),
                  in_range("limits.ess_mm", limits.ess_mm, 0.0, 100.0, true),
                  in_range("limits.overshoot_pct", limits.overshoot_pct, 0.0, 1000.0),
+                 in_range("limits.overshoot_mm", limits.overshoot_mm, 0.0, 100.0),
                  in_range("limits.settling_s", limits.settling_s, 0.0, 60.0),
                  in_range("robust_limits.ess_mm", robust_limits.ess_mm, 0.0, 100.0, true),
                  in_range("robust_limits.overshoot_pct", robust_limits.overshoot_pct, 0.0, 1000.0),
+                 in_range("robust_limits.overshoot_mm", robust_limits.overshoot_mm, 0.0, 100.0),
                  in_range("robust_limits.settling_s", robust_limits.settling_s, 0.0, 60.0),
                  in_range("robust_gain", robust_gain, 0.0, 0.9), in_range("robust_breakpoint_v", robust_breakpoint_v, 0.0, 2.0)})
     if (!s) return s;
@@ -98,9 +100,10 @@ core::Result<CommissionSpec> parse_commission_spec(const std::string& text) {
     const std::string parent = std::string(key) + ".";
     if (!l.is_object()) return core::invalid_argument(std::string("commission spec: ") + key + " must be an object");
     for (const auto& [k, value] : l.items())
-      if (k != "ess_mm" && k != "overshoot_pct" && k != "settling_s")
+      if (k != "ess_mm" && k != "overshoot_pct" && k != "overshoot_mm" && k != "settling_s")
         return core::invalid_argument("commission spec: unknown key '" + parent + k + "'");
     for (auto st : {read_number(l, "ess_mm", limits->ess_mm, parent.c_str()), read_number(l, "overshoot_pct", limits->overshoot_pct, parent.c_str()),
+                    read_number(l, "overshoot_mm", limits->overshoot_mm, parent.c_str()),
                     read_number(l, "settling_s", limits->settling_s, parent.c_str())})
       if (!st) return st.error();
   }

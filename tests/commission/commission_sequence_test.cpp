@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commission/commission_spec.hpp"
+#include "commission/move_acceptance.hpp"
 #include "core/paper_reference.hpp"
 #include "simulated_axis.hpp"
 
@@ -204,6 +205,36 @@ TEST(CommissionSpec, UnknownKeysAndOutOfRangeValuesAreNamed) {
   EXPECT_EQ(back->moves_mm, (std::vector<double>{100, 200}));
   EXPECT_EQ(back->limits.ess_mm, 0.5);
   EXPECT_EQ(back->name, "x-1");
+  auto mm = parse_commission_spec(R"({"limits": {"overshoot_mm": 12}, "robust_limits": {"overshoot_mm": 20}})");
+  ASSERT_TRUE(mm) << mm.error().message;
+  auto mm_back = parse_commission_spec(format_commission_spec(*mm));
+  ASSERT_TRUE(mm_back);
+  EXPECT_EQ(mm_back->limits.overshoot_mm, 12.0);
+  EXPECT_EQ(mm_back->robust_limits.overshoot_mm, 20.0);
+  EXPECT_NE(parse_commission_spec(R"({"limits": {"overshoot_mm": -1}})").error().message.find("limits.overshoot_mm"), std::string::npos);
+}
+
+// An overshoot passes when it is within the percentage or, if given, within overshoot_mm: one
+// breakaway jump of ~12 mm is 24 % of a 50 mm move and 6 % of a 200 mm one.
+TEST(MoveAcceptance, AnOvershootPassesWithinItsPercentageOrWithinItsMillimetres) {
+  core::StepMetrics m;
+  m.moved = true;
+  m.settling_s = 0.5;
+  m.ess_mm = 1.0;
+  m.overshoot_pct = 24.0;  // 12 mm of a 50 mm move
+  MoveLimits pct_only{.ess_mm = 8.0, .overshoot_pct = 20.0, .overshoot_mm = 0.0, .settling_s = 0.0};
+  const auto refused = judge_move(250.0, 200.0, m, pct_only);
+  EXPECT_FALSE(refused.passed);
+  EXPECT_NE(refused.why.find("overshoot 24.0 % (12.00 mm), limit 20.0 %"), std::string::npos) << refused.why;
+  MoveLimits with_mm = pct_only;
+  with_mm.overshoot_mm = 15.0;
+  EXPECT_TRUE(judge_move(250.0, 200.0, m, with_mm).passed);
+  with_mm.overshoot_mm = 11.0;
+  const auto beyond = judge_move(250.0, 200.0, m, with_mm);
+  EXPECT_FALSE(beyond.passed);
+  EXPECT_NE(beyond.why.find("limit 20.0 % or 11 mm"), std::string::npos) << beyond.why;
+  m.overshoot_pct = 6.0;  // 12 mm of a 200 mm move: within the percentage
+  EXPECT_TRUE(judge_move(50.0, 250.0, m, pct_only).passed);
 }
 
 }  // namespace

@@ -9,8 +9,9 @@ the appliance over HTTP, unattended, with a shortened excitation.
 Checks, each printed with its figures:
   * deployed: `epa commission` exits 0 with verdict "deployed", the new set is the running and the
     stored active set; then moves of 25-200 mm in both directions, commanded over HTTP like an HMI
-    would, hold the spec's limits (how many end within 1 mm is printed: the paper's laws have no
-    integral action and end 1-4 mm short on this rig);
+    would, hold the spec's limits, the overshoot within 20 % or 15 mm (one breakaway jump), as
+    the verification moves did (how many end within 1 mm is printed: the paper's laws have no
+    integral action and end 1-5 mm short on this rig);
   * a verification limit the axis cannot meet (e_ss <= 0.02 mm with NG-IDZ: met on the noise-free
     identified model, below the sensor noise on the axis): exit 2, verdict "rolled-back" at the
     first move (or at identification, which can refuse an experiment), the previous set runs
@@ -149,10 +150,14 @@ def run_once(epa, src):
     try:
         # The paper's laws have no integral action: on this rig they end 1-4 mm short (friction, a dead
         # band the model can only approximate), so the spec asks for what they can hold; a 2 % band
-        # of a 100 mm move is as wide as that offset, so settling is not judged.
+        # of a 100 mm move is as wide as that offset, so settling is not judged. The verification
+        # moves cover the sizes the HMI moves below command, both ways (100-200 mm, then +25 and
+        # -50 mm): on an axis with stick-slip, a short move's overshoot can be one breakaway jump
+        # (10-13 mm measured: 26 % of a 50 mm move), which long moves alone would not show, so the
+        # overshoot limit is 20 % or 15 mm, whichever is larger.
         base = {"excitation_runs": 2, "excitation_s": 40, "seed": 3, "controller": "pp-ffidz", "settling_s": 0.3,
-                "overshoot_pct": 0, "moves_mm": [150, 350, 250], "move_hold_s": 4,
-                "limits": {"ess_mm": 8, "overshoot_pct": 20, "settling_s": 0}}
+                "overshoot_pct": 0, "moves_mm": [150, 350, 250, 275, 225], "move_hold_s": 4,
+                "limits": {"ess_mm": 8, "overshoot_pct": 20, "overshoot_mm": 15, "settling_s": 0}}
         before = http(app, "GET", "/api/status")[1]["store"]["tuning_set"]
         paper_moves = hmi_moves(app)  # the paper's tuning, which the appliance starts with
         print(f"      before commissioning ({before}): {summary(paper_moves)}")
@@ -181,10 +186,13 @@ def run_once(epa, src):
         if outcome and outcome["verdict"] == "deployed":
             # What the verification promised, held by the moves an HMI commands afterwards.
             deployed_moves = hmi_moves(app)
+            limits = base["limits"]
             for start, target, final, overshoot in deployed_moves:
-                check(abs(final - target) <= base["limits"]["ess_mm"] and overshoot <= base["limits"]["overshoot_pct"],
+                overshoot_mm = overshoot / 100.0 * abs(target - start)
+                check(abs(final - target) <= limits["ess_mm"] and (overshoot <= limits["overshoot_pct"] or overshoot_mm <= limits["overshoot_mm"]),
                       f"after deployment: move {start:.1f} -> {target} mm ends {abs(final - target):.2f} mm from its target "
-                      f"(spec: {base['limits']['ess_mm']} mm), overshoot {overshoot:.1f} % (spec: {base['limits']['overshoot_pct']} %)")
+                      f"(spec: {limits['ess_mm']} mm), overshoot {overshoot:.1f} % = {overshoot_mm:.2f} mm "
+                      f"(spec: {limits['overshoot_pct']} % or {limits['overshoot_mm']} mm)")
             print(f"      after commissioning (rig-1): {summary(deployed_moves)}")
 
         # A verification limit the axis cannot meet: NG-IDZ ends on the noise-free identified model
