@@ -257,19 +257,27 @@ TEST(PneumaticPlant, SpeedAtFullCommandIsLikeTheRig) {
   EXPECT_LT(mean_speed_mps(5.0), 0.7 * out);
 }
 
+// A plant at 250 mm moving at velocity_mps (0: at rest) whose chambers hold a net pressure force
+// of force_n (chamber B at 3 bar absolute).
+PneumaticPlant plant_with_net_force(const PneumaticParams& params, double force_n, double velocity_mps = 0.0) {
+  const double Aa = area_m2(params.bore_mm), Ab = Aa - area_m2(params.rod_mm), Ar = area_m2(params.rod_mm);
+  const double patm = params.atmospheric_pressure_bar * kBar, pb = 3.0 * kBar;
+  auto plant = make_plant(params, {.initial_position_mm = 250.0});
+  auto s = plant.state();
+  s.pressure_b_pa = pb;
+  s.pressure_a_pa = (force_n + pb * Ab + patm * Ar) / Aa;
+  s.velocity_mps = velocity_mps;
+  plant.set_state(s);
+  EXPECT_NEAR(plant.pressure_force_n(s.pressure_a_pa, s.pressure_b_pa), force_n, 1e-9);
+  return plant;
+}
+
 // Stiction: with the valve centred, a net pressure force just below the breakaway force leaves
 // the piston where it is; just above it, it moves.
 TEST(PneumaticPlant, StictionHoldsAForceBelowBreakaway) {
   const PneumaticParams params;
-  const double Aa = area_m2(params.bore_mm), Ab = Aa - area_m2(params.rod_mm), Ar = area_m2(params.rod_mm);
-  const double patm = params.atmospheric_pressure_bar * kBar, pb = 3.0 * kBar;
   auto moved_mm = [&](double force_n) {
-    auto plant = make_plant(params, {.initial_position_mm = 250.0});
-    auto s = plant.state();
-    s.pressure_b_pa = pb;
-    s.pressure_a_pa = (force_n + pb * Ab + patm * Ar) / Aa;
-    plant.set_state(s);
-    EXPECT_NEAR(plant.pressure_force_n(s.pressure_a_pa, s.pressure_b_pa), force_n, 1e-9);
+    auto plant = plant_with_net_force(params, force_n);
     for (int k = 0; k < 400; ++k) plant.step(0.0);
     return plant.position_mm() - 250.0;
   };
@@ -286,18 +294,12 @@ TEST(PneumaticPlant, StictionHoldsAForceBelowBreakaway) {
 // either side of v = 0 cancel it and such a piston creeps on.
 TEST(PneumaticPlant, APistonPushedBelowSlidingFrictionStopsAndStays) {
   const PneumaticParams params;
-  const double Aa = area_m2(params.bore_mm), Ab = Aa - area_m2(params.rod_mm), Ar = area_m2(params.rod_mm);
-  const double patm = params.atmospheric_pressure_bar * kBar, pb = 3.0 * kBar;
   const double push_n = 0.5 * params.coulomb_friction_n;
-  const double substep_s = 0.005 / 50.0;
+  const PneumaticOptions defaults;
+  const double substep_s = defaults.Ts / defaults.substeps;
   for (double v0_mm_s : {0.2, 0.5, 1.0, 2.0, 5.0, -1.0, -5.0}) {
     const double dir = v0_mm_s > 0 ? 1.0 : -1.0;
-    auto plant = make_plant(params, {.initial_position_mm = 250.0});
-    auto s = plant.state();
-    s.pressure_b_pa = pb;
-    s.pressure_a_pa = (dir * push_n + pb * Ab + patm * Ar) / Aa;
-    s.velocity_mps = v0_mm_s * 1e-3;
-    plant.set_state(s);
+    auto plant = plant_with_net_force(params, dir * push_n, v0_mm_s * 1e-3);
     const double v0 = std::abs(v0_mm_s) * 1e-3;
     const double coulomb_stop_mm = 1e3 * params.piston_mass_kg * v0 * v0 / (2.0 * (params.coulomb_friction_n - push_n));
     // The stop is an event located to the sub-step: within it the piston can travel at its start
