@@ -1,5 +1,7 @@
 #include "commission/commission_spec.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -25,8 +27,30 @@ core::Status read_number(const nlohmann::json& j, const char* key, double& out, 
   return core::ok();
 }
 
+// One table of a verification move's limits, so the reader, the writer and the range checks agree.
+struct LimitKey {
+  const char* name;
+  double MoveLimits::*member;
+  double hi;
+  bool lo_open;  // (0, hi] rather than [0, hi]
+};
+constexpr std::array<LimitKey, 4> kLimitKeys = {{
+    {"ess_mm", &MoveLimits::ess_mm, 100.0, true},
+    {"overshoot_pct", &MoveLimits::overshoot_pct, 1000.0, false},
+    {"overshoot_mm", &MoveLimits::overshoot_mm, 100.0, false},
+    {"settling_s", &MoveLimits::settling_s, 60.0, false},
+}};
+
 nlohmann::json limits_json(const MoveLimits& l) {
-  return {{"ess_mm", l.ess_mm}, {"overshoot_pct", l.overshoot_pct}, {"overshoot_mm", l.overshoot_mm}, {"settling_s", l.settling_s}};
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& k : kLimitKeys) j[k.name] = l.*k.member;
+  return j;
+}
+
+core::Status limits_in_range(const char* parent, const MoveLimits& l) {
+  for (const auto& k : kLimitKeys)
+    if (auto s = in_range((std::string(parent) + "." + k.name).c_str(), l.*k.member, 0.0, k.hi, k.lo_open); !s) return s;
+  return core::ok();
 }
 
 }  // namespace
@@ -38,14 +62,7 @@ core::Status CommissionSpec::validate(double lo_mm, double hi_mm) const {
   for (auto s : {in_range("excitation_s", excitation_s, 5.0, 600.0), in_range("amplitude_max_v", amplitude_max_v, 0.5, 10.0),
                  in_range("overshoot_pct", overshoot_pct, 0.0, 50.0), in_range("settling_s", settling_s, 0.05, 30.0, true),
                  in_range("observer_pole", observer_pole, 0.0, 0.95), in_range("move_hold_s", move_hold_s, 3.0, 60.0),
-                 in_range("limits.ess_mm", limits.ess_mm, 0.0, 100.0, true),
-                 in_range("limits.overshoot_pct", limits.overshoot_pct, 0.0, 1000.0),
-                 in_range("limits.overshoot_mm", limits.overshoot_mm, 0.0, 100.0),
-                 in_range("limits.settling_s", limits.settling_s, 0.0, 60.0),
-                 in_range("robust_limits.ess_mm", robust_limits.ess_mm, 0.0, 100.0, true),
-                 in_range("robust_limits.overshoot_pct", robust_limits.overshoot_pct, 0.0, 1000.0),
-                 in_range("robust_limits.overshoot_mm", robust_limits.overshoot_mm, 0.0, 100.0),
-                 in_range("robust_limits.settling_s", robust_limits.settling_s, 0.0, 60.0),
+                 limits_in_range("limits", limits), limits_in_range("robust_limits", robust_limits),
                  in_range("robust_gain", robust_gain, 0.0, 0.9), in_range("robust_breakpoint_v", robust_breakpoint_v, 0.0, 2.0)})
     if (!s) return s;
   if (moves_mm.empty() || moves_mm.size() > 32)
@@ -100,12 +117,10 @@ core::Result<CommissionSpec> parse_commission_spec(const std::string& text) {
     const std::string parent = std::string(key) + ".";
     if (!l.is_object()) return core::invalid_argument(std::string("commission spec: ") + key + " must be an object");
     for (const auto& [k, value] : l.items())
-      if (k != "ess_mm" && k != "overshoot_pct" && k != "overshoot_mm" && k != "settling_s")
+      if (std::none_of(kLimitKeys.begin(), kLimitKeys.end(), [&](const LimitKey& limit) { return k == limit.name; }))
         return core::invalid_argument("commission spec: unknown key '" + parent + k + "'");
-    for (auto st : {read_number(l, "ess_mm", limits->ess_mm, parent.c_str()), read_number(l, "overshoot_pct", limits->overshoot_pct, parent.c_str()),
-                    read_number(l, "overshoot_mm", limits->overshoot_mm, parent.c_str()),
-                    read_number(l, "settling_s", limits->settling_s, parent.c_str())})
-      if (!st) return st.error();
+    for (const auto& k : kLimitKeys)
+      if (auto st = read_number(l, k.name, limits->*k.member, parent.c_str()); !st) return st.error();
   }
   for (auto st : {read_number(j, "excitation_s", s.excitation_s), read_number(j, "amplitude_max_v", s.amplitude_max_v),
                   read_number(j, "overshoot_pct", s.overshoot_pct), read_number(j, "settling_s", s.settling_s),
