@@ -93,7 +93,9 @@ std::string to_json(const GapReport& r) {
   j["schema"] = "epa-gap-report/1";
   j["horizon_samples"] = d.horizon;
   j["runs"] = {{"train", r.train_names}, {"heldout", r.heldout_names}};
-  j["baseline"] = {{"heldout_gap_mm", round_to(d.baseline_gap_mm, 4)}};
+  j["baseline"] = {{"heldout_gap_mm", round_to(d.baseline_gap_mm, 4)},
+                   {"windows", d.windows},
+                   {"windows_at_end_stop", d.windows_at_end_stop}};
   ordered_json where = ordered_json::array();
   for (const auto& w : r.where)
     where.push_back({{"regime", w.before.regime},
@@ -185,6 +187,11 @@ std::string verdict_text(const GapReport& r) {
   std::snprintf(buf, sizeof buf, ". Held-out gap %.3f mm, %.3f mm after re-fitting gain and break points, %.3f mm with the accepted effects (noise floor %.3f mm).",
                 d.baseline_gap_mm, d.refit_gap_mm, d.final_gap_mm, d.noise_floor_mm);
   s += buf;
+  if (d.windows_at_end_stop) {
+    std::snprintf(buf, sizeof buf, " %zu of %zu windows touch an end stop and are left out of every gap.", d.windows_at_end_stop,
+                  d.windows);
+    s += buf;
+  }
   if (d.unexplained && !r.hints.empty()) s += " Where: " + r.hints.front() + ".";
   return s;
 }

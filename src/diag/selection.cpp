@@ -110,8 +110,17 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
   d.nominal = nominal;
   d.baseline_gap_mm = heldout_gap(current.per_fold, folds, o.horizon);
   d.train_gap_mm = windowed_gap_mm(nominal, train, o.horizon);
-  std::snprintf(buf, sizeof buf, "baseline: held-out gap %.3f mm (training %.3f mm), %zu fold(s)", d.baseline_gap_mm,
-                d.train_gap_mm, folds.size());
+  for (const auto* runs : {&train, &heldout})
+    for (const auto* r : *runs) {
+      const auto s = windowed_sse(nominal, *r, o.horizon);
+      d.windows_at_end_stop += s.windows_at_end_stop;
+      d.windows += s.windows + s.windows_at_end_stop;
+    }
+  std::snprintf(buf, sizeof buf, "baseline: held-out gap %.3f mm (training %.3f mm), %zu fold(s)%s", d.baseline_gap_mm,
+                d.train_gap_mm, folds.size(),
+                d.windows_at_end_stop ? (", " + std::to_string(d.windows_at_end_stop) + " of " + std::to_string(d.windows) +
+                                         " windows left out: they touch an end stop").c_str()
+                                      : "");
   say(buf);
 
   // 1. The nominal model's own parameters (gain, break points), re-fitted: on a rig much of a

@@ -78,6 +78,8 @@ struct Diagnosis {
   ReplayModel nominal, refit, final_model;   // final: nominal with the accepted effects (all training runs)
   double baseline_gap_mm = 0, refit_gap_mm = 0, final_gap_mm = 0;  // held-out (pooled over folds)
   double train_gap_mm = 0;                   // nominal, on the training runs
+  std::size_t windows_at_end_stop = 0;       // left out of every gap (windowed_gap.hpp), all runs
+  std::size_t windows = 0;                   // all windows of all runs, those included
   std::vector<CandidateScore> candidates;    // best first
   std::vector<SelectionStep> steps;          // the forward selection, in order
   std::vector<plant::EffectKind> effects;    // accepted, in order

@@ -22,13 +22,24 @@ double measured_where_mm(const core::Run& run, std::size_t k) {
   return sum / static_cast<double>(plant::kWherePositions);
 }
 
+// Whether a measurement in samples [from, to] lies within kEndStopMarginMm of an end stop.
+bool touches_end_stop(const core::Run& run, std::size_t from, std::size_t to, double stroke_mm) {
+  for (std::size_t k = from; k <= to && k < run.size(); ++k)
+    if (run.y_mm[k] < kEndStopMarginMm || run.y_mm[k] > stroke_mm - kEndStopMarginMm) return true;
+  return false;
+}
+
+struct WindowCount {
+  std::size_t replayed = 0, at_end_stop = 0;
+};
+
 // Calls on_prediction(k, predicted_mm, error_mm) for every prediction.
 template <typename OnPrediction>
-void replay(const ReplayModel& m, const core::Run& run, std::size_t horizon, OnPrediction&& on_prediction) {
+WindowCount replay(const ReplayModel& m, const core::Run& run, std::size_t horizon, OnPrediction&& on_prediction) {
   const auto& model = m.model;
   const std::size_t n = run.size();
   const std::size_t start = first_window_start(model);
-  if (horizon == 0 || n <= start + 1) return;
+  if (horizon == 0 || n <= start + 1) return {};
   const std::size_t na = model.A.size() - 1, nb = model.B.size() - 1;
   std::array<double, core::kMaxModelOrder + 1> a{}, b{};
   for (std::size_t i = 0; i <= na; ++i) a[i] = model.A[i];
@@ -47,7 +58,14 @@ void replay(const ReplayModel& m, const core::Run& run, std::size_t horizon, OnP
 
   const bool reads_position = drive.reads_position();  // else the replay need not know where the piston is
   std::array<double, core::kMaxModelOrder + 1> y{}, ud{};  // y(k), y(k-1), ...; u_d(k), u_d(k-1), ...
+  const std::size_t past = std::max({na, nb, plant::kWherePositions});  // measured samples a window starts from
+  WindowCount count;
   for (std::size_t k0 = start; k0 + 1 < n; k0 += horizon) {
+    if (touches_end_stop(run, k0 >= past ? k0 - past : 0, k0 + horizon, m.stroke_mm)) {
+      ++count.at_end_stop;
+      continue;
+    }
+    ++count.replayed;
     // y holds the measured past (kWherePositions of it, for where the piston is), then the model's.
     for (std::size_t i = 0; i < std::max(na, plant::kWherePositions); ++i) y[i] = run.y_mm[k0 >= i ? k0 - i : 0] / mpv;
     for (std::size_t i = 1; i < nb && i <= k0; ++i)
@@ -70,23 +88,26 @@ void replay(const ReplayModel& m, const core::Run& run, std::size_t horizon, OnP
       on_prediction(k + 1, predicted_mm, predicted_mm - run.y_mm[k + 1]);
     }
   }
+  return count;
 }
 
 }  // namespace
 
 GapSum windowed_sse(const ReplayModel& model, const core::Run& run, std::size_t horizon) {
   GapSum s;
-  replay(model, run, horizon, [&](std::size_t, double, double e) { s.sse_mm2 += e * e, ++s.n; });
+  const auto count = replay(model, run, horizon, [&](std::size_t, double, double e) { s.sse_mm2 += e * e, ++s.n; });
+  s.windows = count.replayed, s.windows_at_end_stop = count.at_end_stop;
   return s;
 }
 
 WindowedReplay windowed_replay(const ReplayModel& model, const core::Run& run, std::size_t horizon) {
   WindowedReplay r;
   r.k.reserve(run.size()), r.predicted_mm.reserve(run.size()), r.error_mm.reserve(run.size());
-  replay(model, run, horizon, [&](std::size_t k, double p, double e) {
+  const auto count = replay(model, run, horizon, [&](std::size_t k, double p, double e) {
     r.k.push_back(k), r.predicted_mm.push_back(p), r.error_mm.push_back(e);
     r.sum.sse_mm2 += e * e, ++r.sum.n;
   });
+  r.sum.windows = count.replayed, r.sum.windows_at_end_stop = count.at_end_stop;
   return r;
 }
 

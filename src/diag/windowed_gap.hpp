@@ -10,6 +10,12 @@
 // valve would; position_dependent_gain reads where the piston is (plant::kWherePositions: the
 // measured positions, then the model's own inside a window);
 // sensor_quantization rounds the prediction as the sensor would round the truth.
+//
+// A window whose measurements (from the model's measured past to its last sample) come within
+// kEndStopMarginMm of an end stop is left out: at a cushion the piston stops dead whatever the
+// valve does, so those samples hold a collision that no effect in the vocabulary describes, and
+// one run that hit a stop would otherwise dominate every fit (a blind rig: 7 mm of a 3 mm training
+// gap from one run). The same windows are left out for every model, so gaps stay comparable.
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -27,12 +33,19 @@ struct ReplayModel {
   double stroke_mm = 500.0;  // end stops at 0 and stroke_mm
 };
 
+inline constexpr double kEndStopMarginMm = 1.0;
+
 // Sum of squared prediction errors and their count: pools over runs, folds and regimes.
 struct GapSum {
   double sse_mm2 = 0.0;
   std::size_t n = 0;
+  std::size_t windows = 0;              // replayed
+  std::size_t windows_at_end_stop = 0;  // left out (above)
   double rms_mm() const;
-  GapSum& operator+=(const GapSum& o) { sse_mm2 += o.sse_mm2, n += o.n; return *this; }
+  GapSum& operator+=(const GapSum& o) {
+    sse_mm2 += o.sse_mm2, n += o.n, windows += o.windows, windows_at_end_stop += o.windows_at_end_stop;
+    return *this;
+  }
 };
 
 // Every prediction of one run, in sample order.

@@ -56,4 +56,29 @@ TEST(WindowedGap, ReplayListsEveryPredictionOnce) {
   EXPECT_EQ(r.sum.n, r.k.size());
 }
 
+TEST(WindowedGap, WindowsThatTouchAnEndStopAreLeftOutAndCounted) {
+  const auto model = epa::core::paper::model();
+  const ReplayModel replay{model, {}, 500};
+  const auto clean = epa::testing::make_run(model, {}, {.closed_loop = true, .duration_s = 8, .noise_std_mm = 0.0});
+  const std::size_t all_windows = epa::diag::windowed_sse(replay, clean, 10).windows;
+  ASSERT_EQ(epa::diag::windowed_sse(replay, clean, 10).windows_at_end_stop, 0u);
+  // 20 readings at the cap (0.4 mm) or at the far end, which the model cannot predict: without
+  // the rule they would make a gap of hundreds of millimetres.
+  for (double at_stop_mm : {0.4, 499.7}) {
+    auto hit = clean;
+    for (std::size_t k = 800; k < 820; ++k) hit.y_mm[k] = at_stop_mm;
+    const auto s = epa::diag::windowed_sse(replay, hit, 10);
+    EXPECT_LT(s.rms_mm(), 1e-9) << at_stop_mm;
+    // Samples 800-819 reach into windows that start up to 10 samples before (their own span) or
+    // whose measured past (3 model orders, 6 positions) reaches back to them: 3 or 4 windows.
+    EXPECT_GE(s.windows_at_end_stop, 3u) << at_stop_mm;
+    EXPECT_LE(s.windows_at_end_stop, 4u) << at_stop_mm;
+    EXPECT_EQ(s.windows + s.windows_at_end_stop, all_windows) << at_stop_mm;
+  }
+  // The same readings 2 mm inside the stroke are a gap like any other.
+  auto near = clean;
+  for (std::size_t k = 800; k < 820; ++k) near.y_mm[k] = 2.0;
+  EXPECT_GT(epa::diag::windowed_sse(replay, near, 10).rms_mm(), 1.0);
+}
+
 }  // namespace
