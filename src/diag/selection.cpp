@@ -76,6 +76,32 @@ bool unexplained(const Diagnosis& d, const DiagnosisOptions& o) {
   return significant && d.final_gap_mm > o.unexplained_share * d.baseline_gap_mm;
 }
 
+// Whether the drive's gain, with the position dependence fitted beside it, is beyond the
+// tolerance on the same side over the whole stroke the runs visited: only then is it a gain
+// change (supply pressure, valve gain). A gain that equals its nominal value somewhere along the
+// stroke and differs elsewhere is the position dependence alone; its level against the nominal
+// is part of its shape (a dip at mid-stroke lowers the mean gain without changing the supply).
+bool gain_off_along_the_whole_stroke(const plant::EffectSet& fitted, const std::vector<const core::Run*>& runs,
+                                     double tolerance) {
+  double lo_mm = 1e300, hi_mm = -1e300;
+  for (const auto* r : runs)
+    for (double y : r->y_mm) lo_mm = std::min(lo_mm, y), hi_mm = std::max(hi_mm, y);
+  if (!(hi_mm >= lo_mm)) return false;
+  const double gain = fitted.param(EffectKind::kGainChange, 0);
+  const plant::DriveEffects position(fitted, core::DeadZone{.m_r = 1.0, .m_l = 1.0, .b_r = 0.0, .b_l = 0.0}, 0.0);
+  bool all_above = true, all_below = true;
+  constexpr int kPoints = 50;
+  for (int i = 0; i <= kPoints; ++i) {
+    const double x = lo_mm + (hi_mm - lo_mm) * i / kPoints;
+    for (double direction : {1.0, -1.0}) {
+      const double g = gain * position.finish(direction, x) / direction;
+      all_above = all_above && g > 1.0 + tolerance;
+      all_below = all_below && g < 1.0 - tolerance;
+    }
+  }
+  return all_above || all_below;
+}
+
 std::string names(const std::vector<EffectKind>& kinds) {
   std::string s;
   for (auto k : kinds) s += (s.empty() ? "" : ", ") + std::string(plant::to_string(k));
@@ -298,7 +324,11 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
     say(buf);
     return cost > chance_threshold_pct(parameter) * o.threshold_scale;
   };
+  const bool position_named = std::find(d.effects.begin(), d.effects.end(), EffectKind::kPositionDependentGain) != d.effects.end();
+  std::vector<const core::Run*> visited = train;
+  visited.insert(visited.end(), heldout.begin(), heldout.end());
   if (refit_significant && std::abs(fe.param(EffectKind::kGainChange, 0) - 1.0) > o.gain_tolerance &&
+      (!position_named || gain_off_along_the_whole_stroke(fe, visited, o.gain_tolerance)) &&
       earns(EffectKind::kGainChange))
     named.push_back(EffectKind::kGainChange);
   if (refit_significant &&

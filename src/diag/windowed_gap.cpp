@@ -14,12 +14,12 @@ std::size_t first_window_start(const core::HammersteinModel& model) {
 
 namespace {
 
-// Where the piston was at sample k by the measurements (plant::kWherePositions; before the run's
-// start, its first reading).
-double measured_where_mm(const core::Run& run, std::size_t k) {
+// Where the piston was at sample k by the measurements: the mean of `samples` readings (before
+// the run's start, its first reading).
+double measured_where_mm(const core::Run& run, std::size_t k, std::size_t samples) {
   double sum = 0.0;
-  for (std::size_t i = 0; i < plant::kWherePositions; ++i) sum += run.y_mm[k >= i ? k - i : 0];
-  return sum / static_cast<double>(plant::kWherePositions);
+  for (std::size_t i = 0; i < samples; ++i) sum += run.y_mm[k >= i ? k - i : 0];
+  return sum / static_cast<double>(samples);
 }
 
 // Whether a measurement in samples [from, to] lies within kEndStopMarginMm of an end stop.
@@ -57,8 +57,10 @@ WindowCount replay(const ReplayModel& m, const core::Run& run, std::size_t horiz
   for (std::size_t k = 0; k < n; ++k) pre[k] = drive.drive_before_position(valve.apply(run.u_V[k]));
 
   const bool reads_position = drive.reads_position();  // else the replay need not know where the piston is
-  std::array<double, core::kMaxModelOrder + 1> y{}, ud{};  // y(k), y(k-1), ...; u_d(k), u_d(k-1), ...
-  const std::size_t past = std::max({na, nb, plant::kWherePositions});  // measured samples a window starts from
+  const std::size_t where_samples = drive.where_samples();
+  // y(k), y(k-1), ... (the model's order, and the positions where the piston is averages); u_d(k), u_d(k-1), ...
+  std::array<double, std::max(core::kMaxModelOrder, plant::kMaxWherePositions) + 1> y{}, ud{};
+  const std::size_t past = std::max({na, nb, where_samples});  // measured samples a window starts from
   WindowCount count;
   for (std::size_t k0 = start; k0 + 1 < n; k0 += horizon) {
     if (touches_end_stop(run, k0 >= past ? k0 - past : 0, k0 + horizon, m.stroke_mm)) {
@@ -66,23 +68,23 @@ WindowCount replay(const ReplayModel& m, const core::Run& run, std::size_t horiz
       continue;
     }
     ++count.replayed;
-    // y holds the measured past (kWherePositions of it, for where the piston is), then the model's.
-    for (std::size_t i = 0; i < std::max(na, plant::kWherePositions); ++i) y[i] = run.y_mm[k0 >= i ? k0 - i : 0] / mpv;
+    // y holds the measured past (where_samples of it, for where the piston is), then the model's.
+    for (std::size_t i = 0; i < std::max(na, where_samples); ++i) y[i] = run.y_mm[k0 >= i ? k0 - i : 0] / mpv;
     for (std::size_t i = 1; i < nb && i <= k0; ++i)
-      ud[i] = drive.finish(pre[k0 - i], reads_position ? measured_where_mm(run, k0 - i) : 0.0);
+      ud[i] = drive.finish(pre[k0 - i], reads_position ? measured_where_mm(run, k0 - i, where_samples) : 0.0);
     const std::size_t end = std::min(n - 1, k0 + horizon);
     for (std::size_t k = k0; k < end; ++k) {
       double where_mm = 0.0;
       if (reads_position) {
-        for (std::size_t i = 0; i < plant::kWherePositions; ++i) where_mm += y[i];
-        where_mm *= mpv / static_cast<double>(plant::kWherePositions);
+        for (std::size_t i = 0; i < where_samples; ++i) where_mm += y[i];
+        where_mm *= mpv / static_cast<double>(where_samples);
       }
       ud[0] = drive.finish(pre[k], where_mm);
       double next = 0.0;
       for (std::size_t i = 1; i <= na; ++i) next -= a[i] * y[i - 1];
       for (std::size_t i = 1; i <= nb; ++i) next += b[i] * ud[i - 1];
       next = std::clamp(next, 0.0, max_v);
-      for (std::size_t i = core::kMaxModelOrder; i > 0; --i) y[i] = y[i - 1], ud[i] = ud[i - 1];
+      for (std::size_t i = y.size() - 1; i > 0; --i) y[i] = y[i - 1], ud[i] = ud[i - 1];
       y[0] = next;
       const double predicted_mm = plant::quantize_mm(next * mpv, step_mm);
       on_prediction(k + 1, predicted_mm, predicted_mm - run.y_mm[k + 1]);

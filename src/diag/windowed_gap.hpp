@@ -7,7 +7,7 @@
 //
 // Effects that depend on the command history alone (delay, lag, dead zone, friction, gain,
 // ceiling) are computed over the whole run, so they carry their state across restarts as the real
-// valve would; position_dependent_gain reads where the piston is (plant::kWherePositions: the
+// valve would; position_dependent_gain reads where the piston is (its where_samples: the
 // measured positions, then the model's own inside a window);
 // sensor_quantization rounds the prediction as the sensor would round the truth.
 //

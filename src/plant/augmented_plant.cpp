@@ -2,6 +2,9 @@
 
 #include <cmath>
 
+static_assert(epa::plant::kMaxWherePositions <= epa::plant::kRememberedPositions,
+              "the plant must remember every position position_dependent_gain may average");
+
 namespace epa::plant {
 
 core::Result<AugmentedPlant> AugmentedPlant::make(const core::HammersteinModel& model, const EffectSet& effects,
@@ -31,7 +34,7 @@ core::Result<AugmentedPlant> AugmentedPlant::make(const core::HammersteinModel& 
 
 void AugmentedPlant::step(double valve_v) noexcept {
   const double spool_v = valve_.apply(std::isfinite(valve_v) ? valve_v : 0.0);
-  arx_.step(drive_.apply(spool_v, arx_.mean_position_mm(kWherePositions)));
+  arx_.step(drive_.apply(spool_v, arx_.mean_position_mm(drive_.where_samples())));
   sample_sensor();
 }
 

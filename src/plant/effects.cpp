@@ -34,7 +34,9 @@ constexpr ParamSpec kPosition[] = {
     {"slope_per_100mm", -0.8, 0.8, 0.0, false, "relative gain change per 100 mm from mid-stroke (250 mm), both directions"},
     {"chamber_slope_per_100mm", -0.8, 0.8, 0.0, false,
      "relative gain fall per 100 mm the driving chamber is longer than at mid-stroke", true},
-    {"curvature", -0.8, 0.8, 0.0, false, "relative gain at the ends over mid-stroke, (x/250 mm - 1)^2 - 1/3 shaped", true}};
+    {"curvature", -0.8, 0.8, 0.0, false, "relative gain at the ends over mid-stroke, (x/250 mm - 1)^2 - 1/3 shaped", true},
+    {"where_samples", 2.0, static_cast<double>(kMaxWherePositions), static_cast<double>(kDefaultWherePositions), true,
+     "positions averaged for where the piston is (effects.hpp says why)", true, true}};
 constexpr ParamSpec kQuantization[] = {{"step_mm", 0.0, 10.0, 0.0, false, "position sensor resolution"}};
 
 constexpr double kMidStrokeMm = 250.0;
@@ -89,6 +91,9 @@ core::Status EffectSet::validate() const {
         return core::invalid_argument("effect " + std::string(to_string(kind)) + ": " + std::string(specs[i].name) + " = " +
                                       core::format_number(v) + " lies outside [" + core::format_number(specs[i].lo) + ", " +
                                       core::format_number(specs[i].hi) + "]");
+      if (specs[i].integer && v != std::round(v))
+        return core::invalid_argument("effect " + std::string(to_string(kind)) + ": " + std::string(specs[i].name) + " = " +
+                                      core::format_number(v) + " is not a whole number");
     }
   }
   return core::ok();
@@ -145,6 +150,8 @@ DriveEffects::DriveEffects(const EffectSet& e, const core::DeadZone& nominal, do
     slope_per_mm_ = e.param(EffectKind::kPositionDependentGain, 0) / 100.0;
     chamber_per_mm_ = e.param(EffectKind::kPositionDependentGain, 1) / 100.0;
     curvature_ = e.param(EffectKind::kPositionDependentGain, 2);
+    where_samples_ = static_cast<std::size_t>(
+        std::clamp(std::lround(e.param(EffectKind::kPositionDependentGain, 3)), 1L, static_cast<long>(kMaxWherePositions)));
   }
   if (e.on(EffectKind::kFlowSaturation) && speed_mm_s_per_V > 0.0)
     max_drive_ = e.param(EffectKind::kFlowSaturation, 0) / speed_mm_s_per_V;

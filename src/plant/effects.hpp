@@ -52,10 +52,13 @@ struct ParamSpec {
   bool integer = false;    // fitted on a grid of integers (delay)
   std::string_view meaning;
   bool optional = false;   // may be left out of a spec: neutral then
+  // A shape parameter that matters only once the others are fitted (with them neutral it changes
+  // nothing): its grid runs after them, and only when the effect is fitted afresh.
+  bool grid_after_the_rest = false;
 };
 std::span<const ParamSpec> param_specs(EffectKind kind);
 
-inline constexpr std::size_t kMaxEffectParams = 3;
+inline constexpr std::size_t kMaxEffectParams = 4;
 using EffectParams = std::array<double, kMaxEffectParams>;
 
 // Which effects are on, with their parameters. Default: none (the nominal model).
@@ -84,6 +87,15 @@ class EffectSet {
 // end are neutral, so "position_dependent_gain=0.2" is the slope alone). Validated; the
 // error names the spec and what is wrong.
 core::Result<EffectSet> parse_effect_specs(const std::vector<std::string>& specs);
+
+// Where the piston is, for position_dependent_gain: the mean of the last where_samples positions
+// (a parameter of the effect, 2 to kMaxWherePositions). Not the last one alone: the printed B
+// swings the model's position by tens of mm at the Nyquist frequency with every change of the
+// drive, which no piston does, and a gain fed from that swing feeds on itself. How a rig's gain
+// sees past that swing is not known, and the fit is sensitive to it (a blind compressibility rig
+// that averages 8: 0.75 mm left with 6 positions, 0.38 mm with 8), so the length is fitted.
+inline constexpr std::size_t kDefaultWherePositions = 6;
+inline constexpr std::size_t kMaxWherePositions = 12;
 
 // Effects on the valve command only (input_delay, valve_lag): what any plant with a step(valve_v)
 // can carry. Explicit state, restartable; the command before sample 0 is taken as 0 V (centred).
@@ -125,6 +137,8 @@ class DriveEffects {
   double finish(double drive, double position_mm) const noexcept;
   // Whether finish() reads the position (position_dependent_gain is on and not neutral).
   bool reads_position() const { return slope_per_mm_ != 0.0 || chamber_per_mm_ != 0.0 || curvature_ != 0.0; }
+  // How many positions finish()'s position_mm should average (kDefaultWherePositions when off).
+  std::size_t where_samples() const { return where_samples_; }
   double apply(double spool_v, double position_mm) noexcept { return finish(drive_before_position(spool_v), position_mm); }
   const State& state() const { return state_; }
   void set_state(const State& s) { state_ = s; }
@@ -135,13 +149,9 @@ class DriveEffects {
   double breakaway_ = 0, coulomb_ = 0;
   double gain_ = 1.0, max_drive_ = 0.0;  // max_drive_ 0: no ceiling
   double slope_per_mm_ = 0.0, chamber_per_mm_ = 0.0, curvature_ = 0.0;  // position_dependent_gain
+  std::size_t where_samples_ = kDefaultWherePositions;
   State state_;
 };
-
-// Where the piston is, for position_dependent_gain: the mean of the last kWherePositions
-// positions. Not the last one alone: the printed B swings the position by tens of mm at the
-// Nyquist frequency with every change of the drive, and a gain fed from that swing feeds on itself.
-inline constexpr std::size_t kWherePositions = 6;
 
 // sensor_quantization: the reading rounded to the sensor's step (identity for step 0).
 double quantize_mm(double position_mm, double step_mm) noexcept;

@@ -18,11 +18,16 @@ struct PlantOptions {
   double stroke_mm = 500.0;          // end stops at 0 and stroke_mm
 };
 
+// Positions the plant remembers: the model's order, and the mean position effects read
+// (plant/effects.hpp, kMaxWherePositions).
+inline constexpr std::size_t kRememberedPositions = 12;
+static_assert(kRememberedPositions >= core::kMaxModelOrder);
+
 class HammersteinPlant {
  public:
   // All the plant's memory, so a run can be saved and replayed from any sample.
   struct State {
-    std::array<double, core::kMaxModelOrder> y_past{};   // y(k), y(k-1), ... true position, V
+    std::array<double, kRememberedPositions> y_past{};   // y(k), y(k-1), ... true position, V
     std::array<double, core::kMaxModelOrder> ud_past{};  // u_d(k-1), u_d(k-2), ... after the dead zone
     double measured_v = 0.0;                             // y(k) + noise, what the sensor reads
     core::Random rng;
@@ -35,7 +40,7 @@ class HammersteinPlant {
   double measured_mm() const { return state_.measured_v * mm_per_volt_; }
   double position_v() const { return state_.y_past[0]; }         // true position at k, V
   double position_mm() const { return state_.y_past[0] * mm_per_volt_; }
-  // The mean of the last `samples` positions (at most kMaxModelOrder), mm.
+  // The mean of the last `samples` positions (at most kRememberedPositions), mm.
   double mean_position_mm(std::size_t samples) const;
 
   // Applies valve command u(k) (V; non-finite is taken as 0 V, the centred valve) and advances.

@@ -120,6 +120,9 @@ TEST(EffectSpecs, TextSpecsSwitchEffectsOnAndBadOnesAreNamed) {
       {"static_friction=0.6", "takes 2 value(s): breakaway_V,coulomb_V"},
       {"valve_lag=fast", "'fast' is not a number"},
       {"valve_lag=-1", "valve_lag"},
+      {"position_dependent_gain=0.1,0,0,6.5", "where_samples = 6.5 is not a whole number"},
+      {"position_dependent_gain=0.1,0,0,13", "where_samples = 13 lies outside [2, 12]"},
+      {"input_delay=2.5", "delay_samples = 2.5 is not a whole number"},
   };
   for (const auto& [spec, expected] : bad) {
     auto r = epa::plant::parse_effect_specs({spec});

@@ -1,0 +1,31 @@
+// Fitting an effect's parameters: a shape parameter whose grid runs after the rest
+// (position_dependent_gain's where_samples) is found where the data put it.
+#include <gtest/gtest.h>
+
+#include "diag/effect_fit.hpp"
+#include "diag_test_data.hpp"
+
+namespace {
+
+using epa::plant::EffectKind;
+
+// The position gain of a plant that averages `where_samples` positions, fitted afresh on the
+// nominal model: the averaging length comes back, and the slope near its value. With the grid
+// run before the slopes (all neutral then), every length would give the same gap and the first
+// would be kept.
+TEST(EffectFit, TheAveragingLengthOfAPositionGainIsFoundAfterItsSlopes) {
+  const auto model = epa::core::paper::model();
+  for (double where_samples : {3.0, 10.0}) {
+    epa::testing::Hidden h;
+    h.effects.set(EffectKind::kPositionDependentGain, {0.25, 0.0, 0.0, where_samples});
+    std::vector<epa::core::Run> runs;
+    for (std::uint64_t seed : {1u, 2u, 3u})
+      runs.push_back(epa::testing::make_run(model, h, {.closed_loop = true, .duration_s = 10, .noise_std_mm = 0.02, .seed = seed}));
+    const auto fit = epa::diag::fit_effect({model, {}, 500}, EffectKind::kPositionDependentGain, epa::testing::pointers(runs), {});
+    const auto& p = fit.model.effects.params(EffectKind::kPositionDependentGain);
+    EXPECT_EQ(p[3], where_samples);
+    EXPECT_NEAR(p[0], 0.25, 0.05) << "where_samples " << where_samples;
+  }
+}
+
+}  // namespace
