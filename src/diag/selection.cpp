@@ -77,16 +77,18 @@ bool unexplained(const Diagnosis& d, const DiagnosisOptions& o) {
 }
 
 // Whether the drive's gain, with the position dependence fitted beside it, is beyond the
-// tolerance on the same side over the whole stroke the runs visited: only then is it a gain
-// change (supply pressure, valve gain). A gain that equals its nominal value somewhere along the
-// stroke and differs elsewhere is the position dependence alone; its level against the nominal
-// is part of its shape (a dip at mid-stroke lowers the mean gain without changing the supply).
+// tolerance on the same side over the stroke the runs worked in (5th to 95th percentile of the
+// readings: the model's swings and a touch of an end stop are not where it works): only then is
+// it a gain change (supply pressure, valve gain). A gain that equals its nominal value somewhere
+// along the stroke and differs elsewhere is the position dependence alone; its level against the
+// nominal is part of its shape (a dip at mid-stroke lowers the mean gain without changing the supply).
 bool gain_off_along_the_whole_stroke(const plant::EffectSet& fitted, const std::vector<const core::Run*>& runs,
                                      double tolerance) {
-  double lo_mm = 1e300, hi_mm = -1e300;
-  for (const auto* r : runs)
-    for (double y : r->y_mm) lo_mm = std::min(lo_mm, y), hi_mm = std::max(hi_mm, y);
-  if (!(hi_mm >= lo_mm)) return false;
+  std::vector<double> y;
+  for (const auto* r : runs) y.insert(y.end(), r->y_mm.begin(), r->y_mm.end());
+  if (y.empty()) return false;
+  std::sort(y.begin(), y.end());
+  const double lo_mm = y[y.size() * 5 / 100], hi_mm = y[y.size() * 95 / 100];
   const double gain = fitted.param(EffectKind::kGainChange, 0);
   const plant::DriveEffects position(fitted, core::DeadZone{.m_r = 1.0, .m_l = 1.0, .b_r = 0.0, .b_l = 0.0}, 0.0);
   bool all_above = true, all_below = true;
