@@ -99,7 +99,6 @@ TEST(PpTraj, OnPlantsItsModelGetsWrongItHoldsTheTargetWithoutChatterAndSettlesIn
 // step of its drive with a spike (gain x1.2 at 25 mm: 30.6 %, dead band 0.1 V narrower: 40.2 %).
 TEST(PpTraj, OnPlantsItsModelGetsWrongShortAndLongMovesOvershootAtMost30Percent) {
   for (const auto& c : kRobustnessCases) {
-    if (c.line.lag_s > 0.0) continue;  // its short moves still exceed 30 % (README)
     for (double step : kSteps) {
       SCOPED_TRACE(std::string(c.name) + ", step " + std::to_string(step) + " mm");
       const StepRun traj = run(ControllerKind::kPpTraj, step, c.plant, c.line);
