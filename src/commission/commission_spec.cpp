@@ -116,9 +116,11 @@ core::Result<CommissionSpec> parse_commission_spec(const std::string& text) {
     const auto& l = j[key];
     const std::string parent = std::string(key) + ".";
     if (!l.is_object()) return core::invalid_argument(std::string("commission spec: ") + key + " must be an object");
-    for (const auto& [k, value] : l.items())
-      if (std::none_of(kLimitKeys.begin(), kLimitKeys.end(), [&](const LimitKey& limit) { return k == limit.name; }))
-        return core::invalid_argument("commission spec: unknown key '" + parent + k + "'");
+    for (const auto& item : l.items()) {
+      const std::string& given = item.key();  // a named variable, not a structured binding: clang 14 (the fuzz build) cannot capture one
+      if (std::none_of(kLimitKeys.begin(), kLimitKeys.end(), [&](const LimitKey& limit) { return given == limit.name; }))
+        return core::invalid_argument("commission spec: unknown key '" + parent + given + "'");
+    }
     for (const auto& k : kLimitKeys)
       if (auto st = read_number(l, k.name, limits->*k.member, parent.c_str()); !st) return st.error();
   }
