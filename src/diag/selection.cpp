@@ -136,14 +136,16 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
 
   Models current{std::vector<ReplayModel>(folds.size(), nominal), nominal};
   d.nominal = nominal;
-  d.baseline_gap_mm = heldout_gap(current.per_fold, folds, o.horizon);
-  d.train_gap_mm = windowed_gap_mm(nominal, train, o.horizon);
-  for (const auto* runs : {&train, &heldout})
-    for (const auto* r : *runs) {
-      const auto s = windowed_sse(nominal, *r, o.horizon);
-      d.windows_at_end_stop += s.windows_at_end_stop;
-      d.windows += s.windows + s.windows_at_end_stop;
-    }
+  // One replay of every run on the nominal model gives the training gap, the held-out baseline
+  // (every fold tests its runs against this same model, each run once, so the pooled folds are
+  // the held-out runs, or with cross-validation the training runs) and the windows left out.
+  GapSum train_sum, heldout_sum;
+  for (const auto* r : train) train_sum += windowed_sse(nominal, *r, o.horizon);
+  for (const auto* r : heldout) heldout_sum += windowed_sse(nominal, *r, o.horizon);
+  d.train_gap_mm = train_sum.rms_mm();
+  d.baseline_gap_mm = (d.cross_validated ? train_sum : heldout_sum).rms_mm();
+  d.windows_at_end_stop = train_sum.windows_at_end_stop + heldout_sum.windows_at_end_stop;
+  d.windows = train_sum.windows + heldout_sum.windows + d.windows_at_end_stop;
   std::snprintf(buf, sizeof buf, "baseline: held-out gap %.3f mm (training %.3f mm), %zu fold(s)%s", d.baseline_gap_mm,
                 d.train_gap_mm, folds.size(),
                 d.windows_at_end_stop ? (", " + std::to_string(d.windows_at_end_stop) + " of " + std::to_string(d.windows) +
@@ -326,11 +328,11 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
     say(buf);
     return cost > chance_threshold_pct(parameter) * o.threshold_scale;
   };
+  std::vector<const core::Run*> all_runs = train;
+  all_runs.insert(all_runs.end(), heldout.begin(), heldout.end());
   const bool position_named = std::find(d.effects.begin(), d.effects.end(), EffectKind::kPositionDependentGain) != d.effects.end();
-  std::vector<const core::Run*> visited = train;
-  visited.insert(visited.end(), heldout.begin(), heldout.end());
   if (refit_significant && std::abs(fe.param(EffectKind::kGainChange, 0) - 1.0) > o.gain_tolerance &&
-      (!position_named || gain_off_along_the_whole_stroke(fe, visited, o.gain_tolerance)) &&
+      (!position_named || gain_off_along_the_whole_stroke(fe, all_runs, o.gain_tolerance)) &&
       earns(EffectKind::kGainChange))
     named.push_back(EffectKind::kGainChange);
   if (refit_significant &&
@@ -353,8 +355,6 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
   // The final model carries only what is named: unnamed nominal parameters stay re-fitted (they
   // are the model's own), and are reported as the re-fit.
 
-  std::vector<const core::Run*> all_runs = train;
-  all_runs.insert(all_runs.end(), heldout.begin(), heldout.end());
   d.noise_std_mm = estimate_noise_std_mm(all_runs, nominal.model.dead_zone);
   d.noise_floor_mm = noise_floor_mm(nominal.model, d.noise_std_mm, o.horizon);
   d.unexplained = unexplained(d, o);
