@@ -283,6 +283,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   ex.number("amplitude_max_v", r.excitation.amplitude_max_v, above(0, 10, "V"));
   ex.number("duration_s", r.excitation.duration_s, closed(1, 600, "s"));
   ex.number("guard_mm", r.excitation.guard_mm, above(0, 10000, "mm"));
+  ex.boolean("sweep", r.excitation.sweep);
   ex.refuse_unknown_keys();
 
   TableReader st(top.subtable("store"), "store", file, error);

@@ -37,6 +37,9 @@ void add_excite_command(CLI::App& app, ExciteOptions& o) {
   cmd->add_option("--ramp-travel", o.ramp_travel_mm, "A ramp turns back once the piston has moved this far, mm")
       ->capture_default_str();
   cmd->add_option("--guard", o.guard_mm, "Pulses away from the middle end this close to a stroke end, mm")->capture_default_str();
+  cmd->add_flag("--centring", o.centring,
+                "Pulse signs keep the piston near the middle (before 2026-11-27 the only way); default: they sweep the "
+                "stroke between the guard lines, which identifies a model that holds across it");
 }
 
 namespace {
@@ -125,6 +128,7 @@ int run_excite(const ExciteOptions& o, std::ostream& out, std::ostream& err) {
   eo.ramp_rate_v_per_s = o.ramp_rate_v_per_s;
   eo.ramp_travel_mm = o.ramp_travel_mm;
   eo.guard_mm = o.guard_mm;
+  eo.sweep = !o.centring;
   eo.seed = o.seed;
   auto excited = physics ? excite_physics(o, eo) : excite_model(o, eo);
   if (!excited) return fail(excited.error().message);

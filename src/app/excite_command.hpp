@@ -30,6 +30,7 @@ struct ExciteOptions {
   double ramp_rate_v_per_s = 0.5;
   double ramp_travel_mm = 40.0;
   double guard_mm = 100.0;
+  bool centring = false;  // pulse signs towards the middle instead of sweeps
 };
 
 void add_excite_command(CLI::App& app, ExciteOptions& options);

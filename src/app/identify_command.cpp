@@ -15,6 +15,7 @@
 #include "ident/hammerstein_identification.hpp"
 #include "ident/order_selection.hpp"
 #include "ident/ramp_reading.hpp"
+#include "ident/stick_slip_fit.hpp"
 
 namespace epa::app {
 
@@ -52,6 +53,8 @@ void add_identify_command(CLI::App& app, IdentifyOptions& o) {
                   "Simulation criterion: ramps: keep each break point between where the ramps start the piston from "
                   "rest and where it stops on the way back; free: wherever the simulation error puts it")
       ->capture_default_str()->check(CLI::IsMember({"ramps", "free"}));
+  cmd->add_flag("!--no-stick-slip", o.stick_slip,
+               "Skip the stick-slip model (the model for simulating a pneumatic axis, fitted after the Hammerstein one)");
   cmd->add_option("--stroke", o.stroke_mm, "Stroke, mm (samples at an end stop are left out)")->capture_default_str()->check(CLI::PositiveNumber);
 }
 
@@ -203,15 +206,35 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   const ModelFitSummary summary = summarise_fit(fit, est_segments, val_segments);
   print_identified_model(out, fit, model, summary, o.m_l);
 
+  std::optional<ident::StickSlipIdentification> stick_slip;
+  if (o.stick_slip) {
+    out << "\nStick-slip model (plant/stick_slip_model.hpp: flow dead zone, air spring, sliding and breakaway "
+           "friction, spool lag, dead time), fitted on the free-run simulation error (BOBYQA) from the model above:\n"
+        << std::flush;
+    ident::StickSlipFitOptions fit_options;
+    fit_options.Ts = *Ts;
+    fit_options.mm_per_volt = o.mm_per_volt;
+    auto fitted = ident::identify_stick_slip(est_segments, val_segments, model, chosen.nk, fit_options);
+    if (!fitted) return fail(fitted.error().message);
+    stick_slip = *fitted;
+    print_stick_slip(out, *stick_slip, summary);
+  }
+
   std::string runs_text;
   for (const auto& r : o.runs) runs_text += (runs_text.empty() ? "" : ", ") + r;
-  char source[512];
-  std::snprintf(source, sizeof source, "epa identify: %s from %s; %s free-run fit %.2f %%; PSO seed %llu%s",
-                chosen.to_string().c_str(), runs_text.c_str(), summary.validated ? "validation" : "estimation",
-                summary.validated ? summary.validation.simulation_pct : summary.estimation.simulation_pct,
-                static_cast<unsigned long long>(o.seed), refining ? ", refined on the simulation error" : "");
+  char source[640];
+  const char* scored = summary.validated ? "validation" : "estimation";
+  const int used = std::snprintf(source, sizeof source, "epa identify: %s from %s; %s free-run fit %.2f %%; PSO seed %llu%s",
+                                 chosen.to_string().c_str(), runs_text.c_str(), scored,
+                                 summary.validated ? summary.validation.simulation_pct : summary.estimation.simulation_pct,
+                                 static_cast<unsigned long long>(o.seed), refining ? ", refined on the simulation error" : "");
+  if (stick_slip && used > 0 && static_cast<std::size_t>(used) < sizeof source)
+    std::snprintf(source + used, sizeof source - static_cast<std::size_t>(used), "; stick-slip model: %s free-run fit %.2f %%",
+                  scored, summary.validated ? stick_slip->validation_pct : stick_slip->estimation_pct);
   if (!o.out_path.empty()) {
-    if (auto s = core::write_model_file(o.out_path, {model, source}); !s) return fail(s.error().message);
+    const std::optional<core::StickSlipParams> stick_slip_params =
+        stick_slip ? std::optional<core::StickSlipParams>(stick_slip->fit.params) : std::nullopt;
+    if (auto s = core::write_model_file(o.out_path, {model, source, stick_slip_params}); !s) return fail(s.error().message);
     out << "\nmodel written to " << o.out_path << "\n";
   }
   if (!o.save_name.empty()) {
@@ -221,7 +244,8 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
         {"validation", summary.validated ? nlohmann::json{{"one_step_pct", summary.validation.one_step_pct},
                                                           {"simulation_pct", summary.validation.simulation_pct}}
                                          : nlohmann::json(nullptr)},
-        {"pso_seed", o.seed}, {"criterion", o.criterion}};
+        {"pso_seed", o.seed}, {"criterion", o.criterion},
+        {"stick_slip", stick_slip ? stick_slip_json(*stick_slip, summary.validated) : nlohmann::json(nullptr)}};
     auto id = save_model(o.db_path, {.id = 0, .name = o.save_name, .created_ms = 0, .source = source, .model = model,
                                      .fit_json = fit_json.dump()});
     if (!id) return fail("--save: " + id.error().message);

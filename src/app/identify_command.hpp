@@ -34,6 +34,7 @@ struct IdentifyOptions {
   std::string criterion = "simulation";  // or "one-step": the swarm's least-squares fit alone (before issue 19)
   double window_s = 0.0;              // simulation criterion: restart from measured y every window_s (0: whole runs)
   std::string break_points = "ramps"; // simulation criterion: "ramps" (within the ramps' band) or "free"
+  bool stick_slip = true;             // also fit the stick-slip model (plant/stick_slip_model.hpp)
 };
 
 void add_identify_command(CLI::App& app, IdentifyOptions& options);

@@ -20,12 +20,6 @@ ModelFitSummary summarise_fit(const ident::HammersteinFit& fit, const std::vecto
   return s;
 }
 
-double piston_speed_mm_s_per_v(const core::HammersteinModel& m, double slope) {
-  double dA = 0.0;  // A'(1) = sum i a_i
-  for (std::size_t i = 1; i < m.A.size(); ++i) dA += static_cast<double>(i) * m.A[i];
-  return slope * m.B.at(1.0) / -dA * m.mm_per_volt / m.Ts;
-}
-
 namespace {
 
 constexpr double kDetailWindowS = 5.0;
@@ -82,8 +76,8 @@ void print_identified_model(std::ostream& out, const ident::HammersteinFit& fit,
   row(out, "right break point b_r", dz.b_r, pdz.b_r, "V");
   row(out, "left break point b_l", dz.b_l, pdz.b_l, "V");
   row(out, "slope ratio m_r / m_l", dz.m_r / dz.m_l, pdz.m_r / pdz.m_l);
-  row(out, "speed per V beyond b_r", piston_speed_mm_s_per_v(model, dz.m_r), piston_speed_mm_s_per_v(paper, pdz.m_r), "mm/s");
-  row(out, "speed per V beyond b_l", piston_speed_mm_s_per_v(model, dz.m_l), piston_speed_mm_s_per_v(paper, pdz.m_l), "mm/s");
+  row(out, "speed per V beyond b_r", core::piston_speed_mm_s_per_v(model, dz.m_r), core::piston_speed_mm_s_per_v(paper, pdz.m_r), "mm/s");
+  row(out, "speed per V beyond b_l", core::piston_speed_mm_s_per_v(model, dz.m_l), core::piston_speed_mm_s_per_v(paper, pdz.m_l), "mm/s");
   std::snprintf(buf, sizeof buf, "m_r (normalised: m_l := %g)", m_l);
   row(out, buf, dz.m_r, pdz.m_r);
   row(out, "m_l", dz.m_l, pdz.m_l);
@@ -138,6 +132,51 @@ std::string render_identification_plot(const std::vector<IdentifiedRun>& runs, c
     panels.push_back(std::move(valve));
   }
   return render_svg("Measured and model output (" + fit.arx.model.orders.to_string() + ")", panels, 1, 1100, 280);
+}
+
+void print_stick_slip(std::ostream& out, const ident::StickSlipIdentification& r, const ModelFitSummary& hammerstein) {
+  const auto& p = r.fit.params;
+  char buf[400];
+  std::snprintf(buf, sizeof buf,
+                "  flow dead zone: b_r = %.4f V, b_l = %.4f V; the piston starts to move at %+.3f / %+.3f V on a %g V/s ramp\n"
+                "  speed per V beyond them: %.1f / %.1f mm/s\n",
+                p.break_right_v, p.break_left_v, r.ramp_right_v, r.ramp_left_v, ident::StickSlipIdentification::kRampVPerS,
+                p.speed_right_mm_s_per_v, p.speed_left_mm_s_per_v);
+  out << buf;
+  std::snprintf(buf, sizeof buf,
+                "  air spring %.1f rad/s, damping ratio %.3f; friction as the spring's wind-up: sliding %.2f mm, "
+                "breakaway %.2f mm\n  spool lag %.1f ms, dead time %d sample(s)\n",
+                p.spring_rad_s, p.damping_ratio, p.coulomb_mm, p.static_mm, 1e3 * p.spool_lag_s, p.delay_samples);
+  out << buf;
+  if (std::isnan(r.validation_pct))
+    std::snprintf(buf, sizeof buf, "  free-run fit: estimation %.2f %% (the Hammerstein model: %.2f %%)\n", r.estimation_pct,
+                  hammerstein.estimation.simulation_pct);
+  else
+    std::snprintf(buf, sizeof buf, "  free-run fit: estimation %.2f %%, validation %.2f %% (the Hammerstein model: %.2f %%, %.2f %%)\n",
+                  r.estimation_pct, r.validation_pct, hammerstein.estimation.simulation_pct,
+                  hammerstein.validation.simulation_pct);
+  out << buf;
+  std::snprintf(buf, sizeof buf, "  simulation error %.3f mm RMS on the estimation runs, %zu simulations\n",
+                std::sqrt(r.fit.loss_mm2), r.fit.evaluations);
+  out << buf;
+}
+
+nlohmann::json stick_slip_json(const ident::StickSlipIdentification& r, bool validated) {
+  const auto& p = r.fit.params;
+  return {{"break_right_v", p.break_right_v},
+          {"break_left_v", p.break_left_v},
+          {"speed_right_mm_s_per_v", p.speed_right_mm_s_per_v},
+          {"speed_left_mm_s_per_v", p.speed_left_mm_s_per_v},
+          {"spring_rad_s", p.spring_rad_s},
+          {"damping_ratio", p.damping_ratio},
+          {"coulomb_mm", p.coulomb_mm},
+          {"static_mm", p.static_mm},
+          {"spool_lag_s", p.spool_lag_s},
+          {"delay_samples", p.delay_samples},
+          {"ramp_start_right_v", r.ramp_right_v},
+          {"ramp_start_left_v", r.ramp_left_v},
+          {"estimation_simulation_pct", r.estimation_pct},
+          {"validation_simulation_pct", validated ? nlohmann::json(r.validation_pct) : nlohmann::json(nullptr)}};
 }
 
 }  // namespace epa::app

@@ -5,11 +5,14 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/hammerstein_model.hpp"
 #include "core/run.hpp"
 #include "ident/arx_metrics.hpp"
 #include "ident/hammerstein_fit.hpp"
 #include "ident/ident_data.hpp"
+#include "ident/stick_slip_fit.hpp"
 
 namespace epa::app {
 
@@ -27,11 +30,6 @@ struct ModelFitSummary {
 ModelFitSummary summarise_fit(const ident::HammersteinFit& fit, const std::vector<ident::Segment>& estimation,
                               const std::vector<ident::Segment>& validation);
 
-// Steady piston speed per volt of valve command beyond a break point, mm/s per V:
-// slope * B(1) / (-A'(1)) * mm_per_volt / Ts, where -A'(1) = -sum i a_i is A(q) / (1 - q) at q = 1
-// for an integrating A. Independent of the normalisation and of the orders, so it compares any
-// identified model with the paper's.
-double piston_speed_mm_s_per_v(const core::HammersteinModel& model, double slope);
 
 // The model, its fits, and the comparison with eq 9-10 (break points, m_r/m_l, speeds, slopes on
 // the paper's normalisation, and the coefficients when the orders are eq 9's).
@@ -43,5 +41,11 @@ void print_identified_model(std::ostream& out, const ident::HammersteinFit& fit,
 inline constexpr std::size_t kMaxPlottedRuns = 4;
 std::string render_identification_plot(const std::vector<IdentifiedRun>& runs, const ident::HammersteinFit& fit,
                                        const core::HammersteinModel& model, bool validation);
+
+// The stick-slip model's section of `epa identify`: its parameters in physical units, where its
+// piston starts to move on a slow ramp, and its free-run fits beside the Hammerstein model's.
+void print_stick_slip(std::ostream& out, const ident::StickSlipIdentification& r, const ModelFitSummary& hammerstein);
+// The same for the tuning store's fit figures (`--save`).
+nlohmann::json stick_slip_json(const ident::StickSlipIdentification& r, bool validated);
 
 }  // namespace epa::app

@@ -28,4 +28,10 @@ Status HammersteinModel::validate() const {
   return dead_zone.validate();
 }
 
+double piston_speed_mm_s_per_v(const HammersteinModel& m, double slope) {
+  double dA = 0.0;  // A'(1) = sum i a_i
+  for (std::size_t i = 1; i < m.A.size(); ++i) dA += static_cast<double>(i) * m.A[i];
+  return slope * m.B.at(1.0) / -dA * m.mm_per_volt / m.Ts;
+}
+
 }  // namespace epa::core

@@ -21,4 +21,10 @@ struct HammersteinModel {
   Status validate() const;
 };
 
+// Steady piston speed per volt of valve command beyond a break point, mm/s per V:
+// slope * B(1) / (-A'(1)) * mm_per_volt / Ts, where -A'(1) = -sum i a_i is A(q) / (1 - q) at q = 1
+// for an integrating A. Independent of the normalisation and of the orders, so it compares any
+// identified model with the paper's.
+double piston_speed_mm_s_per_v(const HammersteinModel& model, double slope);
+
 }  // namespace epa::core

@@ -1,6 +1,7 @@
 #include "core/model_file.hpp"
 
 #include <charconv>
+#include <cstdint>
 #include <cmath>
 #include <sstream>
 #include <toml++/toml.h>
@@ -43,6 +44,40 @@ Result<Polynomial> array_at(const toml::table& t, const char* key, const std::st
     c.push_back(*v);
   }
   return Polynomial(std::move(c));
+}
+
+// The [stick_slip] table: every field, by its name (a reader that knows the table wants it whole).
+Result<StickSlipParams> stick_slip_at(const toml::table& t, const std::string& src) {
+  StickSlipParams p;
+  struct Field {
+    const char* key;
+    double* value;
+  };
+  const Field fields[] = {{"break_right_v", &p.break_right_v},
+                          {"break_left_v", &p.break_left_v},
+                          {"speed_right_mm_s_per_v", &p.speed_right_mm_s_per_v},
+                          {"speed_left_mm_s_per_v", &p.speed_left_mm_s_per_v},
+                          {"spring_rad_s", &p.spring_rad_s},
+                          {"damping_ratio", &p.damping_ratio},
+                          {"coulomb_mm", &p.coulomb_mm},
+                          {"static_mm", &p.static_mm},
+                          {"spool_lag_s", &p.spool_lag_s}};
+  for (const auto& f : fields) {
+    auto v = number_at(t, "stick_slip", f.key, src);
+    if (!v) return v.error();
+    *f.value = *v;
+  }
+  const auto* delay = t.get("delay_samples");
+  if (!delay) return parse_error(src + ": [stick_slip] delay_samples is missing");
+  const auto whole = delay->value<std::int64_t>();
+  if (!whole || !delay->is_integer())
+    return parse_error(src + ": [stick_slip] delay_samples must be a whole number of samples");
+  if (*whole < 0 || *whole > StickSlipParams::kMaxDelay)
+    return parse_error(src + ": [stick_slip] delay_samples " + std::to_string(*whole) + " is outside 0.." +
+                       std::to_string(StickSlipParams::kMaxDelay));
+  p.delay_samples = static_cast<int>(*whole);
+  if (auto s = p.validate(); !s) return invalid_argument(src + ": [stick_slip] " + s.error().message);
+  return p;
 }
 
 }  // namespace
@@ -88,6 +123,13 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
     *fields[i] = *v;
   }
   if (auto s = f.model.validate(); !s) return invalid_argument(src + ": " + s.error().message);
+  if (root.contains("stick_slip")) {
+    const auto* ss = root["stick_slip"].as_table();
+    if (!ss) return parse_error(src + ": stick_slip must be a table");
+    auto params = stick_slip_at(*ss, src);
+    if (!params) return params.error();
+    f.stick_slip = *params;
+  }
   return f;
 }
 
@@ -96,6 +138,20 @@ Result<ModelFile> read_model_file(const std::string& path) {
   if (!text) return text.error();
   return parse_model_toml(*text, path);
 }
+
+namespace {
+
+std::string format_stick_slip(const StickSlipParams& p) {
+  auto num = [](double v) { return toml_float(v); };
+  return "\n[stick_slip]\nbreak_right_v = " + num(p.break_right_v) + "\nbreak_left_v = " + num(p.break_left_v) +
+         "\nspeed_right_mm_s_per_v = " + num(p.speed_right_mm_s_per_v) +
+         "\nspeed_left_mm_s_per_v = " + num(p.speed_left_mm_s_per_v) + "\nspring_rad_s = " + num(p.spring_rad_s) +
+         "\ndamping_ratio = " + num(p.damping_ratio) + "\ncoulomb_mm = " + num(p.coulomb_mm) +
+         "\nstatic_mm = " + num(p.static_mm) + "\nspool_lag_s = " + num(p.spool_lag_s) +
+         "\ndelay_samples = " + std::to_string(p.delay_samples) + "\n";
+}
+
+}  // namespace
 
 std::string format_model_toml(const ModelFile& f) {
   auto num = [](double v) { return toml_float(v); };
@@ -106,7 +162,8 @@ std::string format_model_toml(const ModelFile& f) {
   return "schema = \"" + std::string(kSchema) + "\"\nTs = " + num(m.Ts) + "\nmm_per_volt = " + num(m.mm_per_volt) +
          "\nsource = " + source.str() + "\n\n[arx]\nA = " + list(m.A) + "\nB = " + list(m.B) +
          "\n\n[dead_zone]\nm_r = " + num(m.dead_zone.m_r) + "\nm_l = " + num(m.dead_zone.m_l) +
-         "\nb_r = " + num(m.dead_zone.b_r) + "\nb_l = " + num(m.dead_zone.b_l) + "\n";
+         "\nb_r = " + num(m.dead_zone.b_r) + "\nb_l = " + num(m.dead_zone.b_l) + "\n" +
+         (f.stick_slip ? format_stick_slip(*f.stick_slip) : std::string());
 }
 
 Status write_model_file(const std::string& path, const ModelFile& file) {

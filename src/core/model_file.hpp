@@ -14,16 +14,22 @@
 //   m_l = 1.0707
 //   b_r = 1.232     # V
 //   b_l = -1.722    # V
+//   [stick_slip]    # optional: the stick-slip model `epa identify` fits beside it (core/stick_slip_params.hpp)
+//   break_right_v = 1.17
+//   ...             # every field of StickSlipParams, by its name; delay_samples an integer
+#include <optional>
 #include <string>
 
 #include "core/hammerstein_model.hpp"
 #include "core/result.hpp"
+#include "core/stick_slip_params.hpp"
 
 namespace epa::core {
 
 struct ModelFile {
   HammersteinModel model;
   std::string source;  // provenance text
+  std::optional<StickSlipParams> stick_slip = std::nullopt;  // the axis as a stick-slip model, when identified
 };
 
 // Errors name the file, and the line for syntax errors, and the key that is missing or wrong.

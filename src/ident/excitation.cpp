@@ -56,10 +56,19 @@ std::size_t ExcitationGenerator::random_samples(double lo_s, double hi_s) {
 }
 
 void ExcitationGenerator::start_pulse(double y_mm) {
-  // Certain to head back once the piston is half way from the middle to a guard line, so a pulse
-  // away from the middle starts with room for its travel before the guard cuts it.
   const double middle = 0.5 * o_.stroke_mm, half_span = 0.5 * o_.stroke_mm - o_.guard_mm;
-  const double p_plus = std::clamp(0.5 - (y_mm - middle) / half_span, 0.0, 1.0);
+  // Either way certain to head back once the piston is half way from the middle to a guard line,
+  // so a pulse away from the middle starts with room for its travel (and the piston's coast after
+  // the guard cuts it) before the end.
+  const double offset = (y_mm - middle) / half_span;  // -1 and +1 at the guard lines
+  double p_plus = std::clamp(0.5 - offset, 0.0, 1.0);
+  if (o_.sweep) {
+    if (sweep_direction_ == 0) sweep_direction_ = offset <= 0.0 ? 1 : -1;
+    if (offset >= kSweepTurn) sweep_direction_ = -1;
+    if (offset <= -kSweepTurn) sweep_direction_ = 1;
+    // The centring rule around a point kSweepBias - 0.5 of the way out on the sweep's side.
+    if (std::abs(offset) < 0.5) p_plus = std::clamp(0.5 + sweep_direction_ * (kSweepBias - 0.5) - offset, 0.0, 1.0);
+  }
   const double sign = rng_.uniform() < p_plus ? 1.0 : -1.0;
   const int level = o_.levels == 1 ? 0 : static_cast<int>(rng_.uniform() * o_.levels);
   const double amplitude =
@@ -169,6 +178,7 @@ core::Result<ExcitationResult> run_excitation(plant::PlantSimulator& plant, doub
   run.set_meta("source", source);
   run.set_meta("excitation_seed", std::to_string(o.seed));
   run.set_meta("amplitude_max_V", format_number(o.amplitude_max_v));
+  run.set_meta("pulse_signs", o.sweep ? "sweep" : "centring");
   run.set_meta("noise_mm", format_number(noise_std_mm));
   const std::size_t n = gen->total_samples();
   run.t_s.reserve(n);

@@ -13,11 +13,18 @@
 //
 // Position keeping. The piston integrates the valve command, so random pulses would drive it into
 // an end stop. The measured position only chooses pulse signs and cuts pulses short; it never sets
-// a level, so the run stays an open-loop experiment: a pulse goes towards + with probability
-// 0.5 - (y - middle) / (stroke/2 - guard), clamped to [0, 1] (so only towards the middle once the
-// piston is half way from the middle to a guard line), and a pulse that carries the piston beyond
-// `guard_mm` from an end is ended at once (0 V). The same rule works on a rig with no
-// model of it. All randomness comes from `seed` (core::Random), so a run is repeatable.
+// a level, so the run stays an open-loop experiment. With `sweep` (the default) the pulses favour a
+// travel direction (probability kSweepBias) that turns once the piston is kSweepTurn of the way
+// from the middle to a guard line, so the run crosses the usable stroke again and again; without
+// it a pulse goes towards + with probability 0.5 - (y - middle) / (stroke/2 - guard), clamped to
+// [0, 1], and the piston wanders within about a third of the stroke. Either way a pulse that
+// carries the piston beyond `guard_mm` from an end is ended at once (0 V). The same rule works on a
+// rig with no model of it. All randomness comes from `seed` (core::Random), so a run is repeatable.
+//
+// Why sweep. A run that stays near the middle leaves the model's behaviour elsewhere unseen and
+// fits the few long moves that dominate a free run by chance: on the physics plant a stick-slip
+// model fitted to centring runs reached 78-88 % on held-out runs, fitted to sweeping ones 89-97 %
+// (README, Identification).
 //
 // Timing as core/run.hpp: next(y(k)) returns u(k), applied from k to k+1.
 #include <cstdint>
@@ -44,6 +51,7 @@ struct ExcitationOptions {
   double ramp_rest_s = 1.0;       // rest after each ramp
   double stroke_mm = 500.0;
   double guard_mm = 100.0;        // pulses away from the middle end within this distance of an end
+  bool sweep = true;              // pulse signs cross the stroke (true) or keep near the middle (false)
   std::uint64_t seed = 1;
 
   core::Status validate() const;  // message names the field (as the --option of epa excite)
@@ -68,6 +76,8 @@ class ExcitationGenerator {
   double ramp_motion_up_v() const { return motion_v_[0]; }
   double ramp_motion_down_v() const { return motion_v_[1]; }
   static constexpr double kMotionThresholdMm = 2.0;
+  static constexpr double kSweepBias = 0.8;  // a sweep's pulses head its way with this probability
+  static constexpr double kSweepTurn = 0.45;  // and it turns this far from the middle to a guard line
   std::size_t pulses() const { return pulses_; }
   std::size_t pulses_cut() const { return pulses_cut_; }
 
@@ -88,6 +98,7 @@ class ExcitationGenerator {
   std::size_t left_ = 0;     // samples left in the current pulse or rest
   double motion_v_[2];
   std::size_t pulses_ = 0, pulses_cut_ = 0;
+  int sweep_direction_ = 0;  // +1 / -1 while sweeping; 0 until the first pulse picks the longer way
 };
 
 struct ExcitationResult {

@@ -8,14 +8,23 @@
 namespace epa::ident {
 
 std::string unidentified_side_message(const HammersteinFit& fit) {
-  const bool right = fit.right_unidentified;
-  char evidence[240];
-  std::snprintf(evidence, sizeof evidence, "b_%s = %g V, m_r/m_l = %g; with that side closed V grows only from %.3g to %.3g",
-                right ? "r" : "l", right ? fit.dead_zone.b_r : fit.dead_zone.b_l, fit.ratio, fit.arx.loss,
-                right ? fit.loss_without_right : fit.loss_without_left);
-  return std::string("the ") + (right ? "right" : "left") + " side of the dead zone is not identified (" + evidence +
-         "): the runs never drive the valve far enough beyond the dead band on that side, so its break point "
-         "and slope cannot be identified; record runs with larger pulses (epa excite --amplitude-max)";
+  // Each side that is not identified, with its evidence: a run that drives neither far enough
+  // needs larger pulses on both.
+  std::string sides, evidence;
+  for (const bool right : {true, false}) {
+    if (!(right ? fit.right_unidentified : fit.left_unidentified)) continue;
+    char text[240];
+    std::snprintf(text, sizeof text, "b_%s = %g V, m_r/m_l = %g; with that side closed V grows only from %.3g to %.3g",
+                  right ? "r" : "l", right ? fit.dead_zone.b_r : fit.dead_zone.b_l, fit.ratio, fit.arx.loss,
+                  right ? fit.loss_without_right : fit.loss_without_left);
+    sides += std::string(sides.empty() ? "the " : " and the ") + (right ? "right" : "left");
+    evidence += std::string(evidence.empty() ? "" : "; ") + text;
+  }
+  const bool both = fit.right_unidentified && fit.left_unidentified;
+  return sides + (both ? " sides" : " side") + " of the dead zone " + (both ? "are" : "is") + " not identified (" +
+         evidence + "): the runs never drive the valve far enough beyond the dead band on " +
+         (both ? "those sides" : "that side") +
+         ", so its break point and slope cannot be identified; record runs with larger pulses (epa excite --amplitude-max)";
 }
 
 core::Result<Identification> identify_hammerstein(const std::vector<Segment>& est, const std::vector<Segment>& val,

@@ -12,6 +12,7 @@ ident::ExcitationOptions excitation_options(const ExcitationSettings& s, const R
   o.amplitude_max_v = s.amplitude_max_v;
   o.stroke_mm = config.soft_max_mm - config.soft_min_mm;
   o.guard_mm = s.guard_mm;
+  o.sweep = s.sweep;
   o.seed = s.seed;
   return o;
 }

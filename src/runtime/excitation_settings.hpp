@@ -19,6 +19,7 @@ struct ExcitationSettings {
   double amplitude_max_v = 3.0;   // largest |valve command| of ramps and pulses, V
   double duration_s = 50.0;       // the whole experiment; then STOP by itself
   double guard_mm = 100.0;        // pulses towards a soft limit end this far inside it
+  bool sweep = true;              // pulse signs cross the span (ident::ExcitationOptions::sweep)
 };
 
 // The recorder must still hold the experiment's first sample when its last is written: its ring

@@ -102,6 +102,7 @@ void Recorder::write(const RecordRequest& request) {
     run.set_meta("amplitude_min_V", core::format_number(e.amplitude_min_v));
     run.set_meta("duration_s", core::format_number(e.duration_s));
     run.set_meta("guard_mm", core::format_number(e.guard_mm));
+    run.set_meta("pulse_signs", e.sweep ? "sweep" : "centring");
     run.set_meta("excitation_end", to_string(request.excitation_end));
     run.set_meta("pulses", std::to_string(request.pulses));
     run.set_meta("pulses_cut", std::to_string(request.pulses_cut));

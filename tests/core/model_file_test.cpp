@@ -174,6 +174,69 @@ TEST(ModelFile, MissingArxTableIsNamed) {
   EXPECT_TRUE(contains(file.error().message, "no-arx.toml"));
 }
 
+const std::string kStickSlipTable = R"(
+[stick_slip]
+break_right_v = 1.17
+break_left_v = -1.67
+speed_right_mm_s_per_v = 107.5
+speed_left_mm_s_per_v = 101.0
+spring_rad_s = 52.0
+damping_ratio = 0.3
+coulomb_mm = 5.0
+static_mm = 7.25
+spool_lag_s = 0.013
+delay_samples = 2
+)";
+
+TEST(ModelFile, AFileWithoutAStickSlipTableHasNone) {
+  const auto file = parse_model_toml(kValidText, "plain.toml");
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  EXPECT_FALSE(file->stick_slip.has_value());
+  EXPECT_EQ(format_model_toml(*file).find("stick_slip"), std::string::npos);
+}
+
+TEST(ModelFile, TheStickSlipTableParsesToItsFieldsAndRoundTrips) {
+  const auto file = parse_model_toml(kValidText + kStickSlipTable, "ss.toml");
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  ASSERT_TRUE(file->stick_slip.has_value());
+  const auto& p = *file->stick_slip;
+  EXPECT_EQ(p.break_right_v, 1.17);
+  EXPECT_EQ(p.break_left_v, -1.67);
+  EXPECT_EQ(p.speed_right_mm_s_per_v, 107.5);
+  EXPECT_EQ(p.speed_left_mm_s_per_v, 101.0);
+  EXPECT_EQ(p.spring_rad_s, 52.0);
+  EXPECT_EQ(p.damping_ratio, 0.3);
+  EXPECT_EQ(p.coulomb_mm, 5.0);
+  EXPECT_EQ(p.static_mm, 7.25);
+  EXPECT_EQ(p.spool_lag_s, 0.013);
+  EXPECT_EQ(p.delay_samples, 2);
+  const auto back = parse_model_toml(format_model_toml(*file), "formatted");
+  ASSERT_TRUE(back.has_value()) << back.error().message;
+  ASSERT_TRUE(back->stick_slip.has_value());
+  EXPECT_EQ(back->stick_slip->static_mm, 7.25);
+  EXPECT_EQ(back->stick_slip->spool_lag_s, 0.013);
+  EXPECT_EQ(back->stick_slip->delay_samples, 2);
+}
+
+TEST(ModelFile, AStickSlipTableWithAMissingOrWrongFieldIsRefusedByName) {
+  const std::string text = kValidText + kStickSlipTable;
+  auto file = parse_model_toml(replaced(text, "coulomb_mm = 5.0\n", ""), "ss.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "[stick_slip] coulomb_mm is missing"));
+  file = parse_model_toml(replaced(text, "delay_samples = 2", "delay_samples = 1.5"), "ss.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "delay_samples must be a whole number"));
+  file = parse_model_toml(replaced(text, "delay_samples = 2", "delay_samples = 20"), "ss.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "delay_samples 20 is outside 0..8"));
+  file = parse_model_toml(replaced(text, "static_mm = 7.25", "static_mm = 4.0"), "ss.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "static_mm must be >= coulomb_mm"));
+  file = parse_model_toml(replaced(kValidText, "[arx]", "stick_slip = 3\n\n[arx]"), "ss.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "stick_slip must be a table"));
+}
+
 TEST(ModelFile, MissingDeadZoneKeyIsNamed) {
   const auto file = parse_model_toml(replaced(kValidText, "b_l = -1.722\n", ""), "dz.toml");
   ASSERT_FALSE(file.has_value());

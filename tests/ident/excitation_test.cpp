@@ -128,8 +128,9 @@ TEST(Excitation, WhereTheRampsFirstMoveThePistonBoundsTheBreakPoints) {
   EXPECT_GT(r.ramp_motion_down_v, kPaperDz.b_l - 0.15);
 }
 
-TEST(Excitation, PulseSignsLeanTowardsTheMiddle) {
+TEST(Excitation, CentringPulseSignsLeanTowardsTheMiddle) {
   ExcitationOptions o;
+  o.sweep = false;
   o.ramp_rate_v_per_s = 100.0;  // get the ramps out of the way quickly
   o.ramp_rest_s = 0.0;
   const std::size_t n = 20000, after_ramps = 1000;
@@ -145,6 +146,42 @@ TEST(Excitation, PulseSignsLeanTowardsTheMiddle) {
   EXPECT_GT(count(low, +1), 1000);
   EXPECT_GT(count(middle, +1), 2000);  // about half each way
   EXPECT_GT(count(middle, -1), 2000);
+}
+
+TEST(Excitation, SweepingPulseSignsFavourOneWayUntilItTurnsAndNeverLeaveTheHalfWayRule) {
+  ExcitationOptions o;  // sweep is the default
+  ASSERT_TRUE(o.sweep);
+  o.ramp_rate_v_per_s = 100.0;
+  o.ramp_rest_s = 0.0;
+  const std::size_t n = 20000, after_ramps = 1000;
+  auto count = [&](const std::vector<double>& u, int sign) {
+    return std::count_if(u.begin() + after_ramps, u.end(), [&](double v) { return sign * v > 0.0; });
+  };
+  // Half way from the middle to a guard line (the guard lines at 100 and 400 mm) and beyond: only
+  // back, as with centring.
+  const auto high = drive(o, n, [](double) { return 330.0; });
+  const auto low = drive(o, n, [](double) { return 170.0; });
+  EXPECT_EQ(count(high, +1), 0);
+  EXPECT_EQ(count(low, -1), 0);
+  // Just below the middle, a sweep starts upwards (the longer way is as long; it picks +) and
+  // favours + about 0.8 - 0 = 80 % of the pulses' samples; a piston held there never turns it.
+  const auto middle = drive(o, n, [](double) { return 249.0; });
+  EXPECT_GT(count(middle, +1), 3 * count(middle, -1));
+  EXPECT_GT(count(middle, -1), 0);  // but not all: still a random experiment
+  // A piston that has been up past the turning point (0.45 of the way) sweeps down from then on.
+  bool been_up = false;
+  std::size_t k = 0;
+  const auto turned = drive(o, n, [&](double) {
+    ++k;
+    if (k > 4000) return 249.0;
+    been_up = true;
+    return 320.0;
+  });
+  ASSERT_TRUE(been_up);
+  const std::vector<double> later(turned.begin() + 5000, turned.end());
+  const auto plus = std::count_if(later.begin(), later.end(), [](double v) { return v > 0.0; });
+  const auto minus = std::count_if(later.begin(), later.end(), [](double v) { return v < 0.0; });
+  EXPECT_GT(minus, 3 * plus);
 }
 
 TEST(Excitation, AGuardCutsAPulseThatCarriesThePistonTowardsAnEnd) {

@@ -42,8 +42,9 @@ inline core::Polynomial stable_B() { return {0.0, 0.5, 0.2, -0.1}; }
 
 // An excitation run on the paper's plant (eq 9-10), split into segments.
 inline std::vector<Segment> paper_segments(std::uint64_t seed, double duration_s, double noise_mm,
-                                           double amplitude_max_v = 3.0) {
+                                           double amplitude_max_v = 3.0, bool sweep = true) {
   ExcitationOptions o;
+  o.sweep = sweep;
   o.duration_s = duration_s;
   o.seed = seed;
   o.amplitude_max_v = amplitude_max_v;

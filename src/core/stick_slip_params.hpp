@@ -1,0 +1,26 @@
+#pragma once
+// The parameters of the stick-slip model of a pneumatic axis (plant/stick_slip_model.hpp has the
+// equations and why; ident/stick_slip_fit.hpp fits them; model files carry them as [stick_slip]).
+// Per unit of moving mass, so every value is readable without knowing the mass or the stiffness.
+
+#include "core/result.hpp"
+
+namespace epa::core {
+
+struct StickSlipParams {
+  double break_right_v = 1.2;            // flow starts above this command (spool overlap)
+  double break_left_v = -1.7;            // and below this one
+  double speed_right_mm_s_per_v = 100.0; // steady speed per volt beyond break_right, friction aside
+  double speed_left_mm_s_per_v = 100.0;  // the same beyond break_left
+  double spring_rad_s = 50.0;            // the air spring's natural frequency against the moving mass
+  double damping_ratio = 0.3;            // of that spring-mass mode
+  double coulomb_mm = 5.0;               // sliding friction, as the air spring's wind-up that balances it
+  double static_mm = 8.0;                // breakaway (>= coulomb_mm), the same unit
+  double spool_lag_s = 0.01;             // first-order valve lag (0: none)
+  int delay_samples = 1;                 // dead time of the command, whole samples (0..kMaxDelay)
+
+  static constexpr int kMaxDelay = 8;
+  Status validate() const;  // the message names the field
+};
+
+}  // namespace epa::core

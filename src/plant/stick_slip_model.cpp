@@ -1,0 +1,74 @@
+#include "plant/stick_slip_model.hpp"
+
+#include <cmath>
+
+namespace epa::plant {
+
+core::Result<StickSlipModel> StickSlipModel::make(const StickSlipParams& params, double Ts, int substeps) {
+  if (auto s = params.validate(); !s) return s.error();
+  if (!(Ts > 0.0) || !std::isfinite(Ts)) return core::invalid_argument("stick-slip model: Ts must be > 0");
+  if (substeps < 1 || substeps > 64) return core::invalid_argument("stick-slip model: substeps must be within 1..64");
+  return StickSlipModel(params, Ts, substeps);
+}
+
+StickSlipModel::StickSlipModel(const StickSlipParams& params, double Ts, int substeps)
+    : p_(params), h_s_(Ts / substeps), substeps_(substeps) {
+  spool_gain_ = h_s_ / (p_.spool_lag_s + h_s_);
+  omega2_ = p_.spring_rad_s * p_.spring_rad_s;
+  two_zeta_omega_ = 2.0 * p_.damping_ratio * p_.spring_rad_s;
+}
+
+void StickSlipModel::reset(double position_mm) noexcept {
+  delay_line_.fill(0.0);
+  delay_head_ = 0;
+  spool_v_ = z_mm_ = v_mm_s_ = 0.0;
+  y_mm_ = position_mm;
+  stuck_ = true;
+}
+
+double StickSlipModel::step(double valve_v) noexcept {
+  // The delay line: u(k - delay) leaves as u(k) enters.
+  const std::size_t length = static_cast<std::size_t>(p_.delay_samples) + 1;
+  delay_line_[delay_head_] = std::isfinite(valve_v) ? valve_v : 0.0;
+  const double u = delay_line_[(delay_head_ + 1) % length];
+  delay_head_ = (delay_head_ + 1) % length;
+
+  for (int i = 0; i < substeps_; ++i) {
+    spool_v_ += spool_gain_ * (u - spool_v_);
+    double w = 0.0;
+    if (spool_v_ > p_.break_right_v) w = p_.speed_right_mm_s_per_v * (spool_v_ - p_.break_right_v);
+    else if (spool_v_ < p_.break_left_v) w = p_.speed_left_mm_s_per_v * (spool_v_ - p_.break_left_v);
+    z_mm_ += h_s_ * (w - v_mm_s_);
+    if (stuck_) {
+      if (std::abs(z_mm_) <= p_.static_mm) continue;
+      stuck_ = false;
+    }
+    // Sliding friction opposes the motion; at v = 0 (just broken away) it opposes the wind-up.
+    const double direction = v_mm_s_ != 0.0 ? std::copysign(1.0, v_mm_s_) : std::copysign(1.0, z_mm_);
+    const double a = omega2_ * (z_mm_ - p_.coulomb_mm * direction) - two_zeta_omega_ * v_mm_s_;
+    double v_next = v_mm_s_ + h_s_ * a;
+    if (v_mm_s_ != 0.0 && v_next * v_mm_s_ < 0.0) {  // reversal within the sub-step: it ends at rest
+      v_next = 0.0;
+      stuck_ = std::abs(z_mm_) <= p_.static_mm;
+    } else if (v_mm_s_ == 0.0 && v_next * direction < 0.0) {  // friction cannot start a motion
+      v_next = 0.0;
+    }
+    y_mm_ += 0.5 * h_s_ * (v_mm_s_ + v_next);
+    v_mm_s_ = v_next;
+  }
+  return y_mm_;
+}
+
+double ramp_start_v(const StickSlipParams& params, double Ts, double ramp_v_per_s, double direction, double travel_mm) {
+  auto model = StickSlipModel::make(params, Ts);
+  if (!model || !(ramp_v_per_s > 0.0)) return NAN;
+  model->reset(0.0);
+  const double step_v = direction * ramp_v_per_s * Ts;
+  for (int k = 1; std::abs(step_v * k) <= 10.0; ++k) {
+    const double u = step_v * k;
+    if (std::abs(model->step(u)) >= travel_mm) return u;
+  }
+  return NAN;
+}
+
+}  // namespace epa::plant
