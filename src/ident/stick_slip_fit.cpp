@@ -18,6 +18,7 @@ constexpr double kLossCeilingMm2 = 1e10;  // a diverging simulation scores this
 constexpr double kStartBreakShare = 0.9;  // the flow starts a little inside where the piston moves
 constexpr double kStartFriction[] = {1.0, 0.25, 2.0};  // times the start's friction levels
 constexpr double kStartSpring[] = {1.0, 1.6};          // times its spring
+constexpr double kStartSpeed[] = {1.0, 0.85};          // times its speeds (a Hammerstein fit tends high)
 constexpr unsigned kPolishRounds = 4;     // restarts from the best point
 constexpr double kPolishGain = 0.01;      // a restart that gains less than 1 % of the loss ends them
 
@@ -175,6 +176,9 @@ core::Result<StickSlipFit> fit_stick_slip(const std::vector<Segment>& segments, 
     p.coulomb_mm *= f;
     p.static_mm *= f;
     p.spring_rad_s *= kStartSpring[(i / std::size(kStartFriction)) % std::size(kStartSpring)];
+    const double speed = kStartSpeed[(i / (std::size(kStartFriction) * std::size(kStartSpring))) % std::size(kStartSpeed)];
+    p.speed_right_mm_s_per_v *= speed;
+    p.speed_left_mm_s_per_v *= speed;
     std::vector<double> x = to_unit(p);
     const double value = minimise(c, x, o.evaluations_per_start);
     if (value < best) best = value, best_x = x;

@@ -30,7 +30,7 @@ struct StickSlipFitOptions {
   double Ts = 0.005;                // s
   double mm_per_volt = 50.0;        // the segments' y is in sensor volts
   unsigned evaluations_per_start = 3000;
-  unsigned starts = 6;              // the given start, then others over friction and spring (a grid of 6)
+  unsigned starts = 12;             // the given start, then others over friction, spring and speed (a grid of 12)
   int substeps = 2;                 // of the model's integration
 
   core::Status validate() const;
