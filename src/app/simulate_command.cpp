@@ -26,8 +26,10 @@ void add_simulate_command(CLI::App& app, SimulateOptions& o) {
   cmd->add_option("--controller", o.controllers, "Controllers to run: pp, pp-ngidz, pp-ffidz, pp-traj")->delimiter(',')->capture_default_str();
   cmd->add_option("--steps", o.steps_mm, "Step sizes from rest at --start, mm (negative: towards 0)")->delimiter(',')->capture_default_str();
   cmd->add_option("--start", o.start_mm, "Position every run starts at rest from, mm")->capture_default_str();
-  cmd->add_option("--plant", o.plant, "paper (the model: the paper's or --model) or physics (pneumatic cylinder and valve)")
-      ->capture_default_str()->check(CLI::IsMember({"paper", "hammerstein", "physics"}));
+  cmd->add_option("--plant", o.plant,
+                  "paper (the model: the paper's or --model), physics (pneumatic cylinder and valve) or stick-slip "
+                  "(the [stick_slip] model epa identify wrote into --model)")
+      ->capture_default_str()->check(CLI::IsMember({"paper", "hammerstein", "physics", "stick-slip"}));
   cmd->add_option("--physics-config", o.physics_config, "Physics plant parameters (epa-pneumatic/1 TOML); default: built in")
       ->check(CLI::ExistingFile);
   cmd->add_option("--gain-factor", o.gain_factor, "Robustness: the plant's gain (B) is this times the model's")
@@ -71,9 +73,13 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
     kinds.push_back(*kind);
   }
 
-  const bool physics = o.plant == "physics";
+  const bool physics = o.plant == "physics", stick_slip = o.plant == "stick-slip";
   if (physics && (o.gain_factor != 1.0 || o.break_point_error_v != 0.0))
     return err << "epa simulate: --gain-factor and --break-point-error perturb the model plant; the physics plant has its own (--physics-config)\n", 1;
+  if (stick_slip && (o.gain_factor != 1.0 || o.break_point_error_v != 0.0))
+    return err << "epa simulate: --gain-factor and --break-point-error perturb the Hammerstein model plant, not the stick-slip one\n", 1;
+  if (stick_slip && !model_file->stick_slip)
+    return err << "epa simulate: --plant stick-slip needs a model file with a [stick_slip] table (--model; epa identify writes one)\n", 1;
   if (!physics && !o.physics_config.empty()) return err << "epa simulate: --physics-config applies to --plant physics only\n", 1;
   plant::PneumaticParams physics_params;
   if (!o.physics_config.empty()) {
@@ -88,6 +94,10 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
     if (physics)
       return plant::make_pneumatic_simulator(physics_params, {.initial_position_mm = o.start_mm, .noise_std_mm = o.noise_mm,
                                                                .seed = o.seed, .Ts = model.Ts});
+    if (stick_slip)
+      return plant::make_stick_slip_simulator(*model_file->stick_slip, model.Ts, model.mm_per_volt,
+                                              {.initial_position_mm = o.start_mm, .noise_std_mm = o.noise_mm,
+                                               .seed = o.seed, .stroke_mm = core::kStrokeMm});
     return plant::make_hammerstein_simulator(plant_model, {.initial_position_mm = o.start_mm, .noise_std_mm = o.noise_mm,
                                                            .seed = o.seed, .stroke_mm = core::kStrokeMm});
   };
@@ -119,7 +129,7 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
   out << summary;
   std::snprintf(summary, sizeof summary, "Plant: %s, from rest at %g mm; gain x%g, dead band %+g V each side, delay %zu samples, valve lag %g s\n\n",
                 physics ? ("physics (" + (o.physics_config.empty() ? std::string("built-in parameters") : o.physics_config) + ")").c_str()
-                        : "the model", o.start_mm, o.gain_factor, o.break_point_error_v, o.delay_samples, o.valve_lag_s);
+                        : stick_slip ? "the model's stick-slip table" : "the model", o.start_mm, o.gain_factor, o.break_point_error_v, o.delay_samples, o.valve_lag_s);
   out << summary;
   print_table1_comparison(out, cases);
 
@@ -138,7 +148,7 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
 
   if (!o.json_path.empty()) {
     nlohmann::json j = {{"schema", "epa-sim/1"}, {"Ts", model.Ts}, {"duration_s", o.duration_s},
-                        {"plant", physics ? "physics" : "model"}, {"start_mm", o.start_mm}, {"noise_mm", o.noise_mm},
+                        {"plant", physics ? "physics" : stick_slip ? "stick-slip" : "model"}, {"start_mm", o.start_mm}, {"noise_mm", o.noise_mm},
                         {"gain_factor", o.gain_factor}, {"break_point_error_v", o.break_point_error_v},
                         {"delay_samples", o.delay_samples}, {"valve_lag_s", o.valve_lag_s}, {"results", nlohmann::json::array()}};
     for (const auto& c : cases) {

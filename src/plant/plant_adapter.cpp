@@ -25,4 +25,11 @@ core::Result<std::unique_ptr<PlantSimulator>> make_pneumatic_simulator(const Pne
   return std::unique_ptr<PlantSimulator>(std::make_unique<PlantAdapter<PneumaticPlant>>(std::move(*p), options.Ts, "physics"));
 }
 
+core::Result<std::unique_ptr<PlantSimulator>> make_stick_slip_simulator(const StickSlipParams& params, double Ts,
+                                                                        double mm_per_volt, const PlantOptions& options) {
+  auto p = StickSlipPlant::make(params, Ts, mm_per_volt, options);
+  if (!p) return p.error();
+  return std::unique_ptr<PlantSimulator>(std::make_unique<PlantAdapter<StickSlipPlant>>(std::move(*p), Ts, "stick-slip"));
+}
+
 }  // namespace epa::plant

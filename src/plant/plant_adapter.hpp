@@ -1,5 +1,5 @@
 #pragma once
-// The two plants behind the PlantSimulator interface, and factories that make them so.
+// The plants behind the PlantSimulator interface, and factories that make them so.
 #include <memory>
 #include <string_view>
 #include <utility>
@@ -10,6 +10,7 @@
 #include "plant/hammerstein_plant.hpp"
 #include "plant/plant_simulator.hpp"
 #include "plant/pneumatic_plant.hpp"
+#include "plant/stick_slip_plant.hpp"
 
 namespace epa::plant {
 
@@ -44,5 +45,9 @@ core::Result<std::unique_ptr<PlantSimulator>> make_augmented_simulator(const cor
 // The physics plant; Ts is options.Ts. Errors as PneumaticPlant::make.
 core::Result<std::unique_ptr<PlantSimulator>> make_pneumatic_simulator(const PneumaticParams& params,
                                                                        const PneumaticOptions& options);
+
+// The stick-slip model of an axis (epa identify's [stick_slip]) with a sensor. Errors as StickSlipPlant::make.
+core::Result<std::unique_ptr<PlantSimulator>> make_stick_slip_simulator(const StickSlipParams& params, double Ts,
+                                                                        double mm_per_volt, const PlantOptions& options);
 
 }  // namespace epa::plant

@@ -42,6 +42,12 @@ class StickSlipModel {
   // Applies u(k) (V; non-finite is 0 V) and returns the position at k + 1, mm. Allocates nothing.
   double step(double valve_v) noexcept;
 
+  // The piston held at position_mm at rest (an end stop); the spring keeps its wind-up.
+  void stop_at(double position_mm) noexcept {
+    y_mm_ = position_mm;
+    v_mm_s_ = 0.0;
+    stuck_ = true;
+  }
   double position_mm() const noexcept { return y_mm_; }
   double speed_mm_s() const noexcept { return v_mm_s_; }
   double windup_mm() const noexcept { return z_mm_; }

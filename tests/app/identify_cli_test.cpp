@@ -127,6 +127,23 @@ TEST_F(IdentifyCli, IdentifiesThePhysicsPlant) {
   auto free_model = epa::core::read_model_file(path("free.toml"));
   ASSERT_TRUE(free_model.has_value()) << free_model.error().message;
   EXPECT_LT(free_model->model.dead_zone.b_r, dz.b_r);
+  // The stick-slip model beside it, in the file, and a loop simulated on it.
+  EXPECT_NE(o.output.find("Stick-slip model"), std::string::npos) << o.output;
+  ASSERT_TRUE(model->stick_slip.has_value());
+  EXPECT_GT(model->stick_slip->static_mm, 0.0);
+  const auto sim = run_epa("simulate --model " + path("model.toml") + " --plant stick-slip --controller pp-ffidz --start 250 --steps 50 --json " +
+                           path("ss.json"));
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  EXPECT_NE(sim.output.find("stick-slip"), std::string::npos) << sim.output;
+  std::ifstream json_in(path("ss.json"));
+  const auto j = nlohmann::json::parse(json_in);
+  EXPECT_EQ(j["plant"], "stick-slip");
+  ASSERT_EQ(j["results"].size(), 1u);
+  EXPECT_LT(std::abs(j["results"][0]["ess_mm"].get<double>()), 25.0);  // it moved most of the way
+  // Without the table there is nothing to simulate on, and the message says where it comes from.
+  const auto none = run_epa("simulate --plant stick-slip --controller pp-ffidz --steps 50");
+  EXPECT_NE(none.exit_code, 0);
+  EXPECT_NE(none.output.find("[stick_slip] table"), std::string::npos) << none.output;
   // The one-step criterion alone (before issue 19) cannot see the right side of this plant in runs
   // that keep near the middle, as the issue's were.
   const auto centring = run_epa("excite --plant physics --centring --out " + path("c1.csv") + " --duration 60 --seed 1");

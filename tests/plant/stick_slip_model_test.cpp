@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "plant/stick_slip_model.hpp"
+#include "plant/stick_slip_plant.hpp"
 
 namespace epa::plant {
 namespace {
@@ -148,6 +149,29 @@ TEST(StickSlipModel, ASlowRampStartsThePistonPastTheBreakPointByWhatBreakawayNee
   const double with_friction = ramp_start_v(p, kTs, 0.1, 1.0);
   EXPECT_GT(with_friction - p.break_right_v, 0.07);
   EXPECT_LT(with_friction - p.break_right_v, 0.11);
+}
+
+TEST(StickSlipPlant, TheEndStopsHoldThePistonAndTheSensorReadsItWithSeededNoise) {
+  StickSlipParams p = frictionless();
+  auto plant = StickSlipPlant::make(p, kTs, 50.0, {.initial_position_mm = 480.0, .noise_std_mm = 0.0, .seed = 1, .stroke_mm = 500.0});
+  ASSERT_TRUE(plant.has_value()) << plant.error().message;
+  for (int k = 0; k < 400; ++k) plant->step(3.0);  // full speed into the far stop
+  EXPECT_EQ(plant->position_mm(), 500.0);
+  EXPECT_DOUBLE_EQ(plant->measured_v(), 10.0);
+  for (int k = 0; k < 400; ++k) plant->step(-3.0);  // and away from it again
+  EXPECT_LT(plant->position_mm(), 450.0);
+
+  auto a = StickSlipPlant::make(p, kTs, 50.0, {.initial_position_mm = 250.0, .noise_std_mm = 0.1, .seed = 7, .stroke_mm = 500.0});
+  auto b = StickSlipPlant::make(p, kTs, 50.0, {.initial_position_mm = 250.0, .noise_std_mm = 0.1, .seed = 7, .stroke_mm = 500.0});
+  double spread = 0.0;
+  for (int k = 0; k < 100; ++k) {
+    a->step(0.0), b->step(0.0);
+    EXPECT_EQ(a->measured_v(), b->measured_v());
+    spread = std::max(spread, std::abs(a->measured_v() * 50.0 - 250.0));
+  }
+  EXPECT_GT(spread, 0.05);  // the noise is there
+  EXPECT_LT(spread, 0.6);   // and about 0.1 mm
+  EXPECT_FALSE(StickSlipPlant::make(p, kTs, 50.0, {.initial_position_mm = 600.0}).has_value());
 }
 
 }  // namespace
