@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Issue 19's identification figures for the README: `epa identify` on open-loop runs of the physics
-# plant (defaults, supply 4.8 bar, spool overlap 0.2 V wider each way), every ordered pair of seeds
+# plant (defaults, supply 4.8 bar, spool overlap 0.2 V wider each way, friction 1.5x and 0.5x of
+# the defaults' static / sliding 40 / 25 N), every ordered pair of seeds
 # (estimation run i, validation run j), the Hammerstein model's and the stick-slip model's
 # validation free-run fits and the stick-slip model's ramp starts. The plant's own ramp starts
 # (the truth for the break points) come from ident_physics_test, which measures them on the plant.
@@ -22,16 +23,20 @@ defaults=config/pneumatic-plant.toml
 cp "$defaults" "$work/defaults.toml"
 sed 's/^supply_pressure_bar *=.*/supply_pressure_bar = 4.8/' "$defaults" >"$work/supply-4.8bar.toml"
 sed -e 's/^overlap_pos_v *=.*/overlap_pos_v = 1.4/' -e 's/^overlap_neg_v *=.*/overlap_neg_v = -1.9/' "$defaults" >"$work/overlap+0.2V.toml"
-for plant in defaults supply-4.8bar overlap+0.2V; do
+sed -e 's/^static_friction_n *=.*/static_friction_n = 60.0/' -e 's/^coulomb_friction_n *=.*/coulomb_friction_n = 37.5/' "$defaults" >"$work/friction-x1.5.toml"
+sed -e 's/^static_friction_n *=.*/static_friction_n = 20.0/' -e 's/^coulomb_friction_n *=.*/coulomb_friction_n = 12.5/' "$defaults" >"$work/friction-x0.5.toml"
+plants=(defaults supply-4.8bar overlap+0.2V friction-x1.5 friction-x0.5)
+for plant in "${plants[@]}"; do
   grep -q . "$work/$plant.toml" || { echo "identify_physics: no $plant parameters" >&2; exit 1; }
 done
 cmp -s "$work/defaults.toml" "$work/supply-4.8bar.toml" && { echo "identify_physics: supply_pressure_bar not found in $defaults" >&2; exit 1; }
 cmp -s "$work/defaults.toml" "$work/overlap+0.2V.toml" && { echo "identify_physics: overlap keys not found in $defaults" >&2; exit 1; }
+cmp -s "$work/defaults.toml" "$work/friction-x1.5.toml" && { echo "identify_physics: friction keys not found in $defaults" >&2; exit 1; }
 
 echo "| plant | estimation / validation seed | Hammerstein validation fit | stick-slip validation fit | stick-slip ramp starts (0.1 V/s) | seconds |"
 echo "| --- | --- | --- | --- | --- | --- |"
 all=()
-for plant in defaults supply-4.8bar overlap+0.2V; do
+for plant in "${plants[@]}"; do
   for s in $(seq 1 "$seeds"); do
     "$epa" excite --plant physics --physics-config "$work/$plant.toml" --duration "$duration" --seed "$s" \
       --out "$work/$plant-$s.csv" >/dev/null
