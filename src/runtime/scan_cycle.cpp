@@ -65,7 +65,10 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
   if (refusal == CommandRefusal::kNone) {
     switch (c.kind) {
       case CommandKind::kSetpoint:
-        if (c.value != setpoint_mm_) {
+        // A setpoint written in RUN moves when it changes (an HMI may write the same one every
+        // poll), and also when RUN was just entered and has not yet held: then the client chose
+        // it with the enable, even if it is the one it wrote before.
+        if (c.value != setpoint_mm_ || (mode_ == Mode::kRun && hold_on_enable_)) {
           setpoint_mm_ = c.value;
           if (mode_ == Mode::kRun) start_move(c.value, 0.0, 0.0);
         }

@@ -80,6 +80,26 @@ TEST(Positioning, EnableThenASetpointInTheSameCycleMoves) {
   EXPECT_NEAR(axis.snap().position_mm, 200.0, 3.0);
 }
 
+TEST(Positioning, EnableWithTheSetpointItAlreadyHadMovesThere) {
+  // A client writes setpoint and RUN in one request, the setpoint the one it wrote before (a
+  // move that a fault cut short, then a reset): the write is the client's choice now, not a
+  // retained value, so RUN drives there instead of holding (found by the fault-injection test:
+  // after a reset the axis held 6 mm short of the setpoint it was asked for again).
+  Axis axis(100.0);
+  axis.push(setpoint_command(200.0));  // in STOP: kept, nothing moves
+  axis.cycles(10);
+  ASSERT_NEAR(axis.snap().position_mm, 100.0, 0.5);
+  axis.push(mode_command(Mode::kRun));
+  axis.push(setpoint_command(200.0));
+  axis.cycles(3 * kCyclesPerSecond);
+  EXPECT_NEAR(axis.snap().position_mm, 200.0, 3.0);
+  // Written again in RUN (an HMI that writes every poll): no new move, which would end this one.
+  const auto finished = axis.snap().moves;
+  axis.push(setpoint_command(200.0));
+  axis.cycles(10);
+  EXPECT_EQ(axis.snap().moves, finished);
+}
+
 TEST(Positioning, AStartMovesSetsMovingThenInPositionAndTheAcknowledgeMirrorsStart) {
   for (ControllerKind kind : control::kAllControllerKinds) {
     if (kind == ControllerKind::kPp) continue;  // plain PP stalls in the dead band (the paper's point)
