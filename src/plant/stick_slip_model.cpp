@@ -1,6 +1,7 @@
 #include "plant/stick_slip_model.hpp"
 
 #include <cmath>
+#include <string>
 
 namespace epa::plant {
 
@@ -8,6 +9,13 @@ core::Result<StickSlipModel> StickSlipModel::make(const StickSlipParams& params,
   if (auto s = params.validate(); !s) return s.error();
   if (!(Ts > 0.0) || !std::isfinite(Ts)) return core::invalid_argument("stick-slip model: Ts must be > 0");
   if (substeps < 1 || substeps > 64) return core::invalid_argument("stick-slip model: substeps must be within 1..64");
+  // The explicit sub-steps stay stable (and accurate enough) only while one sub-step is short
+  // against the spring's period and the damping's time constant.
+  const double h = Ts / substeps;
+  if (params.spring_rad_s * h > kMaxStiffnessPerStep || 2.0 * params.damping_ratio * params.spring_rad_s * h > kMaxStiffnessPerStep)
+    return core::invalid_argument("stick-slip model: spring_rad_s " + std::to_string(params.spring_rad_s) + " with damping_ratio " +
+                                  std::to_string(params.damping_ratio) + " is too stiff for sub-steps of " +
+                                  std::to_string(h * 1e3) + " ms (omega h and 2 zeta omega h must stay <= 1)");
   return StickSlipModel(params, Ts, substeps);
 }
 

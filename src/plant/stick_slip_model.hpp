@@ -34,7 +34,9 @@ using core::StickSlipParams;
 
 class StickSlipModel {
  public:
-  // Errors: invalid params (validate), Ts <= 0, substeps outside 1..64.
+  static constexpr double kMaxStiffnessPerStep = 1.0;  // omega h and 2 zeta omega h, h = Ts / substeps
+  // Errors: invalid params (validate), Ts <= 0, substeps outside 1..64, a spring or damping too
+  // stiff for the sub-step (kMaxStiffnessPerStep).
   static core::Result<StickSlipModel> make(const StickSlipParams& params, double Ts, int substeps = 2);
 
   // At rest at position_mm with the spring unwound, the spool centred and no command in the delay line.

@@ -39,6 +39,10 @@ TEST(StickSlipModel, InvalidParametersAreRefusedByName) {
   p = {};
   p.speed_left_mm_s_per_v = NAN;
   EXPECT_NE(StickSlipModel::make(p, kTs).error().message.find("speed_left_mm_s_per_v"), std::string::npos);
+  p = {};
+  p.spring_rad_s = 1000.0;  // 2.5 ms sub-steps: omega h = 2.5, the explicit steps would blow up
+  EXPECT_NE(StickSlipModel::make(p, kTs).error().message.find("too stiff"), std::string::npos);
+  EXPECT_TRUE(StickSlipModel::make(p, kTs, 8).has_value());  // 0.625 ms sub-steps hold it
   EXPECT_FALSE(StickSlipModel::make({}, 0.0).has_value());
   EXPECT_FALSE(StickSlipModel::make({}, kTs, 0).has_value());
 }
