@@ -253,7 +253,9 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   }
   if (!o.plot_path.empty()) {
     const auto& shown = val->empty() ? *est : *val;
-    if (auto s = write_output(o.plot_path, render_identification_plot(shown, fit, model, !val->empty()), out); !s)
+    if (auto s = write_output(o.plot_path, render_identification_plot(shown, fit, model, !val->empty(),
+                                                                 stick_slip ? std::optional<core::StickSlipParams>(stick_slip->fit.params)
+                                                                            : std::nullopt), out); !s)
       return fail(s.error().message);
     out << "picture written to " << o.plot_path << "\n";
   }

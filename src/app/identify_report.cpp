@@ -96,14 +96,18 @@ void print_identified_model(std::ostream& out, const ident::HammersteinFit& fit,
 }
 
 std::string render_identification_plot(const std::vector<IdentifiedRun>& runs, const ident::HammersteinFit& fit,
-                                       const core::HammersteinModel& model, bool validation) {
+                                       const core::HammersteinModel& model, bool validation,
+                                       const std::optional<core::StickSlipParams>& stick_slip) {
   std::vector<Panel> panels;
   const std::size_t first = fit.arx.model.orders.first_row();
   for (std::size_t r = 0; r < runs.size() && r < kMaxPlottedRuns; ++r) {
     const auto& run = runs[r];
     Series measured{"measured", "#000000", {}, {}, false}, simulated{"model (free run)", "#d62728", {}, {}, false};
+    Series sticking{"stick-slip model (free run)", "#2ca02c", {}, {}, false};
     std::vector<std::vector<double>> yhat;
     const auto ud = ident::through_dead_zone(run.segments, fit.dead_zone);
+    const auto stick_yhat = stick_slip ? ident::simulate_stick_slip(run.segments, *stick_slip, model.Ts, model.mm_per_volt)
+                                       : std::vector<std::vector<double>>{};
     for (std::size_t i = 0; i < ud.size(); ++i) {
       yhat.push_back(ident::simulate_free_run(fit.arx.model, ud[i], first));
       for (std::size_t k = 0; k < ud[i].size(); ++k) {
@@ -111,22 +115,28 @@ std::string render_identification_plot(const std::vector<IdentifiedRun>& runs, c
         measured.x.push_back(t), simulated.x.push_back(t);
         measured.y.push_back(ud[i].y[k] * model.mm_per_volt);
         simulated.y.push_back(yhat.back()[k] * model.mm_per_volt);
+        if (stick_slip) sticking.x.push_back(t), sticking.y.push_back(stick_yhat[i][k] * model.mm_per_volt);
       }
-      // A gap between segments (an end stop) breaks both lines.
+      // A gap between segments (an end stop) breaks the lines.
       measured.x.push_back(NAN), measured.y.push_back(NAN), simulated.x.push_back(NAN), simulated.y.push_back(NAN);
+      sticking.x.push_back(NAN), sticking.y.push_back(NAN);
     }
-    char title[300];
-    std::snprintf(title, sizeof title, "%s (%s): position, free-run fit %.1f %%", run.path.c_str(),
-                  validation ? "validation" : "estimation", ident::nrmse_fit_percent(ud, yhat, first));
-    Panel position{title, "time (s)", "position (mm)", {simulated, measured}, {}, {}, {}, {}, {}};
+    char title[400];
+    const int used = std::snprintf(title, sizeof title, "%s (%s): position, free-run fit %.1f %%", run.path.c_str(),
+                                   validation ? "validation" : "estimation", ident::nrmse_fit_percent(ud, yhat, first));
+    if (stick_slip && used > 0 && static_cast<std::size_t>(used) < sizeof title)
+      std::snprintf(title + used, sizeof title - static_cast<std::size_t>(used), ", stick-slip model %.1f %%",
+                    ident::nrmse_fit_percent(run.segments, stick_yhat, 0));
+    std::vector<Series> lines{simulated, measured};
+    if (stick_slip) lines.insert(lines.begin() + 1, sticking);
+    Panel position{title, "time (s)", "position (mm)", lines, {}, {}, {}, {}, {}};
     Panel valve{"valve command", "time (s)", "valve command (V)", {}, {}, {}, {}, {}, {}};
     Series u{"u", "#1f77b4", run.run.t_s, run.run.u_V, false};
     valve.series.push_back(std::move(u));
     valve.bands.push_back({model.dead_zone.b_l, model.dead_zone.b_r, "identified dead band"});
     // A few seconds from the middle of the run, where the two lines can be told apart.
     const double t_mid = run.run.t_s.empty() ? 0.0 : 0.5 * (run.run.t_s.front() + run.run.t_s.back());
-    Panel detail{run.path + ": detail", "time (s)", "position (mm)", {simulated, measured}, {}, t_mid, t_mid + kDetailWindowS,
-                 {}, {}};
+    Panel detail{run.path + ": detail", "time (s)", "position (mm)", lines, {}, t_mid, t_mid + kDetailWindowS, {}, {}};
     panels.push_back(std::move(position));
     panels.push_back(std::move(detail));
     panels.push_back(std::move(valve));

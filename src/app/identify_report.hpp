@@ -1,6 +1,7 @@
 #pragma once
 // What `epa identify` prints and draws: the identified model next to the paper's eq 9-10, its fits,
 // and measured vs model output of the runs (the paper's figure 5).
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -36,11 +37,12 @@ ModelFitSummary summarise_fit(const ident::HammersteinFit& fit, const std::vecto
 void print_identified_model(std::ostream& out, const ident::HammersteinFit& fit, const core::HammersteinModel& model,
                             const ModelFitSummary& summary, double m_l);
 
-// Per run (at most kMaxPlottedRuns): measured position vs the model's free-run simulation, and the
-// valve command with the identified dead band shaded.
+// Per run (at most kMaxPlottedRuns): measured position vs the model's free-run simulation (and the
+// stick-slip model's, when given), and the valve command with the identified dead band shaded.
 inline constexpr std::size_t kMaxPlottedRuns = 4;
 std::string render_identification_plot(const std::vector<IdentifiedRun>& runs, const ident::HammersteinFit& fit,
-                                       const core::HammersteinModel& model, bool validation);
+                                       const core::HammersteinModel& model, bool validation,
+                                       const std::optional<core::StickSlipParams>& stick_slip = std::nullopt);
 
 // The stick-slip model's section of `epa identify`: its parameters in physical units, where its
 // piston starts to move on a slow ramp, and its free-run fits beside the Hammerstein model's.

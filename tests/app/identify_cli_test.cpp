@@ -191,6 +191,7 @@ TEST_F(IdentifyCli, ThreeCommandsTakeRunFilesToAStepTable) {
   std::stringstream s;
   s << svg.rdbuf();
   EXPECT_NE(s.str().find("model (free run)"), std::string::npos);
+  EXPECT_NE(s.str().find("stick-slip model (free run)"), std::string::npos);
 
   std::map<std::string, nlohmann::json> table;  // "identified"/"paper" -> epa-sim/1 results
   for (const std::string which : {"identified", "paper"}) {
