@@ -207,6 +207,7 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   print_identified_model(out, fit, model, summary, o.m_l);
 
   std::optional<ident::StickSlipIdentification> stick_slip;
+  std::optional<core::StickSlipParams> stick_slip_params;  // what the model file and the plot take
   if (o.stick_slip) {
     out << "\nStick-slip model (plant/stick_slip_model.hpp: flow dead zone, air spring, sliding and breakaway "
            "friction, spool lag, dead time), fitted on the free-run simulation error (BOBYQA) from the model above:\n"
@@ -217,6 +218,7 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
     auto fitted = ident::identify_stick_slip(est_segments, val_segments, model, chosen.nk, fit_options);
     if (!fitted) return fail(fitted.error().message);
     stick_slip = *fitted;
+    stick_slip_params = fitted->fit.params;
     print_stick_slip(out, *stick_slip, summary);
   }
 
@@ -232,8 +234,6 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
     std::snprintf(source + used, sizeof source - static_cast<std::size_t>(used), "; stick-slip model: %s free-run fit %.2f %%",
                   scored, summary.validated ? stick_slip->validation_pct : stick_slip->estimation_pct);
   if (!o.out_path.empty()) {
-    const std::optional<core::StickSlipParams> stick_slip_params =
-        stick_slip ? std::optional<core::StickSlipParams>(stick_slip->fit.params) : std::nullopt;
     if (auto s = core::write_model_file(o.out_path, {model, source, stick_slip_params}); !s) return fail(s.error().message);
     out << "\nmodel written to " << o.out_path << "\n";
   }
@@ -253,9 +253,8 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   }
   if (!o.plot_path.empty()) {
     const auto& shown = val->empty() ? *est : *val;
-    if (auto s = write_output(o.plot_path, render_identification_plot(shown, fit, model, !val->empty(),
-                                                                 stick_slip ? std::optional<core::StickSlipParams>(stick_slip->fit.params)
-                                                                            : std::nullopt), out); !s)
+    if (auto s = write_output(o.plot_path, render_identification_plot(shown, fit, model, !val->empty(), stick_slip_params), out);
+        !s)
       return fail(s.error().message);
     out << "picture written to " << o.plot_path << "\n";
   }

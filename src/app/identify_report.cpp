@@ -146,6 +146,7 @@ std::string render_identification_plot(const std::vector<IdentifiedRun>& runs, c
 
 void print_stick_slip(std::ostream& out, const ident::StickSlipIdentification& r, const ModelFitSummary& hammerstein) {
   const auto& p = r.fit.params;
+  const bool validated = !std::isnan(r.validation_pct);
   char buf[400];
   std::snprintf(buf, sizeof buf,
                 "  flow dead zone: b_r = %.4f V, b_l = %.4f V; the piston starts to move at %+.3f / %+.3f V on a %g V/s ramp\n"
@@ -158,7 +159,7 @@ void print_stick_slip(std::ostream& out, const ident::StickSlipIdentification& r
                 "breakaway %.2f mm\n  spool lag %.1f ms, dead time %d sample(s)\n",
                 p.spring_rad_s, p.damping_ratio, p.coulomb_mm, p.static_mm, 1e3 * p.spool_lag_s, p.delay_samples);
   out << buf;
-  if (std::isnan(r.validation_pct))
+  if (!validated)
     std::snprintf(buf, sizeof buf, "  free-run fit: estimation %.2f %% (the Hammerstein model: %.2f %%)\n", r.estimation_pct,
                   hammerstein.estimation.simulation_pct);
   else
@@ -171,7 +172,6 @@ void print_stick_slip(std::ostream& out, const ident::StickSlipIdentification& r
   out << buf;
   // Which of the two to simulate the axis with: the one that follows the held-out runs (or, with
   // none, the estimation runs) better. The design takes the Hammerstein model either way.
-  const bool validated = !std::isnan(r.validation_pct);
   const double stick = validated ? r.validation_pct : r.estimation_pct;
   const double hamm = validated ? hammerstein.validation.simulation_pct : hammerstein.estimation.simulation_pct;
   out << (stick > hamm ? "  the stick-slip model follows the " : "  the Hammerstein model follows the ")

@@ -81,6 +81,18 @@ double start_position_mm(const Segment& s, double mm_per_volt) {
   return n ? sum / static_cast<double>(n) * mm_per_volt : 0.0;
 }
 
+// One segment's free run from rest at its first readings: at_sample(k, simulated position at k, mm)
+// for every sample, allocation-free (the fit runs it thousands of times).
+template <typename AtSample>
+void replay(plant::StickSlipModel& model, const Segment& s, double mm_per_volt, AtSample&& at_sample) {
+  model.reset(start_position_mm(s, mm_per_volt));
+  double y = model.position_mm();
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    at_sample(k, y);
+    y = model.step(s.u[k]);
+  }
+}
+
 // Mean squared simulation error (mm^2) over every sample of every segment.
 double simulation_loss(const std::vector<Segment>& segments, const plant::StickSlipParams& p,
                        const StickSlipFitOptions& o) {
@@ -89,13 +101,10 @@ double simulation_loss(const std::vector<Segment>& segments, const plant::StickS
   double sum = 0.0;
   std::size_t n = 0;
   for (const auto& s : segments) {
-    model->reset(start_position_mm(s, o.mm_per_volt));
-    double y = model->position_mm();
-    for (std::size_t k = 0; k < s.size(); ++k) {
-      const double e = s.y[k] * o.mm_per_volt - y;
+    replay(*model, s, o.mm_per_volt, [&](std::size_t k, double y_mm) {
+      const double e = s.y[k] * o.mm_per_volt - y_mm;
       sum += e * e;
-      y = model->step(s.u[k]);
-    }
+    });
     n += s.size();
     if (!(sum < kLossCeilingMm2 * static_cast<double>(n))) return kLossCeilingMm2;
   }
@@ -213,14 +222,7 @@ std::vector<std::vector<double>> simulate_stick_slip(const std::vector<Segment>&
   auto model = plant::StickSlipModel::make(params, Ts, substeps);
   for (const auto& s : segments) {
     std::vector<double> y(s.size(), NAN);
-    if (model) {
-      model->reset(start_position_mm(s, mm_per_volt));
-      double position = model->position_mm();
-      for (std::size_t k = 0; k < s.size(); ++k) {
-        y[k] = position / mm_per_volt;
-        position = model->step(s.u[k]);
-      }
-    }
+    if (model) replay(*model, s, mm_per_volt, [&](std::size_t k, double y_mm) { y[k] = y_mm / mm_per_volt; });
     out.push_back(std::move(y));
   }
   return out;

@@ -6,17 +6,22 @@
 
 namespace epa::plant {
 
+core::Status PlantOptions::validate() const {
+  if (!(noise_std_mm >= 0.0) || !std::isfinite(noise_std_mm))
+    return core::invalid_argument("plant: sensor noise must be >= 0 mm, got " + std::to_string(noise_std_mm));
+  if (!(stroke_mm > 0.0) || !std::isfinite(stroke_mm))
+    return core::invalid_argument("plant: stroke must be > 0 mm, got " + std::to_string(stroke_mm));
+  if (!(initial_position_mm >= 0.0 && initial_position_mm <= stroke_mm))
+    return core::invalid_argument("plant: initial position " + std::to_string(initial_position_mm) +
+                                  " mm lies outside the stroke [0, " + std::to_string(stroke_mm) + "] mm");
+  return core::ok();
+}
+
 core::Result<HammersteinPlant> HammersteinPlant::make(const core::HammersteinModel& model, const PlantOptions& o) {
   if (auto s = model.validate(); !s) return s.error();
   if (model.B[0] != 0.0)
     return core::invalid_argument("plant: B[0] must be 0: y(k) cannot depend on the command computed from y(k)");
-  if (!(o.noise_std_mm >= 0.0) || !std::isfinite(o.noise_std_mm))
-    return core::invalid_argument("plant: sensor noise must be >= 0 mm, got " + std::to_string(o.noise_std_mm));
-  if (!(o.stroke_mm > 0.0) || !std::isfinite(o.stroke_mm))
-    return core::invalid_argument("plant: stroke must be > 0 mm, got " + std::to_string(o.stroke_mm));
-  if (!(o.initial_position_mm >= 0.0 && o.initial_position_mm <= o.stroke_mm))
-    return core::invalid_argument("plant: initial position " + std::to_string(o.initial_position_mm) +
-                                  " mm lies outside the stroke [0, " + std::to_string(o.stroke_mm) + "] mm");
+  if (auto s = o.validate(); !s) return s.error();
   HammersteinPlant p;
   p.na_ = model.A.size() - 1;
   p.nb_ = model.B.size() - 1;

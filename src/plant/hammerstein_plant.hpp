@@ -16,6 +16,8 @@ struct PlantOptions {
   double noise_std_mm = 0.0;         // Gaussian sensor noise (measurement only, not the piston)
   std::uint64_t seed = 1;            // for the noise
   double stroke_mm = 500.0;          // end stops at 0 and stroke_mm
+
+  core::Status validate() const;  // noise >= 0, stroke > 0, the start within the stroke; names the value
 };
 
 // Positions the plant remembers: the model's order, and the mean position effects read

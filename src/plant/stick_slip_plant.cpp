@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <string>
 
 namespace epa::plant {
 
@@ -12,12 +11,7 @@ core::Result<StickSlipPlant> StickSlipPlant::make(const StickSlipParams& params,
   if (!model) return model.error();
   if (!(mm_per_volt > 0.0) || !std::isfinite(mm_per_volt))
     return core::invalid_argument("stick-slip plant: mm_per_volt must be > 0");
-  if (!(o.noise_std_mm >= 0.0) || !std::isfinite(o.noise_std_mm))
-    return core::invalid_argument("stick-slip plant: sensor noise must be >= 0 mm");
-  if (!(o.stroke_mm > 0.0) || !std::isfinite(o.stroke_mm)) return core::invalid_argument("stick-slip plant: stroke must be > 0 mm");
-  if (!(o.initial_position_mm >= 0.0 && o.initial_position_mm <= o.stroke_mm))
-    return core::invalid_argument("stick-slip plant: the start position lies outside the stroke [0, " +
-                                  std::to_string(o.stroke_mm) + "] mm");
+  if (auto s = o.validate(); !s) return s.error();
   return StickSlipPlant(std::move(*model), mm_per_volt, o);
 }
 
