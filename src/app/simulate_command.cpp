@@ -17,6 +17,8 @@
 #include "core/units.hpp"
 #include "plant/plant_adapter.hpp"
 #include "plant/pneumatic_params.hpp"
+#include "plant/stick_slip_model.hpp"
+#include "store/trajectory_settings.hpp"
 #include "sim/model_perturbation.hpp"
 
 namespace epa::app {
@@ -102,12 +104,22 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
                                                            .seed = o.seed, .stroke_mm = core::kStrokeMm});
   };
 
+  // pp-traj arrives while sliding when the model file says the axis sticks (its [stick_slip] table).
+  store::TrajectorySettings trajectory;
+  if (model_file->stick_slip) {
+    trajectory.coast_s = plant::sliding_arrival_coast_s(*model_file->stick_slip, model.Ts, trajectory.approach_speed_mm_s,
+                                                        trajectory.retry_band_mm);
+    if (!std::isfinite(trajectory.coast_s))
+      return err << "epa simulate: the model's [stick_slip] table does not slide at the approach speed ("
+                 << trajectory.approach_speed_mm_s << " mm/s): no coast time for pp-traj\n", 1;
+  }
   std::vector<SimulationCase> cases;
   for (auto kind : kinds) {
     control::ControllerConfig config{.kind = kind, .F = polynomials->F, .G = polynomials->G, .H = polynomials->H,
                                      .dead_zone = model.dead_zone, .lc_v = o.lc_mm / model.mm_per_volt,
                                      .valve_limit_v = core::paper::kValveLimitV, .safe_valve_v = 0.0,
-                                     .A = model.A, .B = model.B, .Ts = model.Ts, .trajectory = {}};
+                                     .A = model.A, .B = model.B, .Ts = model.Ts,
+                                     .trajectory = store::to_trajectory_config(trajectory, model.mm_per_volt)};
     auto params = control::ControllerParams::make(config);
     if (!params) return err << "epa simulate: " << params.error().message << "\n", 1;
     for (double step : o.steps_mm) {

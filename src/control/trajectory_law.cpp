@@ -72,6 +72,20 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   if (!(c.creep_margin_v >= 0.0) || !std::isfinite(c.creep_margin_v)) return field_error("creep_margin_v", c.creep_margin_v, ">= 0 V");
   if (!(c.idz_ramp >= 0.0) || !std::isfinite(c.idz_ramp)) return field_error("idz_ramp", c.idz_ramp, ">= 0");
   if (!(c.creep_blend_s >= 0.0) || !std::isfinite(c.creep_blend_s)) return field_error("creep_blend_s", c.creep_blend_s, ">= 0 s");
+  if (!(c.coast_s >= 0.0) || !std::isfinite(c.coast_s)) return field_error("coast_s", c.coast_s, ">= 0 s (0: off)");
+  if (c.coast_s > 0.0) {
+    if (!(c.approach_speed_v_s > 0.0) || !std::isfinite(c.approach_speed_v_s))
+      return field_error("approach_speed", c.approach_speed_v_s, "> 0");
+    if (!(c.approach_length_v > 0.0) || !std::isfinite(c.approach_length_v))
+      return field_error("approach_length", c.approach_length_v, "> 0");
+    if (!(c.approach_decel_v_s2 > 0.0) || !std::isfinite(c.approach_decel_v_s2))
+      return field_error("approach_decel", c.approach_decel_v_s2, "> 0");
+    if (!(c.retry_band_v > 0.0) || !std::isfinite(c.retry_band_v)) return field_error("retry_band", c.retry_band_v, "> 0");
+    if (!(c.max_retries >= 0.0 && c.max_retries <= 10.0 && c.max_retries == std::floor(c.max_retries)))
+      return field_error("max_retries", c.max_retries, "a whole number 0..10");
+    if (!(c.approach_settle_s > 0.0 && c.approach_settle_s <= 10.0))
+      return field_error("approach_settle_s", c.approach_settle_s, "in (0, 10] s");
+  }
   for (std::size_t i = 0; i < A.size(); ++i)
     if (!std::isfinite(A[i])) return core::invalid_argument("pp-traj: the model's A[" + std::to_string(i) + "] is not finite");
   for (std::size_t i = 0; i < B.size(); ++i)
@@ -106,6 +120,20 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   p.creep_margin_v = c.creep_margin_v;
   p.creep_margin_step_v = c.creep_margin_v / std::max(1.0, std::round(c.creep_blend_s / Ts));
   p.integrator_limit = std::max(dz.m_r * (valve_limit_v - dz.b_r), dz.m_l * (valve_limit_v + dz.b_l));
+  p.sliding_approach = c.coast_s > 0.0;
+  if (p.sliding_approach) {
+    p.approach.coast_s = c.coast_s;
+    p.approach.speed_v_s = c.approach_speed_v_s;
+    p.approach.length_v = c.approach_length_v;
+    p.approach.decel_v_s2 = c.approach_decel_v_s2;
+    p.approach.top_speed_pos_v_s = p.limits.speed_pos_v_s;
+    p.approach.top_speed_neg_v_s = p.limits.speed_neg_v_s;
+    p.approach.accel_v_s2 = p.limits.accel_v_s2;
+    p.approach.retry_band_v = c.retry_band_v;
+    p.approach.max_retries = static_cast<int>(c.max_retries);
+    p.approach.settle_samples = static_cast<std::size_t>(std::max(1.0, std::round(c.approach_settle_s / Ts)));
+    p.approach.Ts = Ts;
+  }
   return p;
 }
 
@@ -115,9 +143,42 @@ void trajectory_reset(const TrajectoryParams& p, TrajectoryState& s, double y_v,
   for (std::size_t i = 0; i < s.w.size(); ++i) s.w[i] = y_v - s.profile.speed_v_s * p.limits.Ts * static_cast<double>(i);
 }
 
+namespace {
+
+// pp-traj with arrival while sliding: the approach's reference through the same feed-forward and
+// feedback, the valve centred from the cut on.
+TrajectoryOutput approach_trajectory_step(const TrajectoryParams& p, TrajectoryState& s, double r_v, double y_v) noexcept {
+  const ApproachOutput a = approach_step(p.approach, s.approach, r_v, y_v);
+  TrajectoryOutput out;
+  if (a.hold) {
+    s.holding = true;
+    out.holding = true;
+    out.arrived = true;
+    return out;
+  }
+  if (a.leg_started) {  // from rest: no history of an earlier reference, nothing filtered
+    s.w.fill(a.w_v);
+    s.feedback_stage1_v = s.feedback_stage2_v = s.filtered_error_v = 0.0;
+  }
+  s.holding = false;
+  for (std::size_t i = kMaxLawOrder; i > 0; --i) s.w[i] = s.w[i - 1];
+  s.w[0] = a.w_v;
+  double y_d = 0.0, u_ff = 0.0;
+  for (std::size_t i = 0; i <= p.nB; ++i) y_d += p.B[i] * s.w[i];
+  for (std::size_t i = 0; i <= p.nA; ++i) u_ff += p.A[i] * s.w[i];
+  const double e = y_d - y_v;
+  s.feedback_stage1_v += p.feedback_filter_alpha * (e - s.feedback_stage1_v);
+  s.feedback_stage2_v += p.feedback_filter_alpha * (s.feedback_stage1_v - s.feedback_stage2_v);
+  out.u = u_ff + p.proportional_gain * s.feedback_stage2_v;
+  return out;
+}
+
+}  // namespace
+
 TrajectoryOutput trajectory_step(const TrajectoryParams& p, TrajectoryState& s, double r_v, double y_v,
                                  int saturated_sign_last) noexcept {
   if (!s.profile.started) trajectory_reset(p, s, y_v);
+  if (p.sliding_approach) return approach_trajectory_step(p, s, r_v, y_v);
   for (std::size_t i = kMaxLawOrder; i > 0; --i) s.w[i] = s.w[i - 1];
   s.w[0] = motion_profile_step(p.limits, s.profile, r_v);
   double y_d = 0.0, u_ff = 0.0;

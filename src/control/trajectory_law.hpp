@@ -23,10 +23,15 @@
 // Once arrived and within half of hold_band_v the valve is held at 0 V (inside the dead band: the
 // piston stays), so sensor noise cannot make it chatter; it corrects again when the filtered error
 // exceeds hold_band_v.
+//
+// With coast_s > 0 (an axis with stick-slip: the identified stick-slip model's coast, README) the
+// reference comes from sliding_approach.hpp instead of the motion profile, and the law arrives by
+// centring the valve while the piston still slides: no integrator, no creeping inverse.
 #include <array>
 
 #include "control/motion_profile.hpp"
 #include "control/rst_law.hpp"  // kMaxLawOrder
+#include "control/sliding_approach.hpp"
 #include "core/dead_zone.hpp"
 #include "core/polynomial.hpp"
 #include "core/result.hpp"
@@ -52,6 +57,14 @@ struct TrajectoryConfig {
   double idz_ramp = 0.0;              // u over which the inverse dead zone's break-point jump is spread while moving
   double creep_margin_v = 0.2;        // once arrived, the jump stops this short of each break point (creeping_idz_command)
   double creep_blend_s = 0.1;         // over which that margin grows from 0 after arrival, s (0: at once)
+  // Arrival while sliding (sliding_approach.hpp), for an axis with stick-slip.
+  double coast_s = 0.0;               // the piston's coast after the valve is centred, s; 0: off
+  double approach_speed_v_s = 2.4;    // of the final approach (120 mm/s at 50 mm/V: the cut lands within +-0.3 mm of the sample)
+  double approach_length_v = 1.0;     // the final approach's length, V (50 mm)
+  double approach_decel_v_s2 = 6.0;   // braking to the approach speed, V/s^2 (300 mm/s^2: over several air-spring periods)
+  double retry_band_v = 0.006;        // a stop further than this from the target is approached again, V (0.3 mm)
+  double max_retries = 3.0;           // approaches again at most this often (a whole number 0..10)
+  double approach_settle_s = 0.15;    // from the cut to judging the stop, s
 };
 
 // Validated parameters with everything precomputed for the loop.
@@ -67,6 +80,8 @@ struct TrajectoryParams {
   double creep_margin_v = 0.2;
   double creep_margin_step_v = 0.2;  // per sample after arrival, until creep_margin_v
   double integrator_limit = 0.0;  // |u_i| bound: what the valve limit can deliver
+  bool sliding_approach = false;  // coast_s > 0
+  ApproachLimits approach;
 };
 
 struct TrajectoryState {
@@ -77,6 +92,7 @@ struct TrajectoryState {
   double integral = 0.0;
   double creep_margin_v = 0.0;  // the creeping inverse's margin now: 0 while moving, growing after arrival
   bool holding = false;
+  ApproachState approach;
 };
 
 // The model's top speed in each direction at the valve limit, V/s, from A = (1 - q) A1 (the plant

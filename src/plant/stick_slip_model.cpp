@@ -79,4 +79,33 @@ double ramp_start_v(const StickSlipParams& params, double Ts, double ramp_v_per_
   return NAN;
 }
 
+double coast_time_s(const StickSlipParams& params, double Ts, double speed_mm_s) {
+  double sum_s = 0.0;
+  int directions = 0;
+  for (const double direction : {1.0, -1.0}) {
+    auto model = StickSlipModel::make(params, Ts);
+    if (!model || !(speed_mm_s > 0.0)) return NAN;
+    model->reset(0.0);
+    const double u = direction > 0.0 ? params.break_right_v + speed_mm_s / params.speed_right_mm_s_per_v
+                                     : params.break_left_v - speed_mm_s / params.speed_left_mm_s_per_v;
+    std::array<double, 4> y{};  // newest first
+    const int steady_samples = static_cast<int>(std::ceil(1.0 / Ts));
+    for (int k = 0; k < steady_samples; ++k) {
+      for (std::size_t i = y.size() - 1; i > 0; --i) y[i] = y[i - 1];
+      y[0] = model->step(u);
+    }
+    const double speed = direction * (3.0 * y[0] + y[1] - y[2] - 3.0 * y[3]) / (10.0 * Ts);
+    if (!(speed > 0.0)) continue;
+    for (int k = 0; k < steady_samples && !(model->stuck() && k > params.delay_samples); ++k) model->step(0.0);
+    sum_s += direction * (model->position_mm() - y[0]) / speed;
+    ++directions;
+  }
+  return directions > 0 ? sum_s / directions : NAN;
+}
+
+double sliding_arrival_coast_s(const StickSlipParams& params, double Ts, double approach_speed_mm_s, double retry_band_mm) {
+  if (!(breakaway_jump_mm(params) > retry_band_mm)) return 0.0;
+  return coast_time_s(params, Ts, approach_speed_mm_s);
+}
+
 }  // namespace epa::plant

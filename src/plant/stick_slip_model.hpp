@@ -77,4 +77,19 @@ class StickSlipModel {
 double ramp_start_v(const StickSlipParams& params, double Ts, double ramp_v_per_s, double direction,
                     double travel_mm = 0.5);
 
+// How long the model's piston, sliding steadily at speed_mm_s, goes on after the valve is centred:
+// coast distance / speed (s), the mean of both directions (pp-traj's coast_s, control/
+// sliding_approach.hpp). The speed is read as that law reads it, the least-squares slope of the last
+// 4 positions, after 1 s at the command that gives it. NaN when neither direction slides.
+double coast_time_s(const StickSlipParams& params, double Ts, double speed_mm_s);
+
+// 2 (static_mm - coulomb_mm): how far a breakaway throws a piston with the valve centred, mm.
+inline double breakaway_jump_mm(const StickSlipParams& p) { return 2.0 * (p.static_mm - p.coulomb_mm); }
+
+// pp-traj's coast_s for an axis this model describes: coast_time_s at approach_speed_mm_s when a
+// breakaway throws the piston further than retry_band_mm (a stop that far off cannot be corrected
+// from rest without overshooting the band, so the law must arrive while sliding), else 0 (off:
+// the integrator corrects). NaN when the model does not slide at that speed.
+double sliding_arrival_coast_s(const StickSlipParams& params, double Ts, double approach_speed_mm_s, double retry_band_mm);
+
 }  // namespace epa::plant

@@ -30,6 +30,14 @@ struct TrajectorySettings {
   double idz_ramp_v = kTrajectoryDefaults.idz_ramp;
   double creep_margin_v = kTrajectoryDefaults.creep_margin_v;
   double creep_blend_s = kTrajectoryDefaults.creep_blend_s;
+  // Arrival while sliding on an axis with stick-slip (control/sliding_approach.hpp); coast_s 0: off.
+  double coast_s = kTrajectoryDefaults.coast_s;
+  double approach_speed_mm_s = core::sensor_v_to_mm(kTrajectoryDefaults.approach_speed_v_s);
+  double approach_mm = core::sensor_v_to_mm(kTrajectoryDefaults.approach_length_v);
+  double approach_decel_mm_s2 = core::sensor_v_to_mm(kTrajectoryDefaults.approach_decel_v_s2);
+  double retry_band_mm = core::sensor_v_to_mm(kTrajectoryDefaults.retry_band_v);
+  double max_retries = kTrajectoryDefaults.max_retries;
+  double approach_settle_s = kTrajectoryDefaults.approach_settle_s;
 
   bool operator==(const TrajectorySettings&) const = default;
 };

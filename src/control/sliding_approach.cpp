@@ -1,0 +1,125 @@
+#include "control/sliding_approach.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace epa::control {
+
+namespace {
+
+double mean_reading(const ApproachState& s) noexcept {
+  const std::size_t n = std::max<std::size_t>(1, std::min(s.reading_count, s.readings.size()));
+  double sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i) sum += s.readings[i];
+  return sum / static_cast<double>(n);
+}
+
+// Least-squares slope of the last 4 readings (V/s); 0 until there are 4.
+double reading_slope(const ApproachState& s, double Ts) noexcept {
+  if (s.reading_count < 4) return 0.0;
+  const auto& y = s.readings;
+  return (3.0 * y[0] + y[1] - y[2] - 3.0 * y[3]) / (10.0 * Ts);
+}
+
+void start_leg(ApproachState& s, double target_v, double direction, bool final_leg, double from_v) noexcept {
+  s.phase = ApproachPhase::kLeg;
+  s.leg_target_v = target_v;
+  s.leg_direction = direction;
+  s.final_leg = final_leg;
+  s.path_v = from_v;
+  s.path_speed_v_s = 0.0;
+  s.samples_in_phase = 0;
+}
+
+// Plans a move to r from rest at y: straight in when it is at least one approach long, else back
+// off first so that the final approach is.
+void plan(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noexcept {
+  s.planned_r_v = r_v;
+  s.retries = 0;
+  s.coast_s = l.coast_s;
+  const double move = r_v - y_v;
+  if (std::abs(move) <= l.retry_band_v) {
+    s.phase = ApproachPhase::kHolding;
+    s.samples_in_phase = 0;
+    return;
+  }
+  s.final_direction = move > 0.0 ? 1.0 : -1.0;
+  if (std::abs(move) >= l.length_v)
+    start_leg(s, r_v, s.final_direction, true, y_v);
+  else
+    start_leg(s, r_v - s.final_direction * l.length_v, -s.final_direction, false, y_v);
+}
+
+}  // namespace
+
+void approach_reset(ApproachState& state) noexcept { state = {}; }
+
+ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noexcept {
+  for (std::size_t i = s.readings.size() - 1; i > 0; --i) s.readings[i] = s.readings[i - 1];
+  s.readings[0] = y_v;
+  s.reading_count = std::min(s.reading_count + 1, s.readings.size());
+
+  ApproachOutput out;
+  if (s.phase == ApproachPhase::kIdle || r_v != s.planned_r_v) {
+    plan(l, s, r_v, y_v);
+  } else if (s.phase == ApproachPhase::kCoasting && s.samples_in_phase >= l.settle_samples) {
+    const double y_mean = mean_reading(s);
+    const double error = s.planned_r_v - y_mean;
+    if (!s.final_leg) {
+      start_leg(s, s.planned_r_v, s.final_direction, true, y_mean);
+    } else if (std::abs(error) <= l.retry_band_v || s.retries >= l.max_retries) {
+      s.phase = ApproachPhase::kHolding;
+      s.samples_in_phase = 0;
+    } else {
+      // The coast this stop took, if it came from a steady slide: the retry cuts with it.
+      if (s.cut_speed_v_s >= 0.5 * l.speed_v_s) {
+        const double measured_s = s.final_direction * (y_mean - s.cut_position_v) / s.cut_speed_v_s;
+        s.coast_s = std::clamp(measured_s, 0.25 * l.coast_s, 4.0 * l.coast_s);
+      }
+      ++s.retries;
+      start_leg(s, s.planned_r_v - s.final_direction * l.length_v, -s.final_direction, false, y_mean);
+    }
+  } else if (s.phase == ApproachPhase::kHolding && s.reading_count >= s.readings.size() &&
+             std::abs(s.planned_r_v - mean_reading(s)) > 4.0 * l.retry_band_v) {
+    plan(l, s, s.planned_r_v, mean_reading(s));  // pushed away: approach again
+  }
+  ++s.samples_in_phase;
+
+  if (s.phase != ApproachPhase::kLeg) {
+    out.w_v = y_v;
+    out.hold = true;
+    return out;
+  }
+  out.leg_started = s.samples_in_phase == 1;
+
+  // The cut: the piston's predicted stop has reached the leg's target.
+  const double dir = s.leg_direction;
+  const double speed_towards = std::max(0.0, dir * reading_slope(s, l.Ts));
+  if (s.samples_in_phase > 1 && dir * (s.leg_target_v - y_v) - speed_towards * s.coast_s <= 0.0) {
+    s.cut_position_v = y_v;
+    s.cut_speed_v_s = s.final_leg ? speed_towards : 0.0;
+    s.phase = ApproachPhase::kCoasting;
+    s.samples_in_phase = 0;
+    out.w_v = y_v;
+    out.hold = true;
+    return out;
+  }
+
+  // The path: cruise, brake gently to the approach speed over the last length_v, then go on at it
+  // (at most one approach length past the target, should the piston lag that far).
+  // Braking reads the nearer of the path and the piston: a piston that runs ahead of the path (a
+  // plant faster than its model) still arrives at the approach speed.
+  const double left_v = std::min(dir * (s.leg_target_v - s.path_v), dir * (s.leg_target_v - y_v));
+  const double top = dir > 0.0 ? l.top_speed_pos_v_s : l.top_speed_neg_v_s;
+  const double scheduled =
+      left_v < -l.length_v ? 0.0
+                           : std::min(std::max(top, l.speed_v_s),
+                                      l.speed_v_s + std::sqrt(2.0 * l.decel_v_s2 * std::max(0.0, left_v - l.length_v)));
+  s.path_speed_v_s = scheduled > s.path_speed_v_s ? std::min(scheduled, s.path_speed_v_s + l.accel_v_s2 * l.Ts)
+                                                  : std::max(scheduled, s.path_speed_v_s - l.decel_v_s2 * l.Ts);
+  s.path_v += dir * s.path_speed_v_s * l.Ts;
+  out.w_v = s.path_v;
+  return out;
+}
+
+}  // namespace epa::control

@@ -1,0 +1,75 @@
+#pragma once
+// pp-traj's arrival on an axis with stick-slip (README "pp-traj", notes/stick-slip.md): arrive while
+// sliding, never correct from rest by a small amount.
+//
+// Why. A stopped pneumatic piston cannot be moved by less than one breakaway jump (the chambers must
+// build the static friction's force, which then throws the piston 5-10 mm); an integrator that
+// corrects a stop 1-3 mm off therefore hunts. What can be placed precisely is the end of a steady
+// slide: with the valve centred, the piston coasts for a time the air spring and the spool set
+// (coast_s, from the identified stick-slip model: plant/stick_slip_model.hpp, coast_time_s). So:
+//
+//   leg      a path towards the leg's target at the law's top speed, braking gently (decel_v_s2,
+//            slow against the air spring's period so that it does not ring) to a steady approach
+//            speed over the last length_v, and on at that speed past the target if need be
+//   cut      the valve is centred at the first sample where the predicted stop, y + v coast_s
+//            (v: least-squares slope of the last 4 readings), reaches the target
+//   judge    settle_samples later, the mean of the last 4 readings against the target: within
+//            retry_band_v, hold; else back off length_v and approach again (at most max_retries),
+//            cutting with the coast this stop measured (distance / speed at the cut): the coast
+//            depends on where along the stroke the piston is (the air spring stiffens near an end),
+//            and the retry ends where the last approach did
+//   short    a move shorter than length_v backs off first, so that every final approach is a
+//            steady slide of length_v, not the breakaway jump of a start from rest
+//   hold     the valve stays centred until the setpoint changes or the piston is pushed more than
+//            4 retry bands away
+//
+// The approach direction of a retry is the move's: unidirectional positioning, as machine tools do
+// against backlash. Fixed storage, no allocation; positions in sensor volts.
+#include <array>
+#include <cstddef>
+
+namespace epa::control {
+
+struct ApproachLimits {
+  double coast_s = 0.0;          // > 0
+  double speed_v_s = 2.4;        // approach speed, V/s
+  double length_v = 1.0;         // length of the final, steady approach, V
+  double decel_v_s2 = 6.0;       // braking to the approach speed, V/s^2
+  double top_speed_pos_v_s = 10.0, top_speed_neg_v_s = 10.0;  // the leg's cruise speed each way
+  double accel_v_s2 = 100.0;     // speeding up
+  double retry_band_v = 0.006;   // judged within this, V
+  int max_retries = 3;
+  std::size_t settle_samples = 30;  // from the cut to the judgement
+  double Ts = 0.005;
+};
+
+enum class ApproachPhase { kIdle, kLeg, kCoasting, kHolding };
+
+struct ApproachState {
+  ApproachPhase phase = ApproachPhase::kIdle;
+  double planned_r_v = 0.0;    // the setpoint the legs were planned for
+  double leg_target_v = 0.0;
+  double leg_direction = 1.0;  // +1 / -1
+  double final_direction = 1.0;  // the move's approach direction
+  bool final_leg = false;
+  int retries = 0;
+  double path_v = 0.0, path_speed_v_s = 0.0;  // the leg's reference and its speed (>= 0, along leg_direction)
+  double coast_s = 0.0;           // the coast the next cut assumes: the limits' at a new setpoint, then measured
+  double cut_position_v = 0.0, cut_speed_v_s = 0.0;  // at the last cut of a final leg
+  std::size_t samples_in_phase = 0;
+  std::array<double, 4> readings{};  // newest first
+  std::size_t reading_count = 0;
+};
+
+struct ApproachOutput {
+  double w_v = 0.0;          // the reference w(k)
+  bool hold = false;         // valve centred
+  bool leg_started = false;  // a leg starts here: the caller restarts its reference history and filters at w_v
+};
+
+// One sample. The first call (or any after approach_reset) plans from y_v.
+ApproachOutput approach_step(const ApproachLimits& limits, ApproachState& state, double r_v, double y_v) noexcept;
+
+void approach_reset(ApproachState& state) noexcept;
+
+}  // namespace epa::control
