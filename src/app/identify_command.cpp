@@ -234,7 +234,8 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
     std::snprintf(source + used, sizeof source - static_cast<std::size_t>(used), "; stick-slip model: %s free-run fit %.2f %%",
                   scored, summary.validated ? stick_slip->validation_pct : stick_slip->estimation_pct);
   if (!o.out_path.empty()) {
-    if (auto s = core::write_model_file(o.out_path, {model, source, stick_slip_params}); !s) return fail(s.error().message);
+    const auto axis = stick_slip ? axis_model_verdict(*stick_slip, summary) : core::AxisModel::kHammerstein;
+    if (auto s = core::write_model_file(o.out_path, {model, source, stick_slip_params, axis}); !s) return fail(s.error().message);
     out << "\nmodel written to " << o.out_path << "\n";
   }
   if (!o.save_name.empty()) {

@@ -170,14 +170,19 @@ void print_stick_slip(std::ostream& out, const ident::StickSlipIdentification& r
   std::snprintf(buf, sizeof buf, "  simulation error %.3f mm RMS on the estimation runs, %zu simulations\n",
                 std::sqrt(r.fit.loss_mm2), r.fit.evaluations);
   out << buf;
-  // Which of the two to simulate the axis with: the one that follows the held-out runs (or, with
-  // none, the estimation runs) better. The design takes the Hammerstein model either way.
+  const bool stick = axis_model_verdict(r, hammerstein) == core::AxisModel::kStickSlip;
+  out << (stick ? "  the stick-slip model follows the " : "  the Hammerstein model follows the ")
+      << (validated ? "validation" : "estimation")
+      << (stick ? " runs better: it describes the axis (the model file says so: pp-traj arrives while sliding; "
+                  "epa design still takes the Hammerstein model)\n"
+                : " runs better: this plant shows little stick-slip\n");
+}
+
+core::AxisModel axis_model_verdict(const ident::StickSlipIdentification& r, const ModelFitSummary& hammerstein) {
+  const bool validated = !std::isnan(r.validation_pct);
   const double stick = validated ? r.validation_pct : r.estimation_pct;
   const double hamm = validated ? hammerstein.validation.simulation_pct : hammerstein.estimation.simulation_pct;
-  out << (stick > hamm ? "  the stick-slip model follows the " : "  the Hammerstein model follows the ")
-      << (validated ? "validation" : "estimation")
-      << (stick > hamm ? " runs better: simulate the axis with it (epa design still takes the Hammerstein model)\n"
-                       : " runs better: this plant shows little stick-slip\n");
+  return stick > hamm ? core::AxisModel::kStickSlip : core::AxisModel::kHammerstein;
 }
 
 nlohmann::json stick_slip_json(const ident::StickSlipIdentification& r, bool validated) {

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/hammerstein_model.hpp"
+#include "core/model_file.hpp"
 #include "core/run.hpp"
 #include "ident/arx_metrics.hpp"
 #include "ident/hammerstein_fit.hpp"
@@ -47,6 +48,11 @@ std::string render_identification_plot(const std::vector<IdentifiedRun>& runs, c
 // The stick-slip model's section of `epa identify`: its parameters in physical units, where its
 // piston starts to move on a slow ramp, and its free-run fits beside the Hammerstein model's.
 void print_stick_slip(std::ostream& out, const ident::StickSlipIdentification& r, const ModelFitSummary& hammerstein);
+
+// Which model describes the axis: the one whose free run follows the held-out runs (or, with none,
+// the estimation runs) better. The model file records it (axis_model); pp-traj arrives while sliding
+// on a stick-slip axis. The design takes the Hammerstein model either way.
+core::AxisModel axis_model_verdict(const ident::StickSlipIdentification& r, const ModelFitSummary& hammerstein);
 // The same for the tuning store's fit figures (`--save`).
 nlohmann::json stick_slip_json(const ident::StickSlipIdentification& r, bool validated);
 

@@ -130,6 +130,17 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
     if (!params) return params.error();
     f.stick_slip = *params;
   }
+  if (root.contains("axis_model")) {
+    const auto name = root["axis_model"].value<std::string>();
+    if (name == "hammerstein") {
+      f.axis_model = AxisModel::kHammerstein;
+    } else if (name == "stick-slip") {
+      if (!f.stick_slip) return parse_error(src + ": axis_model = \"stick-slip\" needs a [stick_slip] table");
+      f.axis_model = AxisModel::kStickSlip;
+    } else {
+      return parse_error(src + ": axis_model must be \"hammerstein\" or \"stick-slip\"");
+    }
+  }
   return f;
 }
 
@@ -160,7 +171,8 @@ std::string format_model_toml(const ModelFile& f) {
   std::ostringstream source;
   source << toml::value<std::string>(f.source);  // TOML string escaping by the library
   return "schema = \"" + std::string(kSchema) + "\"\nTs = " + num(m.Ts) + "\nmm_per_volt = " + num(m.mm_per_volt) +
-         "\nsource = " + source.str() + "\n\n[arx]\nA = " + list(m.A) + "\nB = " + list(m.B) +
+         "\nsource = " + source.str() + "\n" +
+         (f.axis_model == AxisModel::kStickSlip ? "axis_model = \"stick-slip\"\n" : "") + "\n[arx]\nA = " + list(m.A) + "\nB = " + list(m.B) +
          "\n\n[dead_zone]\nm_r = " + num(m.dead_zone.m_r) + "\nm_l = " + num(m.dead_zone.m_l) +
          "\nb_r = " + num(m.dead_zone.b_r) + "\nb_l = " + num(m.dead_zone.b_l) + "\n" +
          (f.stick_slip ? format_stick_slip(*f.stick_slip) : std::string());

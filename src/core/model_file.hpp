@@ -6,6 +6,9 @@
 //   Ts = 0.005            # s
 //   mm_per_volt = 50.0    # sensor scale
 //   source = "..."        # free text: where the model came from
+//   axis_model = "stick-slip"  # optional: which of the file's models describes the axis ("hammerstein"
+//                         # when left out); "stick-slip" needs [stick_slip], and makes pp-traj arrive
+//                         # while sliding (control/sliding_approach.hpp)
 //   [arx]
 //   A = [1.0, -0.9094, -0.6110, 0.5204]   # coefficients of q^0, q^-1, ...
 //   B = [0.0, 1.024, -2.046, 1.029]
@@ -26,10 +29,14 @@
 
 namespace epa::core {
 
+// Which model describes the axis: epa identify's verdict, the one that follows held-out runs better.
+enum class AxisModel { kHammerstein, kStickSlip };
+
 struct ModelFile {
   HammersteinModel model;
   std::string source;  // provenance text
   std::optional<StickSlipParams> stick_slip = std::nullopt;  // the axis as a stick-slip model, when identified
+  AxisModel axis_model = AxisModel::kHammerstein;
 };
 
 // Errors name the file, and the line for syntax errors, and the key that is missing or wrong.

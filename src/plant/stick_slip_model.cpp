@@ -103,9 +103,9 @@ double coast_time_s(const StickSlipParams& params, double Ts, double speed_mm_s)
   return directions > 0 ? sum_s / directions : NAN;
 }
 
-double sliding_arrival_coast_s(const StickSlipParams& params, double Ts, double approach_speed_mm_s, double retry_band_mm) {
-  if (!(breakaway_jump_mm(params) > retry_band_mm)) return 0.0;
-  return coast_time_s(params, Ts, approach_speed_mm_s);
+double sliding_arrival_coast_s(const core::ModelFile& file, double approach_speed_mm_s) {
+  if (file.axis_model != core::AxisModel::kStickSlip || !file.stick_slip) return 0.0;
+  return coast_time_s(*file.stick_slip, file.model.Ts, approach_speed_mm_s);
 }
 
 }  // namespace epa::plant

@@ -24,6 +24,7 @@
 #include <cstddef>
 #include <string>
 
+#include "core/model_file.hpp"
 #include "core/result.hpp"
 #include "core/stick_slip_params.hpp"
 
@@ -83,13 +84,11 @@ double ramp_start_v(const StickSlipParams& params, double Ts, double ramp_v_per_
 // 4 positions, after 1 s at the command that gives it. NaN when neither direction slides.
 double coast_time_s(const StickSlipParams& params, double Ts, double speed_mm_s);
 
-// 2 (static_mm - coulomb_mm): how far a breakaway throws a piston with the valve centred, mm.
-inline double breakaway_jump_mm(const StickSlipParams& p) { return 2.0 * (p.static_mm - p.coulomb_mm); }
-
-// pp-traj's coast_s for an axis this model describes: coast_time_s at approach_speed_mm_s when a
-// breakaway throws the piston further than retry_band_mm (a stop that far off cannot be corrected
-// from rest without overshooting the band, so the law must arrive while sliding), else 0 (off:
-// the integrator corrects). NaN when the model does not slide at that speed.
-double sliding_arrival_coast_s(const StickSlipParams& params, double Ts, double approach_speed_mm_s, double retry_band_mm);
+// pp-traj's coast_s for the axis a model file describes: coast_time_s of its [stick_slip] model at
+// approach_speed_mm_s when the file says that model describes the axis (axis_model, epa identify's
+// verdict: on such an axis a stop cannot be corrected from rest by less than a breakaway jump, so
+// the law arrives while sliding), else 0 (off: the integrator corrects). NaN when the model does
+// not slide at that speed.
+double sliding_arrival_coast_s(const core::ModelFile& file, double approach_speed_mm_s);
 
 }  // namespace epa::plant
