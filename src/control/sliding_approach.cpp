@@ -71,10 +71,10 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
       s.phase = ApproachPhase::kHolding;
       s.samples_in_phase = 0;
     } else {
-      // The coast this stop took, if it came from a steady slide: the retry cuts with it.
+      // A stop off by e after a steady slide at v: the retry assumes a coast longer by e / v.
       if (s.cut_speed_v_s >= 0.5 * l.speed_v_s) {
-        const double measured_s = s.final_direction * (y_mean - s.cut_position_v) / s.cut_speed_v_s;
-        s.coast_s = std::clamp(measured_s, 0.25 * l.coast_s, 4.0 * l.coast_s);
+        const double correction_s = s.final_direction * (y_mean - s.planned_r_v) / s.cut_speed_v_s;
+        s.coast_s = std::clamp(s.coast_s + correction_s, 0.25 * l.coast_s, 4.0 * l.coast_s);
       }
       ++s.retries;
       start_leg(s, s.planned_r_v - s.final_direction * l.length_v, -s.final_direction, false, y_mean);
@@ -95,8 +95,8 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
   // The cut: the piston's predicted stop has reached the leg's target.
   const double dir = s.leg_direction;
   const double speed_towards = std::max(0.0, dir * reading_slope(s, l.Ts));
-  if (s.samples_in_phase > 1 && dir * (s.leg_target_v - y_v) - speed_towards * s.coast_s <= 0.0) {
-    s.cut_position_v = y_v;
+  const double to_go_v = dir * (s.leg_target_v - y_v) - speed_towards * s.coast_s;  // predicted stop to target
+  if (s.samples_in_phase > 1 && to_go_v <= 0.0) {
     s.cut_speed_v_s = s.final_leg ? speed_towards : 0.0;
     s.phase = ApproachPhase::kCoasting;
     s.samples_in_phase = 0;
@@ -119,6 +119,8 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
                                                   : std::max(scheduled, s.path_speed_v_s - l.decel_v_s2 * l.Ts);
   s.path_v += dir * s.path_speed_v_s * l.Ts;
   out.w_v = s.path_v;
+  const double per_sample_v = speed_towards * l.Ts;
+  if (s.samples_in_phase > 1 && per_sample_v > 0.0 && to_go_v < per_sample_v) out.drive_fraction = to_go_v / per_sample_v;
   return out;
 }
 

@@ -12,12 +12,14 @@
 //            slow against the air spring's period so that it does not ring) to a steady approach
 //            speed over the last length_v, and on at that speed past the target if need be
 //   cut      the valve is centred at the first sample where the predicted stop, y + v coast_s
-//            (v: least-squares slope of the last 4 readings), reaches the target
+//            (v: least-squares slope of the last 4 readings), reaches the target; in the sample
+//            before, the drive is scaled to the share of the sample still to go, so the stop is
+//            not quantised to the v Ts the piston covers per sample (+-0.3 mm at 120 mm/s)
 //   judge    settle_samples later, the mean of the last 4 readings against the target: within
 //            retry_band_v, hold; else back off length_v and approach again (at most max_retries),
-//            cutting with the coast this stop measured (distance / speed at the cut): the coast
-//            depends on where along the stroke the piston is (the air spring stiffens near an end),
-//            and the retry ends where the last approach did
+//            the coast corrected by this stop's error / the speed at the cut: the coast depends on
+//            where along the stroke the piston is (the air spring stiffens near an end), and the
+//            retry ends where the last approach did
 //   short    a move shorter than length_v backs off first, so that every final approach is a
 //            steady slide of length_v, not the breakaway jump of a start from rest
 //   hold     the valve stays centred until the setpoint changes or the piston is pushed more than
@@ -54,8 +56,8 @@ struct ApproachState {
   bool final_leg = false;
   int retries = 0;
   double path_v = 0.0, path_speed_v_s = 0.0;  // the leg's reference and its speed (>= 0, along leg_direction)
-  double coast_s = 0.0;           // the coast the next cut assumes: the limits' at a new setpoint, then measured
-  double cut_position_v = 0.0, cut_speed_v_s = 0.0;  // at the last cut of a final leg
+  double coast_s = 0.0;           // the coast the next cut assumes: the limits' at a new setpoint, then corrected
+  double cut_speed_v_s = 0.0;     // at the last cut of a final leg (0: not a steady slide)
   std::size_t samples_in_phase = 0;
   std::array<double, 4> readings{};  // newest first
   std::size_t reading_count = 0;
@@ -65,6 +67,7 @@ struct ApproachOutput {
   double w_v = 0.0;          // the reference w(k)
   bool hold = false;         // valve centred
   bool leg_started = false;  // a leg starts here: the caller restarts its reference history and filters at w_v
+  double drive_fraction = 1.0;  // of the law's drive to apply (< 1 in the sample before a cut)
 };
 
 // One sample. The first call (or any after approach_reset) plans from y_v.

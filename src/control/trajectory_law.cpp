@@ -169,7 +169,7 @@ TrajectoryOutput approach_trajectory_step(const TrajectoryParams& p, TrajectoryS
   const double e = y_d - y_v;
   s.feedback_stage1_v += p.feedback_filter_alpha * (e - s.feedback_stage1_v);
   s.feedback_stage2_v += p.feedback_filter_alpha * (s.feedback_stage1_v - s.feedback_stage2_v);
-  out.u = u_ff + p.proportional_gain * s.feedback_stage2_v;
+  out.u = a.drive_fraction * (u_ff + p.proportional_gain * s.feedback_stage2_v);
   return out;
 }
 
