@@ -8,6 +8,7 @@
 #include "ident/arx_estimator.hpp"
 #include "ident/arx_metrics.hpp"
 #include "ident/hammerstein_identification.hpp"
+#include "ident/stick_slip_fit.hpp"
 
 namespace epa::app {
 
@@ -81,6 +82,20 @@ commission::Identify identify_for_commissioning(double mm_per_volt) {
                   identified->fit.arx.model.orders.to_string().c_str(), model.dead_zone.b_l, model.dead_zone.b_r,
                   out.estimation_fit_pct, out.validation_fit_pct);
     out.summary = buf;
+
+    // The stick-slip model beside it, as epa identify fits it; the one that follows the held-out run
+    // better describes the axis (pp-traj then arrives while sliding, the simulation runs on it).
+    ident::StickSlipFitOptions fit_options;
+    fit_options.Ts = Ts;
+    fit_options.mm_per_volt = mm_per_volt;
+    auto stick = ident::identify_stick_slip(est, val, model, identified->fit.arx.model.orders.nk, fit_options);
+    if (!stick) return core::numerical_error("the stick-slip model: " + stick.error().message);
+    out.stick_slip = stick->fit.params;
+    out.stick_slip_validation_fit_pct = stick->validation_pct;
+    out.axis_model = axis_model_verdict(*stick, fits);
+    std::snprintf(buf, sizeof buf, "; stick-slip model: free-run fit %.1f %% on the held-out run%s", stick->validation_pct,
+                  out.axis_model == core::AxisModel::kStickSlip ? " (describes the axis)" : "");
+    out.summary += buf;
     return out;
   };
 }

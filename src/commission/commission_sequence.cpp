@@ -1,6 +1,7 @@
 #include "commission/commission_sequence.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -8,6 +9,7 @@
 #include "core/audit.hpp"
 #include "core/step_metrics.hpp"
 #include "core/utc_stamp.hpp"
+#include "plant/stick_slip_model.hpp"
 
 namespace epa::commission {
 
@@ -182,6 +184,11 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
   set.controller = spec.controller;
   set.F = design->F, set.G = design->G, set.H = design->H;
   set.dead_zone = identified->model.dead_zone;
+  // pp-traj arrives while sliding on an axis that a stick-slip model describes (its coast from it).
+  set.trajectory.coast_s = plant::sliding_arrival_coast_s(
+      core::ModelFile{identified->model, "", identified->stick_slip, identified->axis_model}, set.trajectory.approach_speed_mm_s);
+  if (!std::isfinite(set.trajectory.coast_s))
+    return finish(Verdict::kRolledBack, "design: the identified stick-slip model does not slide at pp-traj's approach speed", out);
   set.model_id = 0;
   set.source = "epa commission: " + identified->summary;
   set.design_json = format_commission_spec(spec);
@@ -192,7 +199,8 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
   auto config = store::controller_config(set, identified->model, 0.0);
   auto params = control::ControllerParams::make(config);
   if (!params) return finish(Verdict::kRolledBack, "design: " + params.error().message, out);
-  out.simulation = verify_in_simulation(identified->model, *params, spec, axis_.position_mm());
+  const auto axis_model = identified->axis_model == core::AxisModel::kStickSlip ? identified->stick_slip : std::nullopt;
+  out.simulation = verify_in_simulation(identified->model, axis_model, *params, spec, axis_.position_mm());
   if (!out.simulation->passed) return finish(Verdict::kRolledBack, out.simulation->why, out);
   done_s += kIdentifyWeightS;
   if (aborted(out)) return out;
@@ -253,7 +261,16 @@ std::string format_commission_json(const CommissionOutcome& o) {
                   {"Ts", m.Ts},
                   {"estimation_fit_pct", o.identified->estimation_fit_pct},
                   {"validation_fit_pct", o.identified->validation_fit_pct},
-                  {"summary", o.identified->summary}};
+                  {"summary", o.identified->summary},
+                  {"axis_model", o.identified->axis_model == core::AxisModel::kStickSlip ? "stick-slip" : "hammerstein"}};
+    if (const auto& ss = o.identified->stick_slip)
+      j["model"]["stick_slip"] = {{"break_right_v", ss->break_right_v}, {"break_left_v", ss->break_left_v},
+                                  {"speed_right_mm_s_per_v", ss->speed_right_mm_s_per_v},
+                                  {"speed_left_mm_s_per_v", ss->speed_left_mm_s_per_v}, {"spring_rad_s", ss->spring_rad_s},
+                                  {"damping_ratio", ss->damping_ratio}, {"coulomb_mm", ss->coulomb_mm},
+                                  {"static_mm", ss->static_mm}, {"spool_lag_s", ss->spool_lag_s},
+                                  {"delay_samples", ss->delay_samples},
+                                  {"validation_fit_pct", o.identified->stick_slip_validation_fit_pct}};
   }
   if (o.design)
     j["design"] = {{"F", o.design->F.coefficients()}, {"G", o.design->G.coefficients()}, {"H", o.design->H.coefficients()},

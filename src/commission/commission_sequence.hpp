@@ -10,6 +10,7 @@
 #include <atomic>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,7 @@
 #include "commission/simulated_verification.hpp"
 #include "control/pole_placement_design.hpp"
 #include "core/hammerstein_model.hpp"
+#include "core/model_file.hpp"
 
 namespace epa::commission {
 
@@ -38,6 +40,11 @@ struct IdentifiedModel {
   std::vector<double> validation_simulated_mm;  // the model's free run on the held-out run's commands
   std::string summary;              // one line for the log and the report
   std::size_t held_out_run = 0;     // which of the experiment's runs validated it (the others estimated)
+  // The stick-slip model fitted beside it (ident/stick_slip_fit.hpp), when the identification fits one,
+  // and which of the two describes the axis: the one that follows the held-out run better.
+  std::optional<core::StickSlipParams> stick_slip = std::nullopt;
+  double stick_slip_validation_fit_pct = 0.0;
+  core::AxisModel axis_model = core::AxisModel::kHammerstein;
 };
 using Identify = std::function<core::Result<IdentifiedModel>(const std::vector<core::Run>& estimation,
                                                              const core::Run& validation)>;

@@ -2,7 +2,10 @@
 // The commissioning sequence's check before anything reaches the axis: the designed law against
 // the identified model and against that model perturbed (gain -+, dead band wider and narrower),
 // on the spec's verification moves: the identified model's by the spec's limits, the perturbed
-// ones by its robust_limits.
+// ones by its robust_limits. When identification found that a stick-slip model describes the axis
+// (core::AxisModel), the moves run on that model and its perturbations instead: a law that would
+// hunt on the axis hunts there too, before it reaches the axis.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,6 +13,7 @@
 #include "commission/move_acceptance.hpp"
 #include "control/controller.hpp"
 #include "core/hammerstein_model.hpp"
+#include "core/stick_slip_params.hpp"
 
 
 namespace epa::commission {
@@ -28,7 +32,9 @@ struct SimulatedVerification {
 };
 
 // The moves start at rest at `start_mm`. The law keeps `params` (designed for `model`) in every case.
-SimulatedVerification verify_in_simulation(const core::HammersteinModel& model, const control::ControllerParams& params,
-                                           const CommissionSpec& spec, double start_mm);
+// `axis` (the stick-slip model that describes the axis, if one does) replaces `model` as the plant;
+// its gain is its speeds per volt, its dead band its flow break points.
+SimulatedVerification verify_in_simulation(const core::HammersteinModel& model, const std::optional<core::StickSlipParams>& axis,
+                                           const control::ControllerParams& params, const CommissionSpec& spec, double start_mm);
 
 }  // namespace epa::commission

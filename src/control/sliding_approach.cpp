@@ -21,6 +21,14 @@ double reading_slope(const ApproachState& s, double Ts) noexcept {
   return (3.0 * y[0] + y[1] - y[2] - 3.0 * y[3]) / (10.0 * Ts);
 }
 
+void hold(ApproachState& s, double at_v) noexcept {
+  s.phase = ApproachPhase::kHolding;
+  s.held_at_v = at_v;
+  s.samples_in_phase = 0;
+}
+
+std::size_t direction_index(double direction) noexcept { return direction > 0.0 ? 0 : 1; }
+
 void start_leg(ApproachState& s, double target_v, double direction, bool final_leg, double from_v) noexcept {
   s.phase = ApproachPhase::kLeg;
   s.leg_target_v = target_v;
@@ -36,14 +44,14 @@ void start_leg(ApproachState& s, double target_v, double direction, bool final_l
 void plan(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noexcept {
   s.planned_r_v = r_v;
   s.retries = 0;
-  s.coast_s = l.coast_s;
   const double move = r_v - y_v;
   if (std::abs(move) <= l.retry_band_v) {
-    s.phase = ApproachPhase::kHolding;
-    s.samples_in_phase = 0;
+    hold(s, y_v);
     return;
   }
   s.final_direction = move > 0.0 ? 1.0 : -1.0;
+  const double learned = s.learned_coast_s[direction_index(s.final_direction)];
+  s.coast_s = learned > 0.0 ? learned : l.coast_s;
   if (std::abs(move) >= l.length_v)
     start_leg(s, r_v, s.final_direction, true, y_v);
   else
@@ -65,23 +73,23 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
   } else if (s.phase == ApproachPhase::kCoasting && s.samples_in_phase >= l.settle_samples) {
     const double y_mean = mean_reading(s);
     const double error = s.planned_r_v - y_mean;
+    if (s.final_leg && s.cut_speed_v_s >= 0.5 * l.speed_v_s) {
+      // A stop off by e after a steady slide at v: the next cut this way assumes a coast longer by e / v.
+      const double correction_s = s.final_direction * (y_mean - s.planned_r_v) / s.cut_speed_v_s;
+      s.coast_s = std::clamp(s.coast_s + correction_s, 0.25 * l.coast_s, 4.0 * l.coast_s);
+      s.learned_coast_s[direction_index(s.final_direction)] = s.coast_s;
+    }
     if (!s.final_leg) {
       start_leg(s, s.planned_r_v, s.final_direction, true, y_mean);
     } else if (std::abs(error) <= l.retry_band_v || s.retries >= l.max_retries) {
-      s.phase = ApproachPhase::kHolding;
-      s.samples_in_phase = 0;
+      hold(s, y_mean);
     } else {
-      // A stop off by e after a steady slide at v: the retry assumes a coast longer by e / v.
-      if (s.cut_speed_v_s >= 0.5 * l.speed_v_s) {
-        const double correction_s = s.final_direction * (y_mean - s.planned_r_v) / s.cut_speed_v_s;
-        s.coast_s = std::clamp(s.coast_s + correction_s, 0.25 * l.coast_s, 4.0 * l.coast_s);
-      }
       ++s.retries;
       start_leg(s, s.planned_r_v - s.final_direction * l.length_v, -s.final_direction, false, y_mean);
     }
   } else if (s.phase == ApproachPhase::kHolding && s.reading_count >= s.readings.size() &&
-             std::abs(s.planned_r_v - mean_reading(s)) > 4.0 * l.retry_band_v) {
-    plan(l, s, s.planned_r_v, mean_reading(s));  // pushed away: approach again
+             std::abs(mean_reading(s) - s.held_at_v) > 4.0 * l.retry_band_v) {
+    plan(l, s, s.planned_r_v, mean_reading(s));  // pushed away from where it held: approach again
   }
   ++s.samples_in_phase;
 
@@ -114,7 +122,7 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
   const double scheduled =
       left_v < -l.length_v ? 0.0
                            : std::min(std::max(top, l.speed_v_s),
-                                      l.speed_v_s + std::sqrt(2.0 * l.decel_v_s2 * std::max(0.0, left_v - l.length_v)));
+                                      std::sqrt(l.speed_v_s * l.speed_v_s + 2.0 * l.decel_v_s2 * std::max(0.0, left_v - l.length_v)));
   s.path_speed_v_s = scheduled > s.path_speed_v_s ? std::min(scheduled, s.path_speed_v_s + l.accel_v_s2 * l.Ts)
                                                   : std::max(scheduled, s.path_speed_v_s - l.decel_v_s2 * l.Ts);
   s.path_v += dir * s.path_speed_v_s * l.Ts;

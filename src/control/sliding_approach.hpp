@@ -16,14 +16,16 @@
 //            before, the drive is scaled to the share of the sample still to go, so the stop is
 //            not quantised to the v Ts the piston covers per sample (+-0.3 mm at 120 mm/s)
 //   judge    settle_samples later, the mean of the last 4 readings against the target: within
-//            retry_band_v, hold; else back off length_v and approach again (at most max_retries),
-//            the coast corrected by this stop's error / the speed at the cut: the coast depends on
-//            where along the stroke the piston is (the air spring stiffens near an end), and the
-//            retry ends where the last approach did
+//            retry_band_v, hold; else back off length_v and approach again (at most max_retries)
+//   learn    every stop after a steady slide corrects the coast of its direction by its error /
+//            the speed at the cut, and the next approach that way (a retry, or the next move's)
+//            cuts with it: the model's coast is a first guess (on an axis the identification saw
+//            through a slower I/O path it was 1-3 mm long), and the coast also depends on where
+//            along the stroke the piston is (the air spring stiffens near an end)
 //   short    a move shorter than length_v backs off first, so that every final approach is a
 //            steady slide of length_v, not the breakaway jump of a start from rest
 //   hold     the valve stays centred until the setpoint changes or the piston is pushed more than
-//            4 retry bands away
+//            4 retry bands from where it stopped
 //
 // The approach direction of a retry is the move's: unidirectional positioning, as machine tools do
 // against backlash. Fixed storage, no allocation; positions in sensor volts.
@@ -56,8 +58,10 @@ struct ApproachState {
   bool final_leg = false;
   int retries = 0;
   double path_v = 0.0, path_speed_v_s = 0.0;  // the leg's reference and its speed (>= 0, along leg_direction)
-  double coast_s = 0.0;           // the coast the next cut assumes: the limits' at a new setpoint, then corrected
+  double coast_s = 0.0;           // the coast this move's cuts assume
+  std::array<double, 2> learned_coast_s{};  // upwards, downwards: from the stops so far (0: none yet)
   double cut_speed_v_s = 0.0;     // at the last cut of a final leg (0: not a steady slide)
+  double held_at_v = 0.0;         // where the piston stopped, while holding
   std::size_t samples_in_phase = 0;
   std::array<double, 4> readings{};  // newest first
   std::size_t reading_count = 0;

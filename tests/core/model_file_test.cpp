@@ -237,6 +237,36 @@ TEST(ModelFile, AStickSlipTableWithAMissingOrWrongFieldIsRefusedByName) {
   EXPECT_TRUE(contains(file.error().message, "stick_slip must be a table"));
 }
 
+TEST(ModelFile, TheAxisModelIsHammersteinUnlessTheFileSaysStickSlipAndRoundTrips) {
+  auto file = parse_model_toml(kValidText + kStickSlipTable, "ss.toml");
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  EXPECT_EQ(file->axis_model, AxisModel::kHammerstein);
+  EXPECT_TRUE(contains(format_model_toml(*file), "[stick_slip]"));
+  EXPECT_EQ(format_model_toml(*file).find("axis_model"), std::string::npos);
+  file = parse_model_toml(replaced(kValidText, "[arx]", "axis_model = \"stick-slip\"\n\n[arx]") + kStickSlipTable, "ss.toml");
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  EXPECT_EQ(file->axis_model, AxisModel::kStickSlip);
+  const auto back = parse_model_toml(format_model_toml(*file), "formatted");
+  ASSERT_TRUE(back.has_value()) << back.error().message;
+  EXPECT_EQ(back->axis_model, AxisModel::kStickSlip);
+  file = parse_model_toml(replaced(kValidText, "[arx]", "axis_model = \"hammerstein\"\n\n[arx]"), "h.toml");
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  EXPECT_EQ(file->axis_model, AxisModel::kHammerstein);
+}
+
+TEST(ModelFile, AStickSlipAxisWithoutItsTableOrAnUnknownAxisModelIsRefusedByName) {
+  auto file = parse_model_toml(replaced(kValidText, "[arx]", "axis_model = \"stick-slip\"\n\n[arx]"), "ss.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "needs a [stick_slip] table"));
+  EXPECT_TRUE(contains(file.error().message, "ss.toml"));
+  file = parse_model_toml(replaced(kValidText, "[arx]", "axis_model = \"linear\"\n\n[arx]") + kStickSlipTable, "ss.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "axis_model must be"));
+  file = parse_model_toml(replaced(kValidText, "[arx]", "axis_model = 2\n\n[arx]"), "ss.toml");
+  ASSERT_FALSE(file.has_value());
+  EXPECT_TRUE(contains(file.error().message, "axis_model must be"));
+}
+
 TEST(ModelFile, MissingDeadZoneKeyIsNamed) {
   const auto file = parse_model_toml(replaced(kValidText, "b_l = -1.722\n", ""), "dz.toml");
   ASSERT_FALSE(file.has_value());

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "plant/pneumatic_plant.hpp"
 #include "plant/stick_slip_model.hpp"
 #include "plant/stick_slip_plant.hpp"
 
@@ -176,6 +177,44 @@ TEST(StickSlipPlant, TheEndStopsHoldThePistonAndTheSensorReadsItWithSeededNoise)
   EXPECT_GT(spread, 0.05);  // the noise is there
   EXPECT_LT(spread, 0.6);   // and about 0.1 mm
   EXPECT_FALSE(StickSlipPlant::make(p, kTs, 50.0, {.initial_position_mm = 600.0}).has_value());
+}
+
+// The coast pp-traj cuts with, checked against a plant of another form: the physics plant (chambers,
+// orifices, Stribeck friction) driven at a steady speed and centred, its coast measured as the law
+// reads speed (least-squares slope of 4 readings). The model is the one epa identify fitted to
+// open-loop runs of that plant (tests/sim/pp_traj_sliding_test.cpp has the whole file).
+TEST(StickSlipModel, ItsCoastTimeMatchesThePhysicsPlantsWithinAQuarter) {
+  StickSlipParams identified;
+  identified.break_right_v = 1.176969689128404;
+  identified.break_left_v = -1.683703334845168;
+  identified.speed_right_mm_s_per_v = 112.57081259160479;
+  identified.speed_left_mm_s_per_v = 109.02932094462616;
+  identified.spring_rad_s = 59.015440817565505;
+  identified.damping_ratio = 0.20904450655623621;
+  identified.coulomb_mm = 5.66702578402857;
+  identified.static_mm = 5.768196811811399;
+  identified.spool_lag_s = 0.013662491569187415;
+  identified.delay_samples = 1;
+  for (const double direction : {1.0, -1.0}) {
+    SCOPED_TRACE(direction > 0 ? "outwards" : "inwards");
+    PneumaticOptions options;
+    options.initial_position_mm = direction > 0 ? 100.0 : 400.0;
+    auto physics = PneumaticPlant::make(PneumaticParams{}, options);
+    ASSERT_TRUE(physics.has_value());
+    const double u = direction > 0 ? 2.2 : -2.7;  // about 1 V past each overlap: a steady 100-150 mm/s
+    double y[4] = {};
+    for (int k = 0; k < 200; ++k) {
+      physics->step(u);
+      y[3] = y[2], y[2] = y[1], y[1] = y[0], y[0] = physics->position_mm();
+    }
+    const double speed = direction * (3.0 * y[0] + y[1] - y[2] - 3.0 * y[3]) / (10.0 * kTs);
+    ASSERT_GT(speed, 80.0);
+    for (int k = 0; k < 200; ++k) physics->step(0.0);
+    const double plant_coast_s = direction * (physics->position_mm() - y[0]) / speed;
+    const double model_coast_s = coast_time_s(identified, kTs, speed);
+    EXPECT_GT(plant_coast_s, 0.005);
+    EXPECT_NEAR(model_coast_s, plant_coast_s, 0.25 * plant_coast_s) << "speed " << speed << " mm/s";
+  }
 }
 
 }  // namespace

@@ -1,0 +1,152 @@
+// pp-traj's arrival while sliding (control/sliding_approach.hpp), on a kinematic piston whose coast
+// is known in closed form: its speed follows the commanded path speed through a first-order lag of
+// kLagS, so centred at speed v it goes on for v * kLagS and stops (at rest below kRestSpeed).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "control/sliding_approach.hpp"
+
+namespace epa::control {
+namespace {
+
+constexpr double kTs = 0.005;
+constexpr double kLagS = 0.025;
+constexpr double kRestSpeed = 0.05;  // V/s: friction stops it dead below 2.5 mm/s
+
+ApproachLimits limits(double coast_s = kLagS) {
+  ApproachLimits l;
+  l.coast_s = coast_s;
+  l.speed_v_s = 2.4;
+  l.length_v = 1.0;
+  l.decel_v_s2 = 6.0;
+  l.top_speed_pos_v_s = l.top_speed_neg_v_s = 8.0;
+  l.accel_v_s2 = 200.0;
+  l.retry_band_v = 0.006;
+  l.max_retries = 3;
+  l.settle_samples = 30;
+  l.Ts = kTs;
+  return l;
+}
+
+struct Trace {
+  std::vector<double> y;       // position at each sample
+  std::vector<bool> hold;      // valve centred
+  std::vector<double> leg_direction;  // of the leg at each sample (0 while not in a leg)
+  std::vector<bool> final_leg;        // the leg ends at the target (not a back-off)
+};
+
+// Runs the approach against the kinematic piston for `seconds` from rest at y0; `coast_scale` makes
+// the piston's real coast differ from the lag (a plant the law's coast gets wrong).
+Trace run(const ApproachLimits& l, ApproachState& s, double y0, double r, double seconds, double coast_scale = 1.0) {
+  Trace t;
+  double y = y0, v = 0.0, last_w = y0;
+  const double lag = kLagS * coast_scale;
+  for (int k = 0; k < static_cast<int>(seconds / kTs); ++k) {
+    const ApproachOutput out = approach_step(l, s, r, y);
+    if (out.leg_started) last_w = y;
+    double commanded = 0.0;
+    if (!out.hold) {
+      commanded = out.drive_fraction * (out.w_v - last_w) / kTs;
+      last_w = out.w_v;
+    }
+    v += (commanded - v) * kTs / (lag + kTs);
+    if (out.hold && std::abs(v) < kRestSpeed) v = 0.0;
+    y += v * kTs;
+    t.y.push_back(y);
+    t.hold.push_back(out.hold);
+    t.leg_direction.push_back(s.phase == ApproachPhase::kLeg ? s.leg_direction : 0.0);
+    t.final_leg.push_back(s.phase == ApproachPhase::kLeg && s.final_leg);
+  }
+  return t;
+}
+
+TEST(SlidingApproach, ALongMoveEndsWithinTheBandAtTheFirstApproachAndHolds) {
+  const auto l = limits();
+  ApproachState s;
+  const Trace t = run(l, s, 0.0, 4.0, 4.0);
+  EXPECT_NEAR(t.y.back(), 4.0, l.retry_band_v);
+  EXPECT_EQ(s.retries, 0);
+  EXPECT_EQ(s.phase, ApproachPhase::kHolding);
+  EXPECT_TRUE(t.hold.back());
+  // It arrived at the approach speed, not at its cruise speed: the cut came from a steady slide.
+  EXPECT_NEAR(s.cut_speed_v_s, l.speed_v_s, 0.2 * l.speed_v_s);
+  // Never past the target by more than the band.
+  EXPECT_LE(*std::max_element(t.y.begin(), t.y.end()), 4.0 + l.retry_band_v);
+}
+
+TEST(SlidingApproach, AShortMoveBacksOffFirstSoThatItsFinalApproachIsAWholeApproachLong) {
+  const auto l = limits();
+  ApproachState s;
+  const Trace t = run(l, s, 2.0, 2.5, 4.0);  // 25 mm up, half an approach length
+  const double lowest = *std::min_element(t.y.begin(), t.y.end());
+  EXPECT_NEAR(lowest, 2.5 - l.length_v, 0.05) << "backed off to one approach length before the target";
+  EXPECT_NEAR(t.y.back(), 2.5, l.retry_band_v);
+  EXPECT_LE(*std::max_element(t.y.begin(), t.y.end()), 2.5 + l.retry_band_v);
+}
+
+TEST(SlidingApproach, ACoastTheLawGetsWrongIsCorrectedByRetriesFromTheSameSide) {
+  const auto l = limits(0.5 * kLagS);  // the law expects half the coast: it cuts too late
+  ApproachState s;
+  const Trace t = run(l, s, 0.0, 4.0, 8.0);
+  EXPECT_NEAR(t.y.back(), 4.0, l.retry_band_v);
+  EXPECT_GE(s.retries, 1);
+  EXPECT_LE(s.retries, l.max_retries);
+  EXPECT_GT(s.coast_s, 0.5 * kLagS) << "the coast it cuts with grew towards the piston's";
+  // Every approach to the target was upward: a retry backs off and comes from the same side.
+  std::size_t approach_samples = 0;
+  for (std::size_t k = 0; k < t.y.size(); ++k) {
+    if (t.final_leg[k]) {
+      EXPECT_EQ(t.leg_direction[k], 1.0);
+      ++approach_samples;
+    }
+  }
+  EXPECT_GT(approach_samples, 0u);
+}
+
+TEST(SlidingApproach, AfterMaxRetriesItHoldsWhereverItStoppedAndStartsNoFurtherLeg) {
+  auto l = limits();
+  l.retry_band_v = 1e-7;  // unreachable
+  l.max_retries = 2;
+  ApproachState s;
+  const Trace t = run(l, s, 0.0, 4.0, 10.0, 1.3);
+  EXPECT_EQ(s.retries, 2);
+  EXPECT_EQ(s.phase, ApproachPhase::kHolding);
+  // Held for the last 2 s, still.
+  const std::size_t last2 = t.y.size() - static_cast<std::size_t>(2.0 / kTs);
+  for (std::size_t k = last2; k < t.y.size(); ++k) {
+    EXPECT_TRUE(t.hold[k]);
+    EXPECT_EQ(t.y[k], t.y.back());
+  }
+}
+
+TEST(SlidingApproach, APistonPushedAwayWhileHoldingIsApproachedAgainAndANewSetpointReplans) {
+  const auto l = limits();
+  ApproachState s;
+  run(l, s, 0.0, 4.0, 4.0);
+  ASSERT_EQ(s.phase, ApproachPhase::kHolding);
+  // Pushed 2 bands away: still held.
+  Trace t = run(l, s, 4.0 + 2.0 * l.retry_band_v, 4.0, 0.2);
+  EXPECT_TRUE(t.hold.back());
+  // Pushed 10 bands away: approached again, and it ends within the band.
+  t = run(l, s, 4.0 + 10.0 * l.retry_band_v, 4.0, 4.0);
+  EXPECT_FALSE(std::all_of(t.hold.begin(), t.hold.end(), [](bool h) { return h; }));
+  EXPECT_NEAR(t.y.back(), 4.0, l.retry_band_v);
+  // A new setpoint: planned from where the piston is.
+  t = run(l, s, t.y.back(), 1.0, 5.0);
+  EXPECT_NEAR(t.y.back(), 1.0, l.retry_band_v);
+  EXPECT_EQ(s.planned_r_v, 1.0);
+}
+
+TEST(SlidingApproach, ASetpointWithinTheBandStartsNoMove) {
+  const auto l = limits();
+  ApproachState s;
+  const Trace t = run(l, s, 3.0, 3.0 + 0.5 * l.retry_band_v, 1.0);
+  EXPECT_TRUE(std::all_of(t.hold.begin(), t.hold.end(), [](bool h) { return h; }));
+  EXPECT_EQ(t.y.back(), 3.0);
+}
+
+}  // namespace
+}  // namespace epa::control
