@@ -26,6 +26,22 @@ void BM_ControllerStep(benchmark::State& state) {
 }
 BENCHMARK(BM_ControllerStep)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
 
+// pp-traj arriving while sliding (control/sliding_approach.hpp), as on an axis with stick-slip.
+void BM_ControllerStepSlidingArrival(benchmark::State& state) {
+  auto config = epa::control::paper_controller_config(ControllerKind::kPpTraj);
+  config.trajectory.coast_s = 0.025;
+  const auto params = *epa::control::ControllerParams::make(config);
+  epa::control::ControllerState s;
+  double y = 0.0;
+  for (auto _ : state) {
+    const auto out = epa::control::controller_step(params, s, 1.0, y);
+    y = 0.999 * y + 1e-4 * out.valve_v;
+    benchmark::DoNotOptimize(y);
+  }
+  state.SetLabel("pp-traj, sliding arrival");
+}
+BENCHMARK(BM_ControllerStepSlidingArrival);
+
 void BM_PlantStep(benchmark::State& state) {
   auto plant = *epa::plant::HammersteinPlant::make(epa::core::paper::model(), {.initial_position_mm = 250.0, .noise_std_mm = 0.1});
   double u = 2.0;

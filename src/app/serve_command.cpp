@@ -146,7 +146,8 @@ core::Result<ControlSetup> prepare_control(ApplianceConfig& c, const std::option
     if (r >= c.runtime.setpoint_min_mm && r <= c.runtime.setpoint_max_mm) c.runtime.start_setpoint_mm = r;
     else store->warnings.push_back("store: retained setpoint " + core::format_number(r) + " mm is outside the configured limits: not used");
   }
-  const control::ControllerConfig base = store::controller_config(store->set, model, c.runtime.safe_valve_v);
+  const control::ControllerConfig base =
+      runtime::with_travel_range(store::controller_config(store->set, model, c.runtime.safe_valve_v), c.runtime);
   auto tuning = runtime::make_tuning(base);
   if (!tuning) return tuning.error();  // cannot happen: load_active_tuning validated the set
   return ControlSetup{std::move(*plant_model), std::move(*store), base, *tuning};

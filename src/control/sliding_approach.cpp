@@ -29,14 +29,22 @@ void hold(ApproachState& s, double at_v) noexcept {
 
 std::size_t direction_index(double direction) noexcept { return direction > 0.0 ? 0 : 1; }
 
-void start_leg(ApproachState& s, double target_v, double direction, bool final_leg, double from_v) noexcept {
+// A leg from the piston at from_v; the path starts at the piston's speed along it (a setpoint
+// changed mid-move does not first stop the piston).
+void start_leg(ApproachState& s, double target_v, double direction, bool final_leg, double from_v, double Ts) noexcept {
   s.phase = ApproachPhase::kLeg;
   s.leg_target_v = target_v;
   s.leg_direction = direction;
   s.final_leg = final_leg;
   s.path_v = from_v;
-  s.path_speed_v_s = 0.0;
+  s.path_speed_v_s = std::max(0.0, direction * reading_slope(s, Ts));
   s.samples_in_phase = 0;
+}
+
+// The back-off before an approach: to one approach length before the target, from where the piston is.
+void back_off(const ApproachLimits& l, ApproachState& s, double y_v) noexcept {
+  const double to_v = s.planned_r_v - s.final_direction * l.length_v;
+  start_leg(s, to_v, y_v < to_v ? 1.0 : -1.0, false, y_v, l.Ts);
 }
 
 // Plans a move to r from rest at y: straight in when it is at least one approach long, else back
@@ -50,12 +58,17 @@ void plan(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noe
     return;
   }
   s.final_direction = move > 0.0 ? 1.0 : -1.0;
+  const bool straight_in = std::abs(move) >= l.length_v;
+  if (!straight_in) {
+    const double back_off_v = r_v - s.final_direction * l.length_v;
+    if (back_off_v < l.travel_min_v || back_off_v > l.travel_max_v) s.final_direction = -s.final_direction;
+  }
   const double learned = s.learned_coast_s[direction_index(s.final_direction)];
   s.coast_s = learned > 0.0 ? learned : l.coast_s;
-  if (std::abs(move) >= l.length_v)
-    start_leg(s, r_v, s.final_direction, true, y_v);
+  if (straight_in)
+    start_leg(s, r_v, s.final_direction, true, y_v, l.Ts);
   else
-    start_leg(s, r_v - s.final_direction * l.length_v, -s.final_direction, false, y_v);
+    back_off(l, s, y_v);
 }
 
 }  // namespace
@@ -73,19 +86,22 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
   } else if (s.phase == ApproachPhase::kCoasting && s.samples_in_phase >= l.settle_samples) {
     const double y_mean = mean_reading(s);
     const double error = s.planned_r_v - y_mean;
-    if (s.final_leg && s.cut_speed_v_s >= 0.5 * l.speed_v_s) {
-      // A stop off by e after a steady slide at v: the next cut this way assumes a coast longer by e / v.
+    if (s.final_leg && s.cut_speed_v_s >= 0.5 * l.speed_v_s && s.cut_speed_v_s <= 1.5 * l.speed_v_s) {
+      // A stop off by e after a steady slide at v: the next cut this way assumes a coast longer by
+      // e / v, by at most 30 % of the model's per stop (a cut in a breakaway, or a loop that
+      // stalled, must not teach it a coast it then keeps), within a quarter to 4 times it.
       const double correction_s = s.final_direction * (y_mean - s.planned_r_v) / s.cut_speed_v_s;
-      s.coast_s = std::clamp(s.coast_s + correction_s, 0.25 * l.coast_s, 4.0 * l.coast_s);
+      const double step_limit_s = 0.3 * l.coast_s;
+      s.coast_s = std::clamp(s.coast_s + std::clamp(correction_s, -step_limit_s, step_limit_s), 0.25 * l.coast_s, 4.0 * l.coast_s);
       s.learned_coast_s[direction_index(s.final_direction)] = s.coast_s;
     }
     if (!s.final_leg) {
-      start_leg(s, s.planned_r_v, s.final_direction, true, y_mean);
+      start_leg(s, s.planned_r_v, s.final_direction, true, y_mean, l.Ts);
     } else if (std::abs(error) <= l.retry_band_v || s.retries >= l.max_retries) {
       hold(s, y_mean);
     } else {
       ++s.retries;
-      start_leg(s, s.planned_r_v - s.final_direction * l.length_v, -s.final_direction, false, y_mean);
+      back_off(l, s, y_mean);
     }
   } else if (s.phase == ApproachPhase::kHolding && s.reading_count >= s.readings.size() &&
              std::abs(mean_reading(s) - s.held_at_v) > 4.0 * l.retry_band_v) {

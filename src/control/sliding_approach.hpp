@@ -23,7 +23,9 @@
 //            through a slower I/O path it was 1-3 mm long), and the coast also depends on where
 //            along the stroke the piston is (the air spring stiffens near an end)
 //   short    a move shorter than length_v backs off first, so that every final approach is a
-//            steady slide of length_v, not the breakaway jump of a start from rest
+//            steady slide of length_v, not the breakaway jump of a start from rest; from the far
+//            side of the target when the near side's back-off point lies outside
+//            [travel_min_v, travel_max_v] (the loop's setpoint range: a target near an end)
 //   hold     the valve stays centred until the setpoint changes or the piston is pushed more than
 //            4 retry bands from where it stopped
 //
@@ -45,6 +47,7 @@ struct ApproachLimits {
   int max_retries = 3;
   std::size_t settle_samples = 30;  // from the cut to the judgement
   double Ts = 0.005;
+  double travel_min_v = 0.0, travel_max_v = 10.0;  // back-off points stay within (the loop's setpoint range)
 };
 
 enum class ApproachPhase { kIdle, kLeg, kCoasting, kHolding };

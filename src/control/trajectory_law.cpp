@@ -85,6 +85,8 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
       return field_error("max_retries", c.max_retries, "a whole number 0..10");
     if (!(c.approach_settle_s > 0.0 && c.approach_settle_s <= 10.0))
       return field_error("approach_settle_s", c.approach_settle_s, "in (0, 10] s");
+    if (!std::isfinite(c.travel_min_v) || !(c.travel_max_v > c.travel_min_v) || !std::isfinite(c.travel_max_v))
+      return field_error("travel_max", c.travel_max_v, "finite and above travel_min " + core::format_number(c.travel_min_v));
   }
   for (std::size_t i = 0; i < A.size(); ++i)
     if (!std::isfinite(A[i])) return core::invalid_argument("pp-traj: the model's A[" + std::to_string(i) + "] is not finite");
@@ -133,6 +135,8 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
     p.approach.max_retries = static_cast<int>(c.max_retries);
     p.approach.settle_samples = static_cast<std::size_t>(std::max(1.0, std::round(c.approach_settle_s / Ts)));
     p.approach.Ts = Ts;
+    p.approach.travel_min_v = c.travel_min_v;
+    p.approach.travel_max_v = c.travel_max_v;
   }
   return p;
 }

@@ -65,6 +65,9 @@ struct TrajectoryConfig {
   double retry_band_v = 0.006;        // a stop further than this from the target is approached again, V (0.3 mm)
   double max_retries = 3.0;           // approaches again at most this often (a whole number 0..10)
   double approach_settle_s = 0.15;    // from the cut to judging the stop, s
+  // Where its back-off legs may go, V: the sensor's span unless the appliance narrows it to the
+  // loop's setpoint range (runtime/tuning.hpp, with_travel_range). Not a tuning parameter.
+  double travel_min_v = 0.0, travel_max_v = 10.0;
 };
 
 // Validated parameters with everything precomputed for the loop.

@@ -2,6 +2,7 @@
 // A tuning set ready for the loop: validated parameters of all four laws from one base
 // configuration, so switching the controller is a lookup at a cycle boundary, never a rebuild.
 #include "control/controller.hpp"
+#include "runtime/runtime_config.hpp"
 
 namespace epa::runtime {
 
@@ -39,6 +40,15 @@ inline core::Result<Tuning> make_tuning(control::ControllerConfig base) {
     *slots[i] = *p;
   }
   return t;
+}
+
+// `config` with pp-traj's back-off legs kept within the loop's setpoint range (control/
+// sliding_approach.hpp): a position the loop accepts as a target is one it may pass through.
+// Every tuning the appliance gives the loop goes through here (the first and each replacement).
+inline control::ControllerConfig with_travel_range(control::ControllerConfig config, const RuntimeConfig& rules) {
+  config.trajectory.travel_min_v = rules.setpoint_min_mm / rules.mm_per_volt;
+  config.trajectory.travel_max_v = rules.setpoint_max_mm / rules.mm_per_volt;
+  return config;
 }
 
 }  // namespace epa::runtime

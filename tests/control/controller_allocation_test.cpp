@@ -40,5 +40,25 @@ TEST(Allocation, TenThousandControllerStepsAllocateNothing) {
   }
 }
 
+TEST(Allocation, PpTrajArrivingWhileSlidingAllocatesNothing) {
+  auto config = paper_controller_config(ControllerKind::kPpTraj);
+  config.trajectory.coast_s = 0.025;  // the sliding arrival (sliding_approach.hpp): legs, cuts, retries
+  auto params = ControllerParams::make(config);
+  ASSERT_TRUE(params.has_value());
+  auto plant = plant::HammersteinPlant::make(core::paper::model(), {.noise_std_mm = 0.1});
+  ASSERT_TRUE(plant.has_value());
+  ControllerState state;
+  double sink = 0.0;
+  const long before = epa::testing::allocation_count();
+  for (int k = 0; k < 10000; ++k) {
+    const double r_v = (k / 2000) % 2 == 0 ? 4.0 : 4.5;  // short moves too: back-offs
+    const auto out = controller_step(*params, state, r_v, plant->measured_v());
+    plant->step(out.valve_v);
+    sink += out.valve_v;
+  }
+  EXPECT_EQ(epa::testing::allocation_count() - before, 0);
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
 }  // namespace
 }  // namespace epa::control

@@ -87,6 +87,27 @@ TEST(SlidingApproach, AShortMoveBacksOffFirstSoThatItsFinalApproachIsAWholeAppro
   EXPECT_LE(*std::max_element(t.y.begin(), t.y.end()), 2.5 + l.retry_band_v);
 }
 
+TEST(SlidingApproach, AShortMoveNearAnEndApproachesFromTheFarSideRatherThanBackOffBeyondTheEnd) {
+  const auto l = limits();
+  ApproachState s;
+  const Trace t = run(l, s, 0.3, 0.6, 5.0);  // 15 mm up from 15 mm: the near side's back-off point is -20 mm
+  EXPECT_GE(*std::min_element(t.y.begin(), t.y.end()), l.travel_min_v);
+  EXPECT_NEAR(*std::max_element(t.y.begin(), t.y.end()), 0.6 + l.length_v, 0.05) << "backed off beyond the target";
+  EXPECT_NEAR(t.y.back(), 0.6, l.retry_band_v);
+  EXPECT_EQ(s.final_direction, -1.0);
+}
+
+TEST(SlidingApproach, ASetpointChangedMidMoveContinuesFromThePistonsSpeed) {
+  const auto l = limits();
+  ApproachState s;
+  Trace t = run(l, s, 0.0, 8.0, 0.5);  // cruising upwards
+  const double speed = (t.y.back() - t.y[t.y.size() - 2]) / kTs;
+  ASSERT_GT(speed, 4.0);
+  const double y = t.y.back();
+  approach_step(l, s, 6.0, y);  // a new target ahead
+  EXPECT_GT(s.path_speed_v_s, 0.8 * speed) << "the new leg starts at the piston's speed, not from rest";
+}
+
 TEST(SlidingApproach, ACoastTheLawGetsWrongIsCorrectedByRetriesFromTheSameSide) {
   const auto l = limits(0.5 * kLagS);  // the law expects half the coast: it cuts too late
   ApproachState s;

@@ -7,16 +7,15 @@ the appliance over HTTP, unattended, with a shortened excitation.
     commission_test.py <epa binary> <source dir>
 
 Checks, each printed with its figures:
-  * deployed: `epa commission` exits 0 with verdict "deployed", the new set is the running and the
-    stored active set; then moves of 25-200 mm in both directions, commanded over HTTP like an HMI
-    would, hold the spec's limits, the overshoot within 20 % or 15 mm (one breakaway jump), as
-    the verification moves did (how many end within 1 mm is printed: the paper's laws have no
-    integral action and end 1-5 mm short on this rig);
-  * a verification limit the axis cannot meet (e_ss <= 0.02 mm with NG-IDZ: met on the noise-free
-    identified model, below the sensor noise on the axis): exit 2, verdict "rolled-back" at the
-    first move (or at identification, which can refuse an experiment), the previous set runs
-    again and is still the stored active set, the switches are in the audit trail, and the valve
-    command never left its +-5 V limits;
+  * deployed: `epa commission` with pp-traj and issue 19's limits (1 mm, 5 %) exits 0 with verdict
+    "deployed", the new set is the running and the stored active set; then moves of 25-200 mm in
+    both directions, commanded over HTTP like an HMI would, end within 1 mm with overshoot <= 5 %,
+    and closer to their targets on average than the paper's tuning did on the same rig before;
+  * a verification limit the axis cannot meet (e_ss <= 0.02 mm with NG-IDZ): exit 2, verdict
+    "rolled-back" before the axis moves with it (the simulation on the identified stick-slip model
+    already ends 0.5-1 mm off) or at the first move, or at identification (which can refuse an
+    experiment); the previous set runs again and is still the stored active set, a switch to the
+    new set and back is in the audit trail, and the valve command never left its +-5 V limits;
   * a wrong spec is refused before anything moves (HTTP 400, exit 1).
 Exit 1 on any failure. A run that failed while the machine itself stalled
 (tests/support/stall_monitor.py) is run once more; failing again on a machine as stalled, it has
@@ -119,10 +118,11 @@ HMI_TARGETS = (225, 275, 175, 275, 125, 325, 250, 50, 250, 450)  # moves of 25-2
 
 
 def hmi_moves(app):
-    """The same moves an HMI would command, each held 3 s: [(start, target, final, overshoot)]."""
+    """The same moves an HMI would command, each held 5 s (a retry of pp-traj's sliding arrival
+    takes about 1 s): [(start, target, final, overshoot)]."""
     out = []
     for target in HMI_TARGETS:
-        start, final, overshoot = move(app, target, 3.0)
+        start, final, overshoot = move(app, target, 5.0)
         out.append((start, target, final, overshoot))
     http(app, "POST", "/api/mode", {"mode": "stop"})
     return out
@@ -148,16 +148,14 @@ def run_once(epa, src):
                     f'[hal]\nbackend = "modbus-io"\n[hal.modbus_io]\nport = {plant.port}\nresponse_timeout_ms = 20\n',
                     web_static_dir=os.path.join(src, "web"), web_extra=f'token = "{TOKEN}"\n')
     try:
-        # The paper's laws have no integral action: on this rig they end 1-4 mm short (friction, a dead
-        # band the model can only approximate), so the spec asks for what they can hold; a 2 % band
-        # of a 100 mm move is as wide as that offset, so settling is not judged. The verification
-        # moves cover the sizes the HMI moves below command, both ways (100-200 mm, then +25 and
-        # -50 mm): on an axis with stick-slip, a short move's overshoot can be one breakaway jump
-        # (10-13 mm measured: 26 % of a 50 mm move), which long moves alone would not show, so the
-        # overshoot limit is 20 % or 15 mm, whichever is larger.
-        base = {"excitation_runs": 2, "excitation_s": 40, "seed": 3, "controller": "pp-ffidz", "settling_s": 0.3,
-                "overshoot_pct": 0, "moves_mm": [150, 350, 250, 275, 225], "move_hold_s": 4,
-                "limits": {"ess_mm": 8, "overshoot_pct": 20, "overshoot_mm": 15, "settling_s": 0}}
+        # Issue 19's limits with pp-traj: identification finds that a stick-slip model describes this
+        # rig, so pp-traj arrives while sliding (README, pp-traj). The verification moves cover the
+        # sizes the HMI moves below command, both ways (100-200 mm, then -25 and +50 mm: a short
+        # move is where a breakaway would overshoot). A move that needs a retry takes 2-3 s, so each
+        # is held 6 s (the metrics read the last 2 s) and settling is not judged.
+        base = {"excitation_runs": 2, "excitation_s": 40, "seed": 3, "controller": "pp-traj", "settling_s": 0.3,
+                "overshoot_pct": 0, "moves_mm": [150, 350, 250, 225, 275], "move_hold_s": 6,
+                "limits": {"ess_mm": 1, "overshoot_pct": 5, "overshoot_mm": 0, "settling_s": 0}}
         before = http(app, "GET", "/api/status")[1]["store"]["tuning_set"]
         paper_moves = hmi_moves(app)  # the paper's tuning, which the appliance starts with
         print(f"      before commissioning ({before}): {summary(paper_moves)}")
@@ -194,16 +192,22 @@ def run_once(epa, src):
                       f"(spec: {limits['ess_mm']} mm), overshoot {overshoot:.1f} % = {overshoot_mm:.2f} mm "
                       f"(spec: {limits['overshoot_pct']} % or {limits['overshoot_mm']} mm)")
             print(f"      after commissioning (rig-1): {summary(deployed_moves)}")
+            mean_error = lambda moves: sum(abs(final - target) for _, target, final, _ in moves) / len(moves)
+            check(mean_error(deployed_moves) < mean_error(paper_moves),
+                  f"closer than the paper's tuning on the same rig: mean |error| {mean_error(deployed_moves):.2f} mm "
+                  f"against {mean_error(paper_moves):.2f} mm")
 
-        # A verification limit the axis cannot meet: NG-IDZ ends on the noise-free identified model
-        # within 0.01 mm (the simulation passes); on the axis the mean |error| over 2 s cannot fall
-        # below the sensor noise's 0.04 mm, so e_ss <= 0.02 mm fails at the first move: rolled back.
+        # A verification limit the axis cannot meet: on the axis the mean |error| over 2 s cannot fall
+        # below the sensor noise's 0.04 mm, so e_ss <= 0.02 mm fails at the first move. Since the
+        # simulation runs on the stick-slip model that describes this rig, where NG-IDZ already stops
+        # 0.5-1 mm off, it usually rolls back before the new set reaches the axis (on a Hammerstein
+        # model, where NG-IDZ ends within 0.01 mm, it rolled back at the first move).
         r, outcome, _, took = commission(epa, app, dict(base, controller="pp-ngidz", limits={"ess_mm": 0.02, "overshoot_pct": 15, "settling_s": 0},
                                                         name="rig-2"), folder, "rolled-back")
         # (Identification can also refuse these runs, a side of the dead zone not identified: then the
         # roll-back comes before the axis, which the checks below hold as well.)
         stage = outcome and outcome["failed_stage"]
-        check(r.returncode == 2 and outcome and outcome["verdict"] == "rolled-back" and stage in ("verifying", "identifying"),
+        check(r.returncode == 2 and outcome and outcome["verdict"] == "rolled-back" and stage in ("verifying", "simulating", "identifying"),
               f"a limit the axis cannot meet: exit 2, verdict rolled-back at stage {stage} in {took:.0f} s ({outcome and outcome['reason']})")
         status = http(app, "GET", "/api/status")[1]
         check(status["store"]["tuning_set"] == "rig-1", f"the previous set runs again ({status['store']['tuning_set']})")
