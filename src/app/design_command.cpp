@@ -11,7 +11,9 @@
 #include "app/tuning_source.hpp"
 #include "control/diophantine.hpp"
 #include "control/pole_placement_design.hpp"
+#include "core/format.hpp"
 #include "core/paper_reference.hpp"
+#include "plant/stick_slip_model.hpp"
 
 namespace epa::app {
 
@@ -193,6 +195,13 @@ int run_design(const DesignOptions& o, std::ostream& out, std::ostream& err) {
     set.dead_zone = m.dead_zone;
     set.lc_mm = core::paper::kLcDefaultMm;
     set.valve_limit_v = core::paper::kValveLimitV;
+    // pp-traj arrives while sliding when the model file says a stick-slip model describes the axis.
+    set.trajectory.coast_s = plant::sliding_arrival_coast_s(*model_file, set.trajectory.approach_speed_mm_s);
+    if (!std::isfinite(set.trajectory.coast_s))
+      return err << "epa design: --save: the model's [stick_slip] table does not slide at pp-traj's approach speed\n", 1;
+    if (set.trajectory.coast_s > 0.0)
+      out << "pp-traj in this set arrives while sliding (the model file's axis_model is stick-slip): coast "
+          << core::format_number(1e3 * set.trajectory.coast_s) << " ms at " << set.trajectory.approach_speed_mm_s << " mm/s\n";
     auto id = save_tuning_set(o.db_path, model, set);
     if (!id) return err << "epa design: --save: " << id.error().message << "\n", 1;
     out << "saved as tuning set '" << o.save_name << "' (id " << *id << ") in " << o.db_path

@@ -13,6 +13,7 @@
 #include "store/run_table.hpp"
 #include "store/set_activation.hpp"
 #include "store/store_file.hpp"
+#include "store/trajectory_settings.hpp"
 #include "store/transaction.hpp"
 #include "store/tuning_file.hpp"
 #include "store/tuning_set_table.hpp"
@@ -73,7 +74,7 @@ std::string poly_text(const core::Polynomial& p) {
 
 // Field name and value, in the order `show` prints and `diff` compares them.
 std::vector<std::pair<std::string, std::string>> fields(const store::TuningSet& t, const store::ModelRecord& m) {
-  return {{"name", t.name},
+  std::vector<std::pair<std::string, std::string>> out = {{"name", t.name},
           {"source", t.source},
           {"created", iso_time(t.created_ms)},
           {"modified", iso_time(t.modified_ms)},
@@ -87,14 +88,19 @@ std::vector<std::pair<std::string, std::string>> fields(const store::TuningSet& 
           {"dead_zone b_l V", core::format_number(t.dead_zone.b_l)},
           {"lc_mm", core::format_number(t.lc_mm)},
           {"valve_limit_v", core::format_number(t.valve_limit_v)},
-          {"design", t.design_json},
-          {"model", m.name + " (id " + std::to_string(m.id) + ")"},
-          {"model source", m.source},
-          {"model A", poly_text(m.model.A)},
-          {"model B", poly_text(m.model.B)},
-          {"model Ts s", core::format_number(m.model.Ts)},
-          {"model mm_per_volt", core::format_number(m.model.mm_per_volt)},
-          {"model fit", m.fit_json}};
+          {"design", t.design_json}};
+  for (const auto& [key, value] : store::trajectory_setting_values(t.trajectory))  // pp-traj's own parameters
+    out.emplace_back("pp-traj " + key, core::format_number(value));
+  const std::pair<std::string, std::string> model_fields[] = {
+      {"model", m.name + " (id " + std::to_string(m.id) + ")"},
+      {"model source", m.source},
+      {"model A", poly_text(m.model.A)},
+      {"model B", poly_text(m.model.B)},
+      {"model Ts s", core::format_number(m.model.Ts)},
+      {"model mm_per_volt", core::format_number(m.model.mm_per_volt)},
+      {"model fit", m.fit_json}};
+  out.insert(out.end(), std::begin(model_fields), std::end(model_fields));
+  return out;
 }
 
 std::string number_or_dash(const std::optional<double>& v) { return v ? core::format_number(*v) : "-"; }
