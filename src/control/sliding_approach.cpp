@@ -58,7 +58,10 @@ void plan(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noe
     return;
   }
   s.final_direction = move > 0.0 ? 1.0 : -1.0;
-  const bool straight_in = std::abs(move) >= l.length_v;
+  // Straight in when the move is a whole approach long, or when the piston already slides towards
+  // the target (a setpoint that moved and stopped ahead of it): the back-off is for starts from rest.
+  const bool sliding_towards = s.final_direction * reading_slope(s, l.Ts) >= 0.5 * l.speed_v_s;
+  const bool straight_in = std::abs(move) >= l.length_v || sliding_towards;
   if (!straight_in) {
     const double back_off_v = r_v - s.final_direction * l.length_v;
     if (back_off_v < l.travel_min_v || back_off_v > l.travel_max_v) s.final_direction = -s.final_direction;
@@ -75,10 +78,16 @@ void plan(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noe
 
 void approach_reset(ApproachState& state) noexcept { state = {}; }
 
-ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noexcept {
+void approach_observe(ApproachState& s, double y_v) noexcept {
   for (std::size_t i = s.readings.size() - 1; i > 0; --i) s.readings[i] = s.readings[i - 1];
   s.readings[0] = y_v;
   s.reading_count = std::min(s.reading_count + 1, s.readings.size());
+}
+
+double approach_speed_v_s(const ApproachState& s, double Ts) noexcept { return reading_slope(s, Ts); }
+
+ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noexcept {
+  approach_observe(s, y_v);
 
   ApproachOutput out;
   if (s.phase == ApproachPhase::kIdle || r_v != s.planned_r_v) {

@@ -22,8 +22,9 @@
 //            cuts with it: the model's coast is a first guess (on an axis the identification saw
 //            through a slower I/O path it was 1-3 mm long), and the coast also depends on where
 //            along the stroke the piston is (the air spring stiffens near an end)
-//   short    a move shorter than length_v backs off first, so that every final approach is a
-//            steady slide of length_v, not the breakaway jump of a start from rest; from the far
+//   short    a move shorter than length_v backs off first (unless the piston already slides
+//            towards the target), so that every final approach is a steady slide, not the
+//            breakaway jump of a start from rest; from the far
 //            side of the target when the near side's back-off point lies outside
 //            [travel_min_v, travel_max_v] (the loop's setpoint range: a target near an end)
 //   hold     the valve stays centred until the setpoint changes or the piston is pushed more than
@@ -77,8 +78,15 @@ struct ApproachOutput {
   double drive_fraction = 1.0;  // of the law's drive to apply (< 1 in the sample before a cut)
 };
 
-// One sample. The first call (or any after approach_reset) plans from y_v.
+// One sample. The first call (or any after approach_reset, or with the phase set to kIdle) plans
+// from y_v.
 ApproachOutput approach_step(const ApproachLimits& limits, ApproachState& state, double r_v, double y_v) noexcept;
+
+// Takes a reading without stepping (while another law follows the reference), so that a plan made
+// later starts from the piston's speed.
+void approach_observe(ApproachState& state, double y_v) noexcept;
+// The piston's speed from the last readings, V/s (least-squares slope of 4; 0 until there are 4).
+double approach_speed_v_s(const ApproachState& state, double Ts) noexcept;
 
 void approach_reset(ApproachState& state) noexcept;
 

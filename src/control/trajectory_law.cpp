@@ -182,7 +182,26 @@ TrajectoryOutput approach_trajectory_step(const TrajectoryParams& p, TrajectoryS
 TrajectoryOutput trajectory_step(const TrajectoryParams& p, TrajectoryState& s, double r_v, double y_v,
                                  int saturated_sign_last) noexcept {
   if (!s.profile.started) trajectory_reset(p, s, y_v);
-  if (p.sliding_approach) return approach_trajectory_step(p, s, r_v, y_v);
+  if (p.sliding_approach) {
+    s.reference_changes = r_v != s.last_r_v ? std::min(s.reference_changes + 1, 2) : 0;
+    s.last_r_v = r_v;
+    if (s.reference_changes < 2) {
+      if (s.following_reference) {  // the reference stands: plan the arrival from the piston
+        s.following_reference = false;
+        s.approach.phase = ApproachPhase::kIdle;
+      }
+      return approach_trajectory_step(p, s, r_v, y_v);
+    }
+    if (!s.following_reference) {  // the reference moves: the profile law from the piston, at its speed
+      const ApproachState approach = s.approach;  // its readings and the coast it learned
+      trajectory_reset(p, s, y_v, approach_speed_v_s(approach, p.limits.Ts));
+      s.approach = approach;
+      s.last_r_v = r_v;
+      s.reference_changes = 2;
+      s.following_reference = true;
+    }
+    approach_observe(s.approach, y_v);
+  }
   for (std::size_t i = kMaxLawOrder; i > 0; --i) s.w[i] = s.w[i - 1];
   s.w[0] = motion_profile_step(p.limits, s.profile, r_v);
   double y_d = 0.0, u_ff = 0.0;

@@ -26,8 +26,12 @@
 //
 // With coast_s > 0 (an axis with stick-slip: the identified stick-slip model's coast, README) the
 // reference comes from sliding_approach.hpp instead of the motion profile, and the law arrives by
-// centring the valve while the piston still slides: no integrator, no creeping inverse.
+// centring the valve while the piston still slides: no integrator, no creeping inverse. A setpoint
+// that moves sample after sample (a halt's braking, a jog, a move with a speed limit:
+// runtime/axis_motion.hpp) is followed as above meanwhile; the sliding arrival takes over, from
+// the piston, once it stands still.
 #include <array>
+#include <cmath>
 
 #include "control/motion_profile.hpp"
 #include "control/rst_law.hpp"  // kMaxLawOrder
@@ -96,6 +100,10 @@ struct TrajectoryState {
   double creep_margin_v = 0.0;  // the creeping inverse's margin now: 0 while moving, growing after arrival
   bool holding = false;
   ApproachState approach;
+  // The sliding arrival follows a reference that moves sample after sample with the law above.
+  double last_r_v = NAN;
+  int reference_changes = 0;      // consecutive samples in which r changed (counted to 2)
+  bool following_reference = false;
 };
 
 // The model's top speed in each direction at the valve limit, V/s, from A = (1 - q) A1 (the plant

@@ -6,6 +6,7 @@
 // that describes the axis for its coast.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -107,6 +108,26 @@ TEST(PpTrajSliding, WithTwoSamplesOfDelayTheModelDoesNotKnowItStillEndsWithinThe
       EXPECT_LE(std::abs(r.run.y_mm.back() - (from + step)), 0.3);
       EXPECT_EQ(valve_sign_changes_in_last(r, 1.0), 0u);
     }
+}
+
+// A halt's braking, a jog or a move with a speed limit hands the law a reference that moves sample
+// after sample (runtime/axis_motion.hpp): it is followed, and the arrival takes over once it stands.
+TEST(PpTrajSliding, AMovingReferenceIsFollowedAndTheArrivalTakesOverWhereItStops) {
+  const auto params = pp_traj_for(identified());
+  auto plant = plant::make_pneumatic_simulator(plant::PneumaticParams{}, {.initial_position_mm = 150.0});
+  ASSERT_TRUE(plant.has_value());
+  control::ControllerState state;
+  double worst_lag_mm = 0.0, r_mm = 150.0;
+  for (int k = 0; k < 1000; ++k) {  // 5 s: a ramp at 100 mm/s for 1.5 s (to 299.5 mm), then 3.5 s standing
+    if (k < 300) r_mm = 150.0 + 100.0 * 0.005 * k;
+    const double y_mm = (*plant)->measured_v() * 50.0;
+    if (k >= 100 && k < 300) worst_lag_mm = std::max(worst_lag_mm, std::abs(r_mm - y_mm));
+    const auto out = control::controller_step(params, state, r_mm / 50.0, (*plant)->measured_v());
+    ASSERT_FALSE(out.fault);
+    (*plant)->step(out.valve_v);
+  }
+  EXPECT_LT(worst_lag_mm, 15.0) << "followed the ramp";
+  EXPECT_NEAR((*plant)->measured_v() * 50.0, r_mm, 0.3) << "and arrived where it stopped";
 }
 
 TEST(PpTrajSliding, TheSameLawWithoutTheCoastHuntsOnThisPlant) {
