@@ -97,10 +97,10 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
     const double error = s.planned_r_v - y_mean;
     if (s.final_leg && s.cut_speed_v_s >= 0.5 * l.speed_v_s && s.cut_speed_v_s <= 1.5 * l.speed_v_s) {
       // A stop off by e after a steady slide at v: the next cut this way assumes a coast longer by
-      // e / v, by at most 30 % of the model's per stop (a cut in a breakaway, or a loop that
+      // e / v, by at most the model's coast per stop (a cut in a breakaway, or a loop that
       // stalled, must not teach it a coast it then keeps), within a quarter to 4 times it.
       const double correction_s = s.final_direction * (y_mean - s.planned_r_v) / s.cut_speed_v_s;
-      const double step_limit_s = 0.3 * l.coast_s;
+      const double step_limit_s = l.coast_s;
       s.coast_s = std::clamp(s.coast_s + std::clamp(correction_s, -step_limit_s, step_limit_s), 0.25 * l.coast_s, 4.0 * l.coast_s);
       s.learned_coast_s[direction_index(s.final_direction)] = s.coast_s;
     }
