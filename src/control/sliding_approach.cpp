@@ -29,22 +29,23 @@ void hold(ApproachState& s, double at_v) noexcept {
 
 std::size_t direction_index(double direction) noexcept { return direction > 0.0 ? 0 : 1; }
 
-// A leg from the piston at from_v; the path starts at the piston's speed along it (a setpoint
-// changed mid-move does not first stop the piston).
-void start_leg(ApproachState& s, double target_v, double direction, bool final_leg, double from_v, double Ts) noexcept {
+// A leg from the piston at from_v; the path starts at the piston's speed along it when the piston
+// slides that way (a setpoint changed mid-move does not first stop the piston), else from rest.
+void start_leg(const ApproachLimits& l, ApproachState& s, double target_v, double direction, bool final_leg, double from_v) noexcept {
   s.phase = ApproachPhase::kLeg;
   s.leg_target_v = target_v;
   s.leg_direction = direction;
   s.final_leg = final_leg;
   s.path_v = from_v;
-  s.path_speed_v_s = std::max(0.0, direction * reading_slope(s, Ts));
+  const double sliding = direction * reading_slope(s, l.Ts);
+  s.path_speed_v_s = sliding >= 0.5 * l.speed_v_s ? sliding : 0.0;
   s.samples_in_phase = 0;
 }
 
 // The back-off before an approach: to one approach length before the target, from where the piston is.
 void back_off(const ApproachLimits& l, ApproachState& s, double y_v) noexcept {
   const double to_v = s.planned_r_v - s.final_direction * l.length_v;
-  start_leg(s, to_v, y_v < to_v ? 1.0 : -1.0, false, y_v, l.Ts);
+  start_leg(l, s, to_v, y_v < to_v ? 1.0 : -1.0, false, y_v);
 }
 
 // Plans a move to r from rest at y: straight in when it is at least one approach long, else back
@@ -69,7 +70,7 @@ void plan(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noe
   const double learned = s.learned_coast_s[direction_index(s.final_direction)];
   s.coast_s = learned > 0.0 ? learned : l.coast_s;
   if (straight_in)
-    start_leg(s, r_v, s.final_direction, true, y_v, l.Ts);
+    start_leg(l, s, r_v, s.final_direction, true, y_v);
   else
     back_off(l, s, y_v);
 }
@@ -85,6 +86,22 @@ void approach_observe(ApproachState& s, double y_v) noexcept {
 }
 
 double approach_speed_v_s(const ApproachState& s, double Ts) noexcept { return reading_slope(s, Ts); }
+
+void approach_after_moving_reference(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noexcept {
+  const double direction = r_v > y_v ? 1.0 : -1.0;
+  if (direction * reading_slope(s, l.Ts) >= 0.5 * l.speed_v_s) {
+    plan(l, s, r_v, y_v);     // straight in: it slides towards r
+    s.retries = l.max_retries;  // one cut, then held wherever it stops
+    return;
+  }
+  s.planned_r_v = r_v;
+  s.final_direction = direction;
+  s.final_leg = true;
+  s.retries = l.max_retries;  // judged after the coast: held wherever it stopped
+  s.cut_speed_v_s = 0.0;      // and nothing learned from it
+  s.phase = ApproachPhase::kCoasting;
+  s.samples_in_phase = 0;
+}
 
 ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noexcept {
   approach_observe(s, y_v);
@@ -105,7 +122,7 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
       s.learned_coast_s[direction_index(s.final_direction)] = s.coast_s;
     }
     if (!s.final_leg) {
-      start_leg(s, s.planned_r_v, s.final_direction, true, y_mean, l.Ts);
+      start_leg(l, s, s.planned_r_v, s.final_direction, true, y_mean);
     } else if (std::abs(error) <= l.retry_band_v || s.retries >= l.max_retries) {
       hold(s, y_mean);
     } else {
@@ -143,6 +160,7 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
   // Braking reads the nearer of the path and the piston: a piston that runs ahead of the path (a
   // plant faster than its model) still arrives at the approach speed.
   const double left_v = std::min(dir * (s.leg_target_v - s.path_v), dir * (s.leg_target_v - y_v));
+  out.speed_v_s = dir * s.path_speed_v_s;  // before this sample's change: a leg's history runs at it
   const double top = dir > 0.0 ? l.top_speed_pos_v_s : l.top_speed_neg_v_s;
   const double scheduled =
       left_v < -l.length_v ? 0.0

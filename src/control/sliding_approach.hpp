@@ -75,12 +75,19 @@ struct ApproachOutput {
   double w_v = 0.0;          // the reference w(k)
   bool hold = false;         // valve centred
   bool leg_started = false;  // a leg starts here: the caller restarts its reference history and filters at w_v
+  double speed_v_s = 0.0;    // the reference's speed before this sample, signed (at a leg's start: the speed its history ran at)
   double drive_fraction = 1.0;  // of the law's drive to apply (< 1 in the sample before a cut)
 };
 
 // One sample. The first call (or any after approach_reset, or with the phase set to kIdle) plans
 // from y_v.
 ApproachOutput approach_step(const ApproachLimits& limits, ApproachState& state, double r_v, double y_v) noexcept;
+
+// After a reference that moved (a halt's braking, a jog, a move with a speed limit) has come to
+// stand at r: a piston still sliding towards r at half the approach speed or more is cut at its
+// predicted stop, one that does not is let coast; either is then held where it stops, never
+// backed off and approached again (a halt or a released jog must not set off a new move).
+void approach_after_moving_reference(const ApproachLimits& limits, ApproachState& state, double r_v, double y_v) noexcept;
 
 // Takes a reading without stepping (while another law follows the reference), so that a plan made
 // later starts from the piston's speed.

@@ -160,8 +160,8 @@ TrajectoryOutput approach_trajectory_step(const TrajectoryParams& p, TrajectoryS
     out.arrived = true;
     return out;
   }
-  if (a.leg_started) {  // from rest: no history of an earlier reference, nothing filtered
-    s.w.fill(a.w_v);
+  if (a.leg_started) {  // a reference that has run at its speed so far (0: at rest), nothing filtered
+    for (std::size_t i = 0; i < s.w.size(); ++i) s.w[i] = a.w_v - a.speed_v_s * p.limits.Ts * static_cast<double>(i + 1);
     s.feedback_stage1_v = s.feedback_stage2_v = s.filtered_error_v = 0.0;
   }
   s.holding = false;
@@ -186,9 +186,9 @@ TrajectoryOutput trajectory_step(const TrajectoryParams& p, TrajectoryState& s, 
     s.reference_changes = r_v != s.last_r_v ? std::min(s.reference_changes + 1, 2) : 0;
     s.last_r_v = r_v;
     if (s.reference_changes < 2) {
-      if (s.following_reference) {  // the reference stands: plan the arrival from the piston
+      if (s.following_reference) {  // the reference stands: arrive from the piston, or hold where it stops
         s.following_reference = false;
-        s.approach.phase = ApproachPhase::kIdle;
+        approach_after_moving_reference(p.approach, s.approach, r_v, y_v);
       }
       return approach_trajectory_step(p, s, r_v, y_v);
     }

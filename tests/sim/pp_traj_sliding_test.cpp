@@ -111,7 +111,9 @@ TEST(PpTrajSliding, WithTwoSamplesOfDelayTheModelDoesNotKnowItStillEndsWithinThe
 }
 
 // A halt's braking, a jog or a move with a speed limit hands the law a reference that moves sample
-// after sample (runtime/axis_motion.hpp): it is followed, and the arrival takes over once it stands.
+// after sample (runtime/axis_motion.hpp): it is followed, and once it stands the piston, still
+// sliding towards it, is cut at its predicted stop once (no retry after a moving reference, so that
+// a halt never sets off a back-off): within a first approach's millimetre.
 TEST(PpTrajSliding, AMovingReferenceIsFollowedAndTheArrivalTakesOverWhereItStops) {
   const auto params = pp_traj_for(identified());
   auto plant = plant::make_pneumatic_simulator(plant::PneumaticParams{}, {.initial_position_mm = 150.0});
@@ -127,7 +129,34 @@ TEST(PpTrajSliding, AMovingReferenceIsFollowedAndTheArrivalTakesOverWhereItStops
     (*plant)->step(out.valve_v);
   }
   EXPECT_LT(worst_lag_mm, 15.0) << "followed the ramp";
-  EXPECT_NEAR((*plant)->measured_v() * 50.0, r_mm, 0.3) << "and arrived where it stopped";
+  EXPECT_NEAR((*plant)->measured_v() * 50.0, r_mm, 1.0) << "and arrived where it stopped";
+  EXPECT_EQ(state.trajectory.approach.phase, control::ApproachPhase::kHolding);
+}
+
+// A halt: the reference brakes to a stop point and stands there. The piston (lagging the reference
+// by 6-10 mm) is cut or let coast and held where it stops, near that point, and no new move starts
+// (no back-off of 50 mm and approach again after a halt).
+TEST(PpTrajSliding, AfterAHaltsBrakingThePistonIsHeldWhereItStopsWithoutANewMove) {
+  const auto params = pp_traj_for(identified());
+  auto plant = plant::make_pneumatic_simulator(plant::PneumaticParams{}, {.initial_position_mm = 150.0});
+  ASSERT_TRUE(plant.has_value());
+  control::ControllerState state;
+  double r_mm = 150.0, speed_mm_s = 0.0;
+  double furthest_after_mm = 0.0, stop_mm = 0.0;
+  for (int k = 0; k < 1000; ++k) {  // up to 150 mm/s, then braking at 1500 mm/s^2, then standing
+    if (k < 200) speed_mm_s = std::min(150.0, speed_mm_s + 1500.0 * 0.005);
+    else speed_mm_s = std::max(0.0, speed_mm_s - 1500.0 * 0.005);
+    r_mm += speed_mm_s * 0.005;
+    const double y_mm = (*plant)->measured_v() * 50.0;
+    if (k == 230) stop_mm = r_mm;  // the reference stands from here on
+    if (k > 230) furthest_after_mm = std::max(furthest_after_mm, std::abs(y_mm - stop_mm));
+    const auto out = control::controller_step(params, state, r_mm / 50.0, (*plant)->measured_v());
+    ASSERT_FALSE(out.fault);
+    (*plant)->step(out.valve_v);
+  }
+  ASSERT_EQ(r_mm, stop_mm);
+  EXPECT_LT(furthest_after_mm, 15.0) << "no back-off after the halt (it is 50 mm)";
+  EXPECT_EQ(state.trajectory.approach.phase, control::ApproachPhase::kHolding);
 }
 
 TEST(PpTrajSliding, TheSameLawWithoutTheCoastHuntsOnThisPlant) {
