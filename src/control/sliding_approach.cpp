@@ -48,8 +48,8 @@ void back_off(const ApproachLimits& l, ApproachState& s, double y_v) noexcept {
   start_leg(l, s, to_v, y_v < to_v ? 1.0 : -1.0, false, y_v);
 }
 
-// Plans a move to r from rest at y: straight in when it is at least one approach long, else back
-// off first so that the final approach is.
+// Plans a move to r from the piston at y: straight in when it is at least one approach long or the
+// piston already slides towards r, else back off first so that the final approach is a whole one.
 void plan(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noexcept {
   s.planned_r_v = r_v;
   s.retries = 0;
