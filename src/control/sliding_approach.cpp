@@ -77,8 +77,6 @@ void plan(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noe
 
 }  // namespace
 
-void approach_reset(ApproachState& state) noexcept { state = {}; }
-
 void approach_observe(ApproachState& s, double y_v) noexcept {
   for (std::size_t i = s.readings.size() - 1; i > 0; --i) s.readings[i] = s.readings[i - 1];
   s.readings[0] = y_v;

@@ -79,8 +79,7 @@ struct ApproachOutput {
   double drive_fraction = 1.0;  // of the law's drive to apply (< 1 in the sample before a cut)
 };
 
-// One sample. The first call (or any after approach_reset, or with the phase set to kIdle) plans
-// from y_v.
+// One sample. The first call (or any with the phase set to kIdle) plans from y_v.
 ApproachOutput approach_step(const ApproachLimits& limits, ApproachState& state, double r_v, double y_v) noexcept;
 
 // After a reference that moved (a halt's braking, a jog, a move with a speed limit) has come to
@@ -94,7 +93,5 @@ void approach_after_moving_reference(const ApproachLimits& limits, ApproachState
 void approach_observe(ApproachState& state, double y_v) noexcept;
 // The piston's speed from the last readings, V/s (least-squares slope of 4; 0 until there are 4).
 double approach_speed_v_s(const ApproachState& state, double Ts) noexcept;
-
-void approach_reset(ApproachState& state) noexcept;
 
 }  // namespace epa::control

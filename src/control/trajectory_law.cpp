@@ -149,6 +149,27 @@ void trajectory_reset(const TrajectoryParams& p, TrajectoryState& s, double y_v,
 
 namespace {
 
+// w(k) into the reference history; returns what the model's output does under it (y_d) and the
+// feed-forward that makes it so (u_ff): y_d = B w / B(1), u_ff = A w / B(1).
+struct ModelTracking {
+  double y_d = 0.0, u_ff = 0.0;
+};
+ModelTracking push_reference(const TrajectoryParams& p, TrajectoryState& s, double w_v) noexcept {
+  for (std::size_t i = kMaxLawOrder; i > 0; --i) s.w[i] = s.w[i - 1];
+  s.w[0] = w_v;
+  ModelTracking t;
+  for (std::size_t i = 0; i <= p.nB; ++i) t.y_d += p.B[i] * s.w[i];
+  for (std::size_t i = 0; i <= p.nA; ++i) t.u_ff += p.A[i] * s.w[i];
+  return t;
+}
+
+// The proportional feedback on the tracking error e through its second-order low-pass.
+double feedback_step(const TrajectoryParams& p, TrajectoryState& s, double e) noexcept {
+  s.feedback_stage1_v += p.feedback_filter_alpha * (e - s.feedback_stage1_v);
+  s.feedback_stage2_v += p.feedback_filter_alpha * (s.feedback_stage1_v - s.feedback_stage2_v);
+  return p.proportional_gain * s.feedback_stage2_v;
+}
+
 // pp-traj with arrival while sliding: the approach's reference through the same feed-forward and
 // feedback, the valve centred from the cut on.
 TrajectoryOutput approach_trajectory_step(const TrajectoryParams& p, TrajectoryState& s, double r_v, double y_v) noexcept {
@@ -165,15 +186,8 @@ TrajectoryOutput approach_trajectory_step(const TrajectoryParams& p, TrajectoryS
     s.feedback_stage1_v = s.feedback_stage2_v = s.filtered_error_v = 0.0;
   }
   s.holding = false;
-  for (std::size_t i = kMaxLawOrder; i > 0; --i) s.w[i] = s.w[i - 1];
-  s.w[0] = a.w_v;
-  double y_d = 0.0, u_ff = 0.0;
-  for (std::size_t i = 0; i <= p.nB; ++i) y_d += p.B[i] * s.w[i];
-  for (std::size_t i = 0; i <= p.nA; ++i) u_ff += p.A[i] * s.w[i];
-  const double e = y_d - y_v;
-  s.feedback_stage1_v += p.feedback_filter_alpha * (e - s.feedback_stage1_v);
-  s.feedback_stage2_v += p.feedback_filter_alpha * (s.feedback_stage1_v - s.feedback_stage2_v);
-  out.u = a.drive_fraction * (u_ff + p.proportional_gain * s.feedback_stage2_v);
+  const ModelTracking t = push_reference(p, s, a.w_v);
+  out.u = a.drive_fraction * (t.u_ff + feedback_step(p, s, t.y_d - y_v));
   return out;
 }
 
@@ -202,15 +216,11 @@ TrajectoryOutput trajectory_step(const TrajectoryParams& p, TrajectoryState& s, 
     }
     approach_observe(s.approach, y_v);
   }
-  for (std::size_t i = kMaxLawOrder; i > 0; --i) s.w[i] = s.w[i - 1];
-  s.w[0] = motion_profile_step(p.limits, s.profile, r_v);
-  double y_d = 0.0, u_ff = 0.0;
-  for (std::size_t i = 0; i <= p.nB; ++i) y_d += p.B[i] * s.w[i];
-  for (std::size_t i = 0; i <= p.nA; ++i) u_ff += p.A[i] * s.w[i];
+  const ModelTracking t = push_reference(p, s, motion_profile_step(p.limits, s.profile, r_v));
 
   // The tracking error against what the model's output does, not against r: y_d reaches r a few
   // samples after the profile (B's delay), and an integrator fed r - y meanwhile would wind up.
-  const double e = y_d - y_v;
+  const double e = t.y_d - y_v;
   s.filtered_error_v += p.filter_alpha * (e - s.filtered_error_v);
   bool arrived = motion_profile_arrived(p.limits, s.profile, r_v);
   for (std::size_t i = 0; arrived && i <= std::max(p.nA, p.nB); ++i) arrived = s.w[i] == r_v;
@@ -227,15 +237,13 @@ TrajectoryOutput trajectory_step(const TrajectoryParams& p, TrajectoryState& s, 
     if (direction != saturated_sign_last)  // anti-windup: no integrating further into the limit
       s.integral = std::clamp(s.integral + p.integral_gain * p.limits.Ts * ef, -p.integrator_limit, p.integrator_limit);
   }
-  s.feedback_stage1_v += p.feedback_filter_alpha * (e - s.feedback_stage1_v);
-  s.feedback_stage2_v += p.feedback_filter_alpha * (s.feedback_stage1_v - s.feedback_stage2_v);
-  const double u_fb = p.proportional_gain * s.feedback_stage2_v;
+  const double u_fb = feedback_step(p, s, e);
   // The creeping inverse takes over from NG-IDZ gradually: a margin that jumped at arrival would
   // step the drive by up to the margin's worth, and the printed B answers a step of its drive with
   // a spike at the Nyquist rate (NOTES.md), on a plant whose dead band or gain is not the model's.
   s.creep_margin_v = arrived ? std::min(p.creep_margin_v, s.creep_margin_v + p.creep_margin_step_v) : 0.0;
   TrajectoryOutput out;
-  out.u = u_ff + u_fb + s.integral;
+  out.u = t.u_ff + u_fb + s.integral;
   out.holding = s.holding;
   out.arrived = arrived;
   out.creep_margin_v = s.creep_margin_v;
