@@ -234,34 +234,42 @@ TEST_F(IdentifyCli, ThreeCommandsTakeRunFilesToAStepTable) {
 // On a cylinder with stiction the model file says the stick-slip model describes the axis, and a set
 // designed on it has pp-traj arrive while sliding; on the paper's plant neither (issue 17, 19).
 TEST_F(IdentifyCli, AStickSlipAxisIsRecordedInTheModelFileAndGivesPpTrajItsCoast) {
-  const auto est = excite("phys1.csv", 1, 30, " --plant physics"), val = excite("phys2.csv", 2, 30, " --plant physics");
   auto o = run_epa("serve --config " + std::string(EPA_SOURCE_DIR) + "/config/epa.toml --modbus-port 0 --web-port 0 " +
                    "--duration 0.2 --db " + path("epa.db") + " --record-dir " + path("runs"));
   ASSERT_EQ(o.exit_code, 0) << o.output;
-  o = run_epa("identify " + est + " --validate " + val + " --out " + path("phys.toml") + kSmallBudget);
-  ASSERT_EQ(o.exit_code, 0) << o.output;
-  auto model = epa::core::read_model_file(path("phys.toml"));
-  ASSERT_TRUE(model.has_value()) << model.error().message;
-  EXPECT_EQ(model->axis_model, epa::core::AxisModel::kStickSlip) << o.output;
-  o = run_epa("design --model " + path("phys.toml") + kDesignT + " --save on-physics --db " + path("epa.db"));
-  ASSERT_EQ(o.exit_code, 0) << o.output;
-  EXPECT_NE(o.output.find("arrives while sliding"), std::string::npos) << o.output;
-  o = run_epa("tuning --db " + path("epa.db") + " show on-physics");
-  ASSERT_EQ(o.exit_code, 0) << o.output;
-  EXPECT_NE(o.output.find("pp-traj coast_s: 0.0"), std::string::npos) << o.output;  // tens of ms
-  EXPECT_EQ(o.output.find("pp-traj coast_s: 0\n"), std::string::npos) << o.output;
+  // identify -> model file -> design --save -> tuning show, for one plant: the model file's axis, and
+  // what design and show said.
+  struct Outcome {
+    epa::core::AxisModel axis = epa::core::AxisModel::kHammerstein;
+    std::string design, show;
+  };
+  auto identify_and_save = [&](const std::string& est, const std::string& val, const std::string& name) {
+    Outcome out;
+    auto r = run_epa("identify " + est + " --validate " + val + " --out " + path(name + ".toml") + kSmallBudget);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    auto model = epa::core::read_model_file(path(name + ".toml"));
+    EXPECT_TRUE(model.has_value()) << (model ? "" : model.error().message);
+    if (model) out.axis = model->axis_model;
+    r = run_epa("design --model " + path(name + ".toml") + kDesignT + " --save on-" + name + " --db " + path("epa.db"));
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    out.design = r.output;
+    r = run_epa("tuning --db " + path("epa.db") + " show on-" + name);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    out.show = r.output;
+    return out;
+  };
 
-  const auto paper_est = excite("paper1.csv", 1, 60), paper_val = excite("paper2.csv", 2, 60);
-  o = run_epa("identify " + paper_est + " --validate " + paper_val + " --out " + path("paper.toml") + kSmallBudget);
-  ASSERT_EQ(o.exit_code, 0) << o.output;
-  model = epa::core::read_model_file(path("paper.toml"));
-  ASSERT_TRUE(model.has_value()) << model.error().message;
-  EXPECT_EQ(model->axis_model, epa::core::AxisModel::kHammerstein) << o.output;
-  o = run_epa("design --model " + path("paper.toml") + kDesignT + " --save on-paper --db " + path("epa.db"));
-  ASSERT_EQ(o.exit_code, 0) << o.output;
-  EXPECT_EQ(o.output.find("arrives while sliding"), std::string::npos) << o.output;
-  o = run_epa("tuning --db " + path("epa.db") + " show on-paper");
-  EXPECT_NE(o.output.find("pp-traj coast_s: 0\n"), std::string::npos) << o.output;
+  const auto physics = identify_and_save(excite("phys1.csv", 1, 30, " --plant physics"),
+                                         excite("phys2.csv", 2, 30, " --plant physics"), "physics");
+  EXPECT_EQ(physics.axis, epa::core::AxisModel::kStickSlip);
+  EXPECT_NE(physics.design.find("arrives while sliding"), std::string::npos) << physics.design;
+  EXPECT_NE(physics.show.find("pp-traj coast_s: 0.0"), std::string::npos) << physics.show;  // tens of ms
+  EXPECT_EQ(physics.show.find("pp-traj coast_s: 0\n"), std::string::npos) << physics.show;
+
+  const auto paper = identify_and_save(excite("paper1.csv", 1, 60), excite("paper2.csv", 2, 60), "paper");
+  EXPECT_EQ(paper.axis, epa::core::AxisModel::kHammerstein);
+  EXPECT_EQ(paper.design.find("arrives while sliding"), std::string::npos) << paper.design;
+  EXPECT_NE(paper.show.find("pp-traj coast_s: 0\n"), std::string::npos) << paper.show;
 }
 
 TEST_F(IdentifyCli, TheSameSeedGivesTheSameModelFile) {

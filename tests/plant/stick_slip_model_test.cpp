@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "../support/physics_identified_model.hpp"
+#include "core/model_file.hpp"
 #include "plant/pneumatic_plant.hpp"
 #include "plant/stick_slip_model.hpp"
 #include "plant/stick_slip_plant.hpp"
@@ -182,19 +184,11 @@ TEST(StickSlipPlant, TheEndStopsHoldThePistonAndTheSensorReadsItWithSeededNoise)
 // The coast pp-traj cuts with, checked against a plant of another form: the physics plant (chambers,
 // orifices, Stribeck friction) driven at a steady speed and centred, its coast measured as the law
 // reads speed (least-squares slope of 4 readings). The model is the one epa identify fitted to
-// open-loop runs of that plant (tests/sim/pp_traj_sliding_test.cpp has the whole file).
+// open-loop runs of that plant (support/physics_identified_model.hpp).
 TEST(StickSlipModel, ItsCoastTimeMatchesThePhysicsPlantsWithinAQuarter) {
-  StickSlipParams identified;
-  identified.break_right_v = 1.176969689128404;
-  identified.break_left_v = -1.683703334845168;
-  identified.speed_right_mm_s_per_v = 112.57081259160479;
-  identified.speed_left_mm_s_per_v = 109.02932094462616;
-  identified.spring_rad_s = 59.015440817565505;
-  identified.damping_ratio = 0.20904450655623621;
-  identified.coulomb_mm = 5.66702578402857;
-  identified.static_mm = 5.768196811811399;
-  identified.spool_lag_s = 0.013662491569187415;
-  identified.delay_samples = 1;
+  const auto file = core::parse_model_toml(epa::testing::kPhysicsIdentifiedModelToml, "identified");
+  ASSERT_TRUE(file.has_value() && file->stick_slip.has_value());
+  const StickSlipParams identified = *file->stick_slip;
   for (const double direction : {1.0, -1.0}) {
     SCOPED_TRACE(direction > 0 ? "outwards" : "inwards");
     PneumaticOptions options;
