@@ -196,9 +196,9 @@ int run_design(const DesignOptions& o, std::ostream& out, std::ostream& err) {
     set.lc_mm = core::paper::kLcDefaultMm;
     set.valve_limit_v = core::paper::kValveLimitV;
     // pp-traj arrives while sliding when the model file says a stick-slip model describes the axis.
-    set.trajectory.coast_s = plant::sliding_arrival_coast_s(*model_file, set.trajectory.approach_speed_mm_s);
-    if (!std::isfinite(set.trajectory.coast_s))
-      return err << "epa design: --save: the model's [stick_slip] table does not slide at pp-traj's approach speed\n", 1;
+    const auto coast = plant::sliding_arrival_coast_s(*model_file, set.trajectory.approach_speed_mm_s);
+    if (!coast) return err << "epa design: --save: " << coast.error().message << "\n", 1;
+    set.trajectory.coast_s = *coast;
     if (set.trajectory.coast_s > 0.0)
       out << "pp-traj in this set arrives while sliding (the model file's axis_model is stick-slip): coast "
           << core::format_number(1e3 * set.trajectory.coast_s) << " ms at " << set.trajectory.approach_speed_mm_s << " mm/s\n";

@@ -106,10 +106,9 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
 
   // pp-traj arrives while sliding when the model file says a stick-slip model describes the axis.
   store::TrajectorySettings trajectory;
-  trajectory.coast_s = plant::sliding_arrival_coast_s(*model_file, trajectory.approach_speed_mm_s);
-  if (!std::isfinite(trajectory.coast_s))
-    return err << "epa simulate: the model's [stick_slip] table does not slide at the approach speed ("
-               << trajectory.approach_speed_mm_s << " mm/s): no coast time for pp-traj\n", 1;
+  const auto coast = plant::sliding_arrival_coast_s(*model_file, trajectory.approach_speed_mm_s);
+  if (!coast) return err << "epa simulate: " << coast.error().message << "\n", 1;
+  trajectory.coast_s = *coast;
   std::vector<SimulationCase> cases;
   for (auto kind : kinds) {
     control::ControllerConfig config{.kind = kind, .F = polynomials->F, .G = polynomials->G, .H = polynomials->H,

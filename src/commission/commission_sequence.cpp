@@ -1,7 +1,6 @@
 #include "commission/commission_sequence.hpp"
 
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -187,10 +186,10 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
   // pp-traj arrives while sliding on an axis that a stick-slip model describes (its coast from it),
   // and approaches again when a stop is further off than half the verification's e_ss limit: a stop
   // it accepts then passes with margin, and it does not back off for precision nobody asked for.
-  set.trajectory.coast_s = plant::sliding_arrival_coast_s(
+  const auto coast = plant::sliding_arrival_coast_s(
       core::ModelFile{identified->model, "", identified->stick_slip, identified->axis_model}, set.trajectory.approach_speed_mm_s);
-  if (!std::isfinite(set.trajectory.coast_s))
-    return finish(Verdict::kRolledBack, "design: the identified stick-slip model does not slide at pp-traj's approach speed", out);
+  if (!coast) return finish(Verdict::kRolledBack, "design: " + coast.error().message, out);
+  set.trajectory.coast_s = *coast;
   set.trajectory.retry_band_mm = 0.5 * spec.limits.ess_mm;
   set.model_id = 0;
   set.source = "epa commission: " + identified->summary;

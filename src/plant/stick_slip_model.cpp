@@ -3,6 +3,8 @@
 #include <cmath>
 #include <string>
 
+#include "core/format.hpp"
+
 namespace epa::plant {
 
 core::Result<StickSlipModel> StickSlipModel::make(const StickSlipParams& params, double Ts, int substeps) {
@@ -103,9 +105,13 @@ double coast_time_s(const StickSlipParams& params, double Ts, double speed_mm_s)
   return directions > 0 ? sum_s / directions : NAN;
 }
 
-double sliding_arrival_coast_s(const core::ModelFile& file, double approach_speed_mm_s) {
+core::Result<double> sliding_arrival_coast_s(const core::ModelFile& file, double approach_speed_mm_s) {
   if (file.axis_model != core::AxisModel::kStickSlip || !file.stick_slip) return 0.0;
-  return coast_time_s(*file.stick_slip, file.model.Ts, approach_speed_mm_s);
+  const double coast_s = coast_time_s(*file.stick_slip, file.model.Ts, approach_speed_mm_s);
+  if (!std::isfinite(coast_s))
+    return core::invalid_argument("the model's [stick_slip] table does not slide at pp-traj's approach speed (" +
+                                  core::format_number(approach_speed_mm_s) + " mm/s): no coast time for its arrival");
+  return coast_s;
 }
 
 }  // namespace epa::plant

@@ -87,8 +87,8 @@ double coast_time_s(const StickSlipParams& params, double Ts, double speed_mm_s)
 // pp-traj's coast_s for the axis a model file describes: coast_time_s of its [stick_slip] model at
 // approach_speed_mm_s when the file says that model describes the axis (axis_model, epa identify's
 // verdict: on such an axis a stop cannot be corrected from rest by less than a breakaway jump, so
-// the law arrives while sliding), else 0 (off: the integrator corrects). NaN when the model does
-// not slide at that speed.
-double sliding_arrival_coast_s(const core::ModelFile& file, double approach_speed_mm_s);
+// the law arrives while sliding), else 0 (off: the integrator corrects). Error: the stick-slip
+// model does not slide at that speed (no coast to give).
+core::Result<double> sliding_arrival_coast_s(const core::ModelFile& file, double approach_speed_mm_s);
 
 }  // namespace epa::plant

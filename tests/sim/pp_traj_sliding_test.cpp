@@ -32,7 +32,9 @@ control::ControllerParams pp_traj_for(const core::ModelFile& f) {
   c.A = f.model.A;
   c.B = f.model.B;
   c.dead_zone = f.model.dead_zone;
-  c.trajectory.coast_s = plant::sliding_arrival_coast_s(f, 50.0 * c.trajectory.approach_speed_v_s);
+  const auto coast = plant::sliding_arrival_coast_s(f, 50.0 * c.trajectory.approach_speed_v_s);
+  EXPECT_TRUE(coast.has_value());
+  c.trajectory.coast_s = coast ? *coast : 0.0;
   auto p = control::ControllerParams::make(c);
   EXPECT_TRUE(p.has_value()) << (p ? "" : p.error().message);
   return *p;
@@ -49,11 +51,14 @@ StepRun physics_move(const control::ControllerParams& params, double from_mm, do
 
 TEST(PpTrajSliding, TheCoastComesFromTheStickSlipModelOnlyWhenItDescribesTheAxis) {
   auto f = identified();
-  const double coast = plant::sliding_arrival_coast_s(f, 120.0);
-  EXPECT_GT(coast, 0.005);
-  EXPECT_LT(coast, 0.1);
+  const auto coast = plant::sliding_arrival_coast_s(f, 120.0);
+  ASSERT_TRUE(coast.has_value());
+  EXPECT_GT(*coast, 0.005);
+  EXPECT_LT(*coast, 0.1);
   f.axis_model = core::AxisModel::kHammerstein;
-  EXPECT_EQ(plant::sliding_arrival_coast_s(f, 120.0), 0.0);
+  const auto off = plant::sliding_arrival_coast_s(f, 120.0);
+  ASSERT_TRUE(off.has_value());
+  EXPECT_EQ(*off, 0.0);
 }
 
 TEST(PpTrajSliding, OnThePhysicsPlantEveryMoveEndsWithinAThirdOfAMillimetreWithoutOvershoot) {
