@@ -29,6 +29,8 @@ void hold(ApproachState& s, double at_v) noexcept {
 
 std::size_t direction_index(double direction) noexcept { return direction > 0.0 ? 0 : 1; }
 
+constexpr double kSensorSpanV = 10.0;  // the stroke, in sensor volts
+
 // A leg from the piston at from_v; the path starts at the piston's speed along it when the piston
 // slides that way (a setpoint changed mid-move does not first stop the piston), else from rest.
 void start_leg(const ApproachLimits& l, ApproachState& s, double target_v, double direction, bool final_leg, double from_v) noexcept {
@@ -37,6 +39,7 @@ void start_leg(const ApproachLimits& l, ApproachState& s, double target_v, doubl
   s.leg_direction = direction;
   s.final_leg = final_leg;
   s.path_v = from_v;
+  s.leg_coast_s = std::max(0.0, coast_at_s(l, target_v) + s.coast_offset_s);
   const double sliding = direction * reading_slope(s, l.Ts);
   s.path_speed_v_s = sliding >= 0.5 * l.speed_v_s ? sliding : 0.0;
   s.samples_in_phase = 0;
@@ -67,8 +70,7 @@ void plan(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noe
     const double back_off_v = r_v - s.final_direction * l.length_v;
     if (back_off_v < l.travel_min_v || back_off_v > l.travel_max_v) s.final_direction = -s.final_direction;
   }
-  const double learned = s.learned_coast_s[direction_index(s.final_direction)];
-  s.coast_s = learned > 0.0 ? learned : l.coast_s;
+  s.coast_offset_s = s.learned_offset_s[direction_index(s.final_direction)];
   if (straight_in)
     start_leg(l, s, r_v, s.final_direction, true, y_v);
   else
@@ -76,6 +78,14 @@ void plan(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noe
 }
 
 }  // namespace
+
+double coast_at_s(const ApproachLimits& l, double x_v) noexcept {
+  const auto compliance = [&](double x) {  // 1 / stiffness, up to the factor they share
+    x = std::clamp(x, 0.0, kSensorSpanV);
+    return 1.0 / (1.0 / (x + l.dead_length_v) + 1.0 / (kSensorSpanV - x + l.dead_length_v));
+  };
+  return l.coast_s * std::sqrt(compliance(x_v) / compliance(0.5 * kSensorSpanV));
+}
 
 void approach_observe(ApproachState& s, double y_v) noexcept {
   for (std::size_t i = s.readings.size() - 1; i > 0; --i) s.readings[i] = s.readings[i - 1];
@@ -113,11 +123,12 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
     if (s.final_leg && s.cut_speed_v_s >= 0.5 * l.speed_v_s && s.cut_speed_v_s <= 1.5 * l.speed_v_s) {
       // A stop off by e after a steady slide at v: the next cut this way assumes a coast longer by
       // e / v, by at most the model's coast per stop (a cut in a breakaway, or a loop that
-      // stalled, must not teach it a coast it then keeps), within a quarter to 4 times it.
+      // stalled, must not teach it a coast it then keeps), the offset within -3/4 to 3 times it.
       const double correction_s = s.final_direction * (y_mean - s.planned_r_v) / s.cut_speed_v_s;
       const double step_limit_s = l.coast_s;
-      s.coast_s = std::clamp(s.coast_s + std::clamp(correction_s, -step_limit_s, step_limit_s), 0.25 * l.coast_s, 4.0 * l.coast_s);
-      s.learned_coast_s[direction_index(s.final_direction)] = s.coast_s;
+      s.coast_offset_s = std::clamp(s.coast_offset_s + std::clamp(correction_s, -step_limit_s, step_limit_s), -0.75 * l.coast_s,
+                                    3.0 * l.coast_s);
+      s.learned_offset_s[direction_index(s.final_direction)] = s.coast_offset_s;
     }
     if (!s.final_leg) {
       start_leg(l, s, s.planned_r_v, s.final_direction, true, y_mean);
@@ -143,7 +154,7 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
   // The cut: the piston's predicted stop has reached the leg's target.
   const double dir = s.leg_direction;
   const double speed_towards = std::max(0.0, dir * reading_slope(s, l.Ts));
-  const double to_go_v = dir * (s.leg_target_v - y_v) - speed_towards * s.coast_s;  // predicted stop to target
+  const double to_go_v = dir * (s.leg_target_v - y_v) - speed_towards * s.leg_coast_s;  // predicted stop to target
   if (s.samples_in_phase > 1 && to_go_v <= 0.0) {
     s.cut_speed_v_s = s.final_leg ? speed_towards : 0.0;
     s.phase = ApproachPhase::kCoasting;

@@ -17,11 +17,13 @@
 //            not quantised to the v Ts the piston covers per sample (+-0.3 mm at 120 mm/s)
 //   judge    settle_samples later, the mean of the last 4 readings against the target: within
 //            retry_band_v, hold; else back off length_v and approach again (at most max_retries)
+//   where    the coast depends on where along the stroke the piston stops: the air spring that
+//            brakes it stiffens near an end (coast_at_s below)
 //   learn    every stop after a steady slide corrects the coast of its direction by its error /
 //            the speed at the cut, and the next approach that way (a retry, or the next move's)
 //            cuts with it: the model's coast is a first guess (on an axis the identification saw
-//            through a slower I/O path it was 1-3 mm long), and the coast also depends on where
-//            along the stroke the piston is (the air spring stiffens near an end)
+//            through a slower I/O path it was 1-3 mm long); the correction is kept as an offset,
+//            the same at every position, as a delay the model did not see would be
 //   short    a move shorter than length_v backs off first (unless the piston already slides
 //            towards the target), so that every final approach is a steady slide, not the
 //            breakaway jump of a start from rest; from the far
@@ -38,7 +40,8 @@
 namespace epa::control {
 
 struct ApproachLimits {
-  double coast_s = 0.0;          // > 0
+  double coast_s = 0.0;          // > 0, at mid-stroke
+  double dead_length_v = 0.5;    // each chamber's dead volume (ports, tubing) as a length of stroke, V (> 0)
   double speed_v_s = 2.4;        // approach speed, V/s
   double length_v = 1.0;         // length of the final, steady approach, V
   double decel_v_s2 = 6.0;       // braking to the approach speed, V/s^2
@@ -62,8 +65,9 @@ struct ApproachState {
   bool final_leg = false;
   int retries = 0;
   double path_v = 0.0, path_speed_v_s = 0.0;  // the leg's reference and its speed (>= 0, along leg_direction)
-  double coast_s = 0.0;           // the coast this move's cuts assume
-  std::array<double, 2> learned_coast_s{};  // upwards, downwards: from the stops so far (0: none yet)
+  double coast_offset_s = 0.0;    // what this move's cuts add to the coast at their target
+  double leg_coast_s = 0.0;       // the coast this leg's cut assumes
+  std::array<double, 2> learned_offset_s{};  // upwards, downwards: from the stops so far
   double cut_speed_v_s = 0.0;     // at the last cut of a final leg (0: not a steady slide)
   double held_at_v = 0.0;         // where the piston stopped, while holding
   std::size_t samples_in_phase = 0;
@@ -78,6 +82,20 @@ struct ApproachOutput {
   double speed_v_s = 0.0;    // the reference's speed before this sample, signed (at a leg's start: the speed its history ran at)
   double drive_fraction = 1.0;  // of the law's drive to apply (< 1 in the sample before a cut)
 };
+
+// The coast after a cut at x_v (sensor volts, the stroke's ends at 0 and 10 V), s: coast_s scaled
+// by 1/omega of the air spring there against mid-stroke. With the valve centred, the chambers act
+// as an air spring that brakes the piston; at force balance its stiffness goes with
+// 1/(length of A) + 1/(length of B), each length counted with its chamber's dead volume, so it
+// stiffens near an end and the coast shortens: on the physics plant from 23-24 ms at mid-stroke to
+// 17 ms at 75 mm and 8 ms at 3 mm of 500. Given that plant's dead volumes, this form follows its
+// coast within 6 % from 25 to 475 mm (PpTrajSliding.TheCoastAlongTheStrokeFollowsThePhysicsPlant).
+// The dead length is a tuning parameter, not identified: the excitation keeps 100 mm from the ends,
+// where it hardly matters (on that plant's first approaches 12.5 or 25 mm: within 0.36 or 0.24 mm).
+// Why the whole coast scales, though the valve's dead time and spool lag are part of it: the physics
+// plant's coast follows the pure form, and the split the stick-slip model fits (0.79 of it the
+// spring's) missed its ends.
+double coast_at_s(const ApproachLimits& limits, double x_v) noexcept;
 
 // One sample. The first call (or any with the phase set to kIdle) plans from y_v.
 ApproachOutput approach_step(const ApproachLimits& limits, ApproachState& state, double r_v, double y_v) noexcept;

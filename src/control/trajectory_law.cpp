@@ -85,6 +85,8 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
       return field_error("max_retries", c.max_retries, "a whole number 0..10");
     if (!(c.approach_settle_s > 0.0 && c.approach_settle_s <= 10.0))
       return field_error("approach_settle_s", c.approach_settle_s, "in (0, 10] s");
+    if (!(c.coast_dead_length_v > 0.0) || !std::isfinite(c.coast_dead_length_v))
+      return field_error("coast_dead_length", c.coast_dead_length_v, "> 0");
     if (!std::isfinite(c.travel_min_v) || !(c.travel_max_v > c.travel_min_v) || !std::isfinite(c.travel_max_v))
       return field_error("travel_max", c.travel_max_v, "finite and above travel_min " + core::format_number(c.travel_min_v));
   }
@@ -125,6 +127,7 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   p.sliding_approach = c.coast_s > 0.0;
   if (p.sliding_approach) {
     p.approach.coast_s = c.coast_s;
+    p.approach.dead_length_v = c.coast_dead_length_v;
     p.approach.speed_v_s = c.approach_speed_v_s;
     p.approach.length_v = c.approach_length_v;
     p.approach.decel_v_s2 = c.approach_decel_v_s2;

@@ -62,7 +62,8 @@ struct TrajectoryConfig {
   double creep_margin_v = 0.2;        // once arrived, the jump stops this short of each break point (creeping_idz_command)
   double creep_blend_s = 0.1;         // over which that margin grows from 0 after arrival, s (0: at once)
   // Arrival while sliding (sliding_approach.hpp), for an axis with stick-slip.
-  double coast_s = 0.0;               // the piston's coast after the valve is centred, s; 0: off
+  double coast_s = 0.0;               // the piston's coast after the valve is centred, at mid-stroke, s; 0: off
+  double coast_dead_length_v = 0.5;   // each chamber's dead volume as a length of stroke, V (25 mm: ports and tubing; coast_at_s)
   double approach_speed_v_s = 2.4;    // of the final approach (120 mm/s at 50 mm/V: the cut lands within +-0.3 mm of the sample)
   double approach_length_v = 1.0;     // the final approach's length, V (50 mm)
   double approach_decel_v_s2 = 6.0;   // braking to the approach speed, V/s^2 (300 mm/s^2: over several air-spring periods)

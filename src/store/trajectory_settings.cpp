@@ -10,7 +10,7 @@ namespace {
 
 // One table of keys, so the JSON writer, the reader and the points agree.
 using Member = double TrajectorySettings::*;
-constexpr std::array<std::pair<const char*, Member>, 20> kKeys = {{
+constexpr std::array<std::pair<const char*, Member>, 21> kKeys = {{
     {"speed_fraction", &TrajectorySettings::speed_fraction},
     {"accel_mm_s2", &TrajectorySettings::accel_mm_s2},
     {"accel_per_distance_per_s2", &TrajectorySettings::accel_per_distance_per_s2},
@@ -25,6 +25,7 @@ constexpr std::array<std::pair<const char*, Member>, 20> kKeys = {{
     {"creep_margin_v", &TrajectorySettings::creep_margin_v},
     {"creep_blend_s", &TrajectorySettings::creep_blend_s},
     {"coast_s", &TrajectorySettings::coast_s},
+    {"coast_dead_length_mm", &TrajectorySettings::coast_dead_length_mm},
     {"approach_speed_mm_s", &TrajectorySettings::approach_speed_mm_s},
     {"approach_mm", &TrajectorySettings::approach_mm},
     {"approach_decel_mm_s2", &TrajectorySettings::approach_decel_mm_s2},
@@ -51,6 +52,7 @@ control::TrajectoryConfig to_trajectory_config(const TrajectorySettings& s, doub
   c.creep_margin_v = s.creep_margin_v;
   c.creep_blend_s = s.creep_blend_s;
   c.coast_s = s.coast_s;
+  c.coast_dead_length_v = s.coast_dead_length_mm / mm_per_volt;
   c.approach_speed_v_s = s.approach_speed_mm_s / mm_per_volt;
   c.approach_length_v = s.approach_mm / mm_per_volt;
   c.approach_decel_v_s2 = s.approach_decel_mm_s2 / mm_per_volt;

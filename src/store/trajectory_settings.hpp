@@ -32,6 +32,7 @@ struct TrajectorySettings {
   double creep_blend_s = kTrajectoryDefaults.creep_blend_s;
   // Arrival while sliding on an axis with stick-slip (control/sliding_approach.hpp); coast_s 0: off.
   double coast_s = kTrajectoryDefaults.coast_s;
+  double coast_dead_length_mm = core::sensor_v_to_mm(kTrajectoryDefaults.coast_dead_length_v);
   double approach_speed_mm_s = core::sensor_v_to_mm(kTrajectoryDefaults.approach_speed_v_s);
   double approach_mm = core::sensor_v_to_mm(kTrajectoryDefaults.approach_length_v);
   double approach_decel_mm_s2 = core::sensor_v_to_mm(kTrajectoryDefaults.approach_decel_v_s2);

@@ -115,7 +115,8 @@ TEST(SlidingApproach, ACoastTheLawGetsWrongIsCorrectedByRetriesFromTheSameSide) 
   EXPECT_NEAR(t.y.back(), 4.0, l.retry_band_v);
   EXPECT_GE(s.retries, 1);
   EXPECT_LE(s.retries, l.max_retries);
-  EXPECT_GT(s.coast_s, 0.5 * kLagS) << "the coast it cuts with grew towards the piston's";
+  EXPECT_GT(s.coast_offset_s, 0.0) << "the coast it cuts with grew towards the piston's";
+  EXPECT_GT(s.leg_coast_s, 0.5 * kLagS);
   // Every approach to the target was upward: a retry backs off and comes from the same side.
   std::size_t approach_samples = 0;
   for (std::size_t k = 0; k < t.y.size(); ++k) {
@@ -167,6 +168,47 @@ TEST(SlidingApproach, ASetpointWithinTheBandStartsNoMove) {
   const Trace t = run(l, s, 3.0, 3.0 + 0.5 * l.retry_band_v, 1.0);
   EXPECT_TRUE(std::all_of(t.hold.begin(), t.hold.end(), [](bool h) { return h; }));
   EXPECT_EQ(t.y.back(), 3.0);
+}
+
+// The air spring that brakes the piston is stiffest near an end, where one chamber is short: the
+// coast the law assumes is coast_s at mid-stroke and shorter towards either end, the same at
+// mirrored positions, and the flatter the longer the chambers' dead volume.
+TEST(SlidingApproach, TheCoastShortensTowardsEitherEndAsTheAirSpringStiffens) {
+  auto l = limits();
+  l.dead_length_v = 0.25;
+  EXPECT_DOUBLE_EQ(coast_at_s(l, 5.0), l.coast_s);
+  double previous = coast_at_s(l, 5.0);
+  for (double x = 4.5; x >= 0.0; x -= 0.5) {
+    const double coast = coast_at_s(l, x);
+    EXPECT_LT(coast, previous) << "at " << x << " V";
+    EXPECT_NEAR(coast, coast_at_s(l, 10.0 - x), 1e-12) << "mirrored";
+    previous = coast;
+  }
+  // At the end one chamber is its dead volume alone: stiffness 1/0.25 + 1/10.25 against
+  // 2/5.25 at mid-stroke, omega sqrt(10.76) times higher.
+  EXPECT_NEAR(coast_at_s(l, 0.0) / l.coast_s, std::sqrt((2.0 / 5.25) / (1.0 / 0.25 + 1.0 / 10.25)), 1e-12);
+  auto longer = l;
+  longer.dead_length_v = 2.0;
+  EXPECT_GT(coast_at_s(longer, 0.5), coast_at_s(l, 0.5));
+  EXPECT_EQ(coast_at_s(l, -1.0), coast_at_s(l, 0.0)) << "outside the stroke: its end";
+}
+
+// A stop the law's coast gets wrong teaches an offset, not a factor: a coast the model misses by a
+// delay it did not see is off by that delay at every position, so what one stop taught holds for
+// the next target elsewhere along the stroke.
+TEST(SlidingApproach, WhatAStopTaughtIsAnOffsetThatTheNextMoveElsewhereUses) {
+  auto l = limits(0.5 * kLagS);  // the law expects half the coast
+  ApproachState s;
+  run(l, s, 5.0, 8.0, 8.0);
+  ASSERT_GT(s.learned_offset_s[0], 0.0);
+  const double learned = s.learned_offset_s[0];
+  approach_step(l, s, 2.0, s.readings[0]);  // a move down: that direction has learned nothing
+  EXPECT_EQ(s.coast_offset_s, 0.0);
+  ApproachState up = s;
+  up.phase = ApproachPhase::kIdle;
+  approach_step(l, up, 9.5, 1.0);  // up again, far along the stroke
+  EXPECT_EQ(up.coast_offset_s, learned);
+  EXPECT_NEAR(up.leg_coast_s, coast_at_s(l, 9.5) + learned, 1e-12);
 }
 
 }  // namespace

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -15,6 +17,7 @@
 #include "core/model_file.hpp"
 #include "plant/plant_adapter.hpp"
 #include "plant/pneumatic_params.hpp"
+#include "plant/pneumatic_plant.hpp"
 #include "plant/stick_slip_model.hpp"
 #include "sim/closed_loop.hpp"
 
@@ -61,7 +64,54 @@ TEST(PpTrajSliding, TheCoastComesFromTheStickSlipModelOnlyWhenItDescribesTheAxis
   EXPECT_EQ(*off, 0.0);
 }
 
-TEST(PpTrajSliding, OnThePhysicsPlantEveryMoveEndsWithinAThirdOfAMillimetreWithoutOvershoot) {
+// The physics plant's coast, centred after a steady slide at ~100-150 mm/s through x_mm, as the law
+// reads speed (least-squares slope of 4 readings): distance / speed, s.
+double physics_coast_s(double x_mm, double direction) {
+  plant::PneumaticOptions options;
+  options.initial_position_mm = std::clamp(x_mm - direction * 150.0, 0.0, 500.0);
+  auto physics = plant::PneumaticPlant::make(plant::PneumaticParams{}, options);
+  EXPECT_TRUE(physics.has_value());
+  const double u = direction > 0 ? 2.2 : -2.75;  // about 1 V past each overlap
+  std::array<double, 4> y{};
+  y.fill(options.initial_position_mm);
+  for (int k = 0; k < 2000 && direction * (physics->position_mm() - x_mm) < 0.0; ++k) {
+    physics->step(u);
+    y = {physics->position_mm(), y[0], y[1], y[2]};
+  }
+  const double speed = direction * (3.0 * y[0] + y[1] - y[2] - 3.0 * y[3]) / (10.0 * 0.005);
+  EXPECT_GT(speed, 90.0);
+  for (int k = 0; k < 200; ++k) physics->step(0.0);
+  return direction * (physics->position_mm() - y[0]) / speed;
+}
+
+// The law's coast along the stroke (control::coast_at_s, 1/omega of an air spring of two chambers
+// with dead volumes) against a plant of another form: the physics plant's chambers, orifices and
+// Stribeck friction, its coast measured after slides that reach x steadily (at least 150 mm of
+// run-up). Given the plant's coast at mid-stroke and its dead volumes as lengths, the form follows
+// it within 6 % from 25 mm to 475 mm; a coast taken as the same everywhere misses by a third at
+// 25 mm.
+TEST(PpTrajSliding, TheCoastAlongTheStrokeFollowsThePhysicsPlant) {
+  const plant::PneumaticParams physics;
+  const double area_a_mm2 = std::numbers::pi / 4.0 * physics.bore_mm * physics.bore_mm;
+  const double area_b_mm2 = area_a_mm2 - std::numbers::pi / 4.0 * physics.rod_mm * physics.rod_mm;
+  control::ApproachLimits l;
+  l.dead_length_v = 0.5 * (1e3 * physics.dead_volume_a_cm3 / area_a_mm2 + 1e3 * physics.dead_volume_b_cm3 / area_b_mm2) / 50.0;
+  for (const double direction : {1.0, -1.0}) {
+    SCOPED_TRACE(direction > 0 ? "outwards" : "inwards");
+    l.coast_s = physics_coast_s(250.0, direction);
+    for (const double x_mm : {25.0, 50.0, 100.0, 150.0, 350.0, 400.0, 450.0, 475.0}) {
+      if (direction * (x_mm - 250.0) < 0.0) continue;  // a slide needs its 150 mm of run-up within the stroke
+      SCOPED_TRACE("at " + std::to_string(x_mm) + " mm");
+      const double plant_coast_s = physics_coast_s(x_mm, direction);
+      EXPECT_NEAR(control::coast_at_s(l, x_mm / 50.0), plant_coast_s, 0.06 * plant_coast_s);
+    }
+  }
+  EXPECT_LT(physics_coast_s(25.0, -1.0), 0.67 * physics_coast_s(250.0, -1.0)) << "a coast the same everywhere would miss";
+}
+
+// Issue 17's physics limits on the 18 moves of bench/pp_traj_tables.sh: each from a fresh law, so
+// nothing is learned from an earlier move, and every first approach must land within the band.
+TEST(PpTrajSliding, OnThePhysicsPlantEveryMoveSettlesWithinASecondWithinAThirdOfAMillimetreWithoutOvershoot) {
   const auto params = pp_traj_for(identified());
   for (double from : {100.0, 250.0, 400.0})
     for (double step : {25.0, 50.0, 100.0, -25.0, -50.0, -100.0}) {
@@ -69,6 +119,8 @@ TEST(PpTrajSliding, OnThePhysicsPlantEveryMoveEndsWithinAThirdOfAMillimetreWitho
       const StepRun r = physics_move(params, from, step);
       const double final_error = std::abs(r.run.y_mm.back() - (from + step));
       EXPECT_LE(final_error, 0.3);
+      ASSERT_TRUE(r.metrics.settling_s.has_value());
+      EXPECT_LE(*r.metrics.settling_s, 1.0);
       ASSERT_TRUE(r.metrics.overshoot_pct.has_value());
       EXPECT_LE(*r.metrics.overshoot_pct / 100.0 * std::abs(step), 0.5) << "overshoot in mm";
       EXPECT_EQ(valve_sign_changes_in_last(r, 1.0), 0u) << "held still at the end";
