@@ -211,5 +211,24 @@ TEST(SlidingApproach, WhatAStopTaughtIsAnOffsetThatTheNextMoveElsewhereUses) {
   EXPECT_NEAR(up.leg_coast_s, coast_at_s(l, 9.5) + learned, 1e-12);
 }
 
+// A stop scatters about what the coast predicts; once four stops have taught a direction, one more
+// moves its offset by a quarter of what it asks for, not all of it, so retries do not chase the
+// scatter. The first stop, with nothing learned yet, is taken whole.
+TEST(SlidingApproach, AfterFourStopsOneMoreMovesTheOffsetByAQuarterOfItsError) {
+  auto l = limits(0.5 * kLagS);  // the law expects half the coast: every stop asks for more
+  l.max_retries = 0;             // one approach per move: one stop, one lesson
+  ApproachState fresh;
+  run(l, fresh, 0.0, 4.0, 3.0);
+  ASSERT_EQ(fresh.learned_stops[0], 1);
+  const double first_lesson_s = fresh.learned_offset_s[0];
+  ASSERT_GT(first_lesson_s, 0.0);
+
+  ApproachState taught;
+  taught.learned_stops = {4, 0};  // four stops taught it an offset of 0 upwards
+  run(l, taught, 0.0, 4.0, 3.0);
+  EXPECT_NEAR(taught.learned_offset_s[0], 0.25 * first_lesson_s, 1e-9);
+  EXPECT_EQ(taught.learned_stops[0], 5);
+}
+
 }  // namespace
 }  // namespace epa::control
