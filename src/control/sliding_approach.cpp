@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/units.hpp"
+
 namespace epa::control {
 
 namespace {
@@ -29,7 +31,7 @@ void hold(ApproachState& s, double at_v) noexcept {
 
 std::size_t direction_index(double direction) noexcept { return direction > 0.0 ? 0 : 1; }
 
-constexpr double kSensorSpanV = 10.0;  // the stroke, in sensor volts
+constexpr double kSensorSpanV = core::mm_to_sensor_v(core::kStrokeMm);  // the stroke's ends at 0 and this
 // Each direction's offset is the running mean of what its stops asked for (gain 1, 1/2, 1/3), then
 // of about the last 4 (gain 1/4): on the commissioning test's rig through its remote I/O a stop
 // scatters by +-0.8 mm about what the coast predicts, and with a gain of 1 the retries chased that

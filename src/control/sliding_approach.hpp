@@ -23,7 +23,9 @@
 //            the speed at the cut, and the next approach that way (a retry, or the next move's)
 //            cuts with it: the model's coast is a first guess (on an axis the identification saw
 //            through a slower I/O path it was 1-3 mm long); the correction is kept as an offset,
-//            the same at every position, as a delay the model did not see would be
+//            the same at every position, as a delay the model did not see would be, and the
+//            offset is the running mean of what the stops asked for (over about the last 4), so
+//            that a retry does not chase one stop's scatter
 //   short    a move shorter than length_v backs off first (unless the piston already slides
 //            towards the target), so that every final approach is a steady slide, not the
 //            breakaway jump of a start from rest; from the far
