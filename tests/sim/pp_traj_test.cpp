@@ -161,6 +161,16 @@ TEST(PpTraj, AModelThatDoesNotIntegrateOrABadParameterIsRefusedByName) {
   ASSERT_FALSE(p);
   EXPECT_NE(p.error().message.find("speed_fraction"), std::string::npos) << p.error().message;
 
+  // The sliding arrival's parameters are checked when it is on (coast_s > 0).
+  for (const double dead_length_v : {0.0, -0.5, std::nan("")}) {
+    config = control::paper_controller_config(ControllerKind::kPpTraj);
+    config.trajectory.coast_s = 0.024;
+    config.trajectory.coast_dead_length_v = dead_length_v;
+    p = control::ControllerParams::make(config);
+    ASSERT_FALSE(p) << dead_length_v;
+    EXPECT_NE(p.error().message.find("coast_dead_length"), std::string::npos) << p.error().message;
+  }
+
   config = control::paper_controller_config(ControllerKind::kPpFfidz);  // the other laws do not need the model
   config.A = core::Polynomial({1.0, -0.5});
   EXPECT_TRUE(control::ControllerParams::make(config));
