@@ -14,6 +14,7 @@
 
 #include "../support/physics_identified_model.hpp"
 #include "control/paper_controller.hpp"
+#include "control/sliding_approach.hpp"
 #include "core/model_file.hpp"
 #include "plant/plant_adapter.hpp"
 #include "plant/pneumatic_params.hpp"
