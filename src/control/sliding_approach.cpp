@@ -48,7 +48,7 @@ void start_leg(const ApproachLimits& l, ApproachState& s, double target_v, doubl
   s.leg_direction = direction;
   s.final_leg = final_leg;
   s.path_v = from_v;
-  s.leg_coast_s = std::max(0.0, coast_at_s(l, target_v) + s.coast_offset_s);
+  s.leg_coast_s = std::max(0.0, coast_at_s(l, target_v) + s.learned_offset_s[direction_index(s.final_direction)]);
   const double sliding = direction * reading_slope(s, l.Ts);
   s.path_speed_v_s = sliding >= 0.5 * l.speed_v_s ? sliding : 0.0;
   s.samples_in_phase = 0;
@@ -79,7 +79,6 @@ void plan(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noe
     const double back_off_v = r_v - s.final_direction * l.length_v;
     if (back_off_v < l.travel_min_v || back_off_v > l.travel_max_v) s.final_direction = -s.final_direction;
   }
-  s.coast_offset_s = s.learned_offset_s[direction_index(s.final_direction)];
   if (straight_in)
     start_leg(l, s, r_v, s.final_direction, true, y_v);
   else
@@ -137,9 +136,8 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
       const double correction_s = s.final_direction * (y_mean - s.planned_r_v) / s.cut_speed_v_s;
       const double step_limit_s = l.coast_s;
       const double gain = 1.0 / static_cast<double>(std::min<int>(s.learned_stops[d] + 1, kLearningMemory));
-      s.coast_offset_s = std::clamp(s.coast_offset_s + gain * std::clamp(correction_s, -step_limit_s, step_limit_s),
-                                    -0.75 * l.coast_s, 3.0 * l.coast_s);
-      s.learned_offset_s[d] = s.coast_offset_s;
+      s.learned_offset_s[d] = std::clamp(s.learned_offset_s[d] + gain * std::clamp(correction_s, -step_limit_s, step_limit_s),
+                                         -0.75 * l.coast_s, 3.0 * l.coast_s);
       ++s.learned_stops[d];
     }
     if (!s.final_leg) {

@@ -67,9 +67,8 @@ struct ApproachState {
   bool final_leg = false;
   int retries = 0;
   double path_v = 0.0, path_speed_v_s = 0.0;  // the leg's reference and its speed (>= 0, along leg_direction)
-  double coast_offset_s = 0.0;    // what this move's cuts add to the coast at their target
-  double leg_coast_s = 0.0;       // the coast this leg's cut assumes
-  std::array<double, 2> learned_offset_s{};  // upwards, downwards: from the stops so far
+  double leg_coast_s = 0.0;       // the coast this leg's cut assumes: at its target, plus the move's direction's offset
+  std::array<double, 2> learned_offset_s{};  // upwards, downwards: what the stops so far add to the coast
   std::array<int, 2> learned_stops{};         // how many stops taught it, each way
   double cut_speed_v_s = 0.0;     // at the last cut of a final leg (0: not a steady slide)
   double held_at_v = 0.0;         // where the piston stopped, while holding
