@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "../support/physics_coast.hpp"
 #include "../support/physics_identified_model.hpp"
 #include "core/model_file.hpp"
 #include "plant/pneumatic_plant.hpp"
@@ -196,15 +197,9 @@ TEST(StickSlipModel, ItsCoastTimeMatchesThePhysicsPlantsWithinAQuarter) {
     auto physics = PneumaticPlant::make(PneumaticParams{}, options);
     ASSERT_TRUE(physics.has_value());
     const double u = direction > 0 ? 2.2 : -2.7;  // about 1 V past each overlap: a steady 100-150 mm/s
-    double y[4] = {};
-    for (int k = 0; k < 200; ++k) {
-      physics->step(u);
-      y[3] = y[2], y[2] = y[1], y[1] = y[0], y[0] = physics->position_mm();
-    }
-    const double speed = direction * (3.0 * y[0] + y[1] - y[2] - 3.0 * y[3]) / (10.0 * kTs);
+    const auto measured = epa::testing::measure_physics_coast(*physics, u, direction, [](int k, double) { return k < 200; });
+    const double speed = measured.speed_mm_s, plant_coast_s = measured.coast_s;
     ASSERT_GT(speed, 80.0);
-    for (int k = 0; k < 200; ++k) physics->step(0.0);
-    const double plant_coast_s = direction * (physics->position_mm() - y[0]) / speed;
     const double model_coast_s = coast_time_s(identified, kTs, speed);
     EXPECT_GT(plant_coast_s, 0.005);
     EXPECT_NEAR(model_coast_s, plant_coast_s, 0.25 * plant_coast_s) << "speed " << speed << " mm/s";

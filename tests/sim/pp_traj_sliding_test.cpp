@@ -6,13 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <deque>
 #include <numbers>
 #include <string>
 #include <vector>
 
+#include "../support/physics_coast.hpp"
 #include "../support/physics_identified_model.hpp"
 #include "control/paper_controller.hpp"
 #include "control/sliding_approach.hpp"
@@ -22,6 +21,7 @@
 #include "plant/pneumatic_plant.hpp"
 #include "plant/stick_slip_model.hpp"
 #include "sim/closed_loop.hpp"
+#include "sim/valve_line.hpp"
 
 namespace epa::sim {
 namespace {
@@ -66,24 +66,18 @@ TEST(PpTrajSliding, TheCoastComesFromTheStickSlipModelOnlyWhenItDescribesTheAxis
   EXPECT_EQ(*off, 0.0);
 }
 
-// The physics plant's coast, centred after a steady slide at ~100-150 mm/s through x_mm, as the law
-// reads speed (least-squares slope of 4 readings): distance / speed, s.
+// The physics plant's coast, centred after a steady slide at ~100-150 mm/s through x_mm: its run-up
+// starts 150 mm before x.
 double physics_coast_s(double x_mm, double direction) {
   plant::PneumaticOptions options;
   options.initial_position_mm = std::clamp(x_mm - direction * 150.0, 0.0, 500.0);
   auto physics = plant::PneumaticPlant::make(plant::PneumaticParams{}, options);
   EXPECT_TRUE(physics.has_value());
   const double u = direction > 0 ? 2.2 : -2.75;  // about 1 V past each overlap
-  std::array<double, 4> y{};
-  y.fill(options.initial_position_mm);
-  for (int k = 0; k < 2000 && direction * (physics->position_mm() - x_mm) < 0.0; ++k) {
-    physics->step(u);
-    y = {physics->position_mm(), y[0], y[1], y[2]};
-  }
-  const double speed = direction * (3.0 * y[0] + y[1] - y[2] - 3.0 * y[3]) / (10.0 * 0.005);
-  EXPECT_GT(speed, 90.0);
-  for (int k = 0; k < 200; ++k) physics->step(0.0);
-  return direction * (physics->position_mm() - y[0]) / speed;
+  const auto measured = epa::testing::measure_physics_coast(
+      *physics, u, direction, [&](int k, double y_mm) { return k < 2000 && direction * (y_mm - x_mm) < 0.0; });
+  EXPECT_GT(measured.speed_mm_s, 90.0);
+  return measured.coast_s;
 }
 
 // The law's coast along the stroke (control::coast_at_s, 1/omega of an air spring of two chambers
@@ -150,7 +144,7 @@ TEST(PpTrajSliding, WithADelayTheModelDoesNotKnowWhatTheFirstMovesTaughtCarriesT
   auto plant = plant::make_pneumatic_simulator(plant::PneumaticParams{}, {.initial_position_mm = 250.0});
   ASSERT_TRUE(plant.has_value());
   control::ControllerState state;
-  std::deque<double> line(2, 0.0);  // the valve commands under way: 2 samples of delay
+  sim::ValveLine line({.delay_samples = 2}, 0.005);
   const std::vector<double> targets_mm = {300, 200, 350, 150, 250, 320, 180, 400, 100, 250, 275, 225};
   for (std::size_t move = 0; move < targets_mm.size(); ++move) {
     const double target_mm = targets_mm[move];
@@ -159,9 +153,7 @@ TEST(PpTrajSliding, WithADelayTheModelDoesNotKnowWhatTheFirstMovesTaughtCarriesT
     double past_mm = 0.0;
     for (int k = 0; k < 800; ++k) {  // 4 s
       const auto out = control::controller_step(params, state, target_mm / 50.0, (*plant)->measured_v());
-      line.push_back(out.valve_v);
-      (*plant)->step(line.front());
-      line.pop_front();
+      (*plant)->step(line.pass(out.valve_v));
       past_mm = std::max(past_mm, (target_mm > from_mm ? 1.0 : -1.0) * ((*plant)->measured_v() * 50.0 - target_mm));
     }
     EXPECT_LE(std::abs((*plant)->measured_v() * 50.0 - target_mm), 0.3);
