@@ -63,6 +63,14 @@ GapReport build_report(const Diagnosis& d, const std::vector<NamedRun>& train, c
   r.residuals_before = residual_stats(shown_runs, before.replays);
   r.residuals_after = residual_stats(shown_runs, after.replays);
   r.hints = hints(d.effects.empty() ? sb : sa, d.effects.empty() ? r.residuals_before : r.residuals_after);
+  if (d.rest_drift.moving) {
+    char line[300];
+    std::snprintf(line, sizeof line,
+                  "the readings move %.2f mm/s while the valve rests inside the dead band (median of %zu rests): a drifting "
+                  "sensor, a leaking valve or seal, or a load, none of them in the vocabulary",
+                  d.rest_drift.median_speed_mm_s, d.rest_drift.rests);
+    r.hints.insert(r.hints.begin(), line);
+  }
 
   auto add_runs = [&](const std::vector<NamedRun>& runs, const char* set) {
     for (const auto& n : runs) {
@@ -163,6 +171,10 @@ std::string to_json(const GapReport& r) {
   };
   j["residuals"] = {{"before", stats(r.residuals_before)}, {"after", stats(r.residuals_after)}};
   j["hints"] = r.hints;
+  j["rest_drift"] = {{"rests", d.rest_drift.rests},
+                     {"median_speed_mm_s", round_to(d.rest_drift.median_speed_mm_s, 4)},
+                     {"threshold_mm_s", round_to(d.rest_drift.threshold_mm_s, 4)},
+                     {"moving", d.rest_drift.moving}};
   j["cross_validated"] = d.cross_validated;
   j["noise_std_mm"] = round_to(d.noise_std_mm, 4);
   return j.dump(1) + "\n";
@@ -172,7 +184,9 @@ std::string verdict_text(const GapReport& r) {
   const Diagnosis& d = r.diagnosis;
   char buf[400];
   std::string s;
-  if (d.effects.empty()) {
+  if (d.effects.empty() && d.rest_drift.moving) {
+    s = "Unexplained: the readings move while the valve rests inside the dead band, which no effect in the library does";
+  } else if (d.effects.empty()) {
     s = d.unexplained ? "Unexplained: no effect in the library reduces the held-out gap beyond chance, and a significant gap remains"
                       : "No effect: the held-out gap is at the level of sensor noise and the model's own rounding";
   } else {

@@ -377,9 +377,24 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
     for (auto& c : d.candidates)
       if (c.kind == EffectKind::kSensorQuantization) c.params = plant::EffectParams{*step, 0.0, 0.0}, c.accepted = true;
   }
+  // 9. Readings that move at rest, where the final model holds the piston still.
+  {
+    core::DeadZone band = nominal.model.dead_zone;
+    if (d.final_model.effects.on(EffectKind::kDeadzoneShift)) {
+      band.b_r += d.final_model.effects.param(EffectKind::kDeadzoneShift, 0);
+      band.b_l += d.final_model.effects.param(EffectKind::kDeadzoneShift, 1);
+    }
+    d.rest_drift = rest_drift(all_runs, band, d.noise_std_mm);
+    std::snprintf(buf, sizeof buf, "at rest inside the dead band: the readings move %.3f mm/s (median of %zu rests; noise stays below %.3f)%s",
+                  d.rest_drift.median_speed_mm_s, d.rest_drift.rests, d.rest_drift.threshold_mm_s,
+                  d.rest_drift.moving ? ": outside the vocabulary (a drifting sensor, a leak, a load)" : "");
+    say(buf);
+    d.unexplained = d.unexplained || d.rest_drift.moving;
+  }
   std::snprintf(buf, sizeof buf, "verdict: %s; held-out gap %.3f -> %.3f mm; noise floor %.3f mm (sensor noise %.3f mm)%s",
                 d.effects.empty() ? "no effect accepted" : names(d.effects).c_str(), d.baseline_gap_mm,
-                d.final_gap_mm, d.noise_floor_mm, d.noise_std_mm, d.unexplained ? "; a significant gap remains unexplained" : "");
+                d.final_gap_mm, d.noise_floor_mm, d.noise_std_mm,
+                !d.unexplained ? "" : d.rest_drift.moving ? "; unexplained: the readings move at rest" : "; a significant gap remains unexplained");
   say(buf);
   return d;
 }

@@ -24,7 +24,9 @@
 //  8. Unexplained: a held-out gap left above unexplained_factor times the noise floor (the gap
 //     that sensor noise alone gives a perfect model, estimated from the runs at rest) and, when
 //     effects are named, above unexplained_share of the baseline gap: a rig's effect never has
-//     the library's exact form, and the residue of the named effects' forms is theirs.
+//     the library's exact form, and the residue of the named effects' forms is theirs. Also when
+//     the readings move while the valve rests inside the dead band (rest_drift.hpp): no effect
+//     of the vocabulary moves a piston there, and the windowed gap is blind to a slow drift.
 // Without held-out runs, folds leave one training run out each (cross-validation by run).
 #include <functional>
 #include <string>
@@ -33,6 +35,7 @@
 
 #include "core/run.hpp"
 #include "diag/effect_fit.hpp"
+#include "diag/rest_drift.hpp"
 #include "diag/windowed_gap.hpp"
 #include "plant/effects.hpp"
 
@@ -85,6 +88,7 @@ struct Diagnosis {
   std::vector<plant::EffectKind> effects;    // accepted, in order
   std::vector<std::pair<plant::EffectKind, plant::EffectKind>> confusable;
   double noise_std_mm = 0, noise_floor_mm = 0;
+  RestDrift rest_drift;                      // readings that move while the final model rests
   bool unexplained = false;
   bool cross_validated = false;
   std::size_t evaluations = 0;
