@@ -5,6 +5,7 @@
 #include <string>
 
 #include "plant/effects.hpp"
+#include "plant/force_path.hpp"
 
 namespace epa::app {
 
@@ -33,19 +34,17 @@ Panel position_gain(const diag::Diagnosis& d) {
   return p;
 }
 
-// Drive in -> drive out of the friction form, from rest (breakaway) and while moving (Coulomb).
+// The friction force against the piston's mechanical speed: Coulomb while sliding, and the band
+// of drive that friction holds while the piston sticks.
 Panel friction(const diag::Diagnosis& d) {
-  Panel p{"static_friction: drive left by friction", "drive u_d (V)", "drive after friction (V)", {}, {}, {}, {}, {}, {}};
-  Series from_rest{"from rest", "#d62728", {}, {}, false}, moving{"while moving", "#1f77b4", {}, {}, true};
-  const auto effects = fitted(d, {EffectKind::kStaticFriction});
-  const core::DeadZone identity{};
-  for (double u = -3.0; u <= 3.0 + 1e-9; u += 0.02) {
-    plant::DriveEffects rest(effects, identity, 0.0), move(effects, identity, 0.0);
-    move.set_state({.stuck = false});
-    from_rest.x.push_back(u), from_rest.y.push_back(rest.drive_before_position(u));
-    moving.x.push_back(u), moving.y.push_back(move.drive_before_position(u));
-  }
-  p.series = {from_rest, moving};
+  Panel p{"static_friction: friction against the piston's speed", "mechanical speed (mm/s)", "friction (V of drive)",
+          {}, {}, {}, {}, {}, {}};
+  Series sliding{"sliding", "#1f77b4", {}, {}, false}, sticking{"sticking (holds up to)", "#d62728", {}, {}, true};
+  const auto path = plant::force_path(d.nominal.model);
+  const plant::DriveEffects form(fitted(d, {EffectKind::kStaticFriction}), core::DeadZone{}, path.speed_mm_s_per_V, path.pole);
+  for (double v = -100.0; v <= 100.0 + 1e-9; v += 0.5) sliding.x.push_back(v), sliding.y.push_back(form.friction_V(v, 0.0));
+  for (double drive : {-10.0, 10.0}) sticking.x.push_back(0.0), sticking.y.push_back(form.friction_V(0.0, drive));
+  p.series = {sliding, sticking};
   return p;
 }
 

@@ -174,7 +174,7 @@ std::string to_json(const GapReport& r) {
   j["rest_drift"] = {{"rests", d.rest_drift.rests},
                      {"median_speed_mm_s", round_to(d.rest_drift.median_speed_mm_s, 4)},
                      {"threshold_mm_s", round_to(d.rest_drift.threshold_mm_s, 4)},
-                     {"moving", d.rest_drift.moving}};
+                     {"readings_move", d.rest_drift.moving}};
   j["cross_validated"] = d.cross_validated;
   j["noise_std_mm"] = round_to(d.noise_std_mm, 4);
   return j.dump(1) + "\n";

@@ -167,8 +167,15 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
     say(buf);
   }
 
+  // The gap sensor noise alone leaves a perfect model: below it there is nothing left to explain.
+  std::vector<const core::Run*> all_runs = train;
+  all_runs.insert(all_runs.end(), heldout.begin(), heldout.end());
+  d.noise_std_mm = estimate_noise_std_mm(all_runs, nominal.model.dead_zone);
+  d.noise_floor_mm = noise_floor_mm(nominal.model, d.noise_std_mm, o.horizon);
+
   // 2. Forward selection over the structural effects, each fitted together with the nominal
-  // parameters; its first round scores every candidate.
+  // parameters; its first round scores every candidate. An effect is accepted only while the gap
+  // before it lies above the noise floor: below it, what a fit takes away is noise.
   double gap = d.refit_gap_mm;
   std::vector<EffectKind> remaining;
   for (auto k : o.candidates)
@@ -195,10 +202,12 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
     const EffectKind kind = remaining[best];
     SelectionStep step{kind, gap, trials[best].heldout_gap_mm, reduction(gap, trials[best].heldout_gap_mm),
                        chance_threshold_pct(kind) * o.threshold_scale, false};
-    step.accepted = step.reduction_pct > step.threshold_pct;
+    const bool above_floor = gap > d.noise_floor_mm;
+    step.accepted = step.reduction_pct > step.threshold_pct && above_floor;
     std::snprintf(buf, sizeof buf, "round %zu: best %s, held-out gap %.3f -> %.3f mm (%.1f %%, chance threshold %.1f %%): %s",
                   round + 1, std::string(plant::to_string(kind)).c_str(), gap, step.gap_after_mm, step.reduction_pct,
-                  step.threshold_pct, step.accepted ? "accepted" : "not accepted");
+                  step.threshold_pct,
+                  step.accepted ? "accepted" : above_floor ? "not accepted" : "not accepted (the gap was at the noise floor)");
     say(buf);
     d.steps.push_back(step);
     if (!step.accepted) break;
@@ -328,8 +337,6 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
     say(buf);
     return cost > chance_threshold_pct(parameter) * o.threshold_scale;
   };
-  std::vector<const core::Run*> all_runs = train;
-  all_runs.insert(all_runs.end(), heldout.begin(), heldout.end());
   const bool position_named = std::find(d.effects.begin(), d.effects.end(), EffectKind::kPositionDependentGain) != d.effects.end();
   if (refit_significant && std::abs(fe.param(EffectKind::kGainChange, 0) - 1.0) > o.gain_tolerance &&
       (!position_named || gain_off_along_the_whole_stroke(fe, all_runs, o.gain_tolerance)) &&
@@ -355,8 +362,6 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
   // The final model carries only what is named: unnamed nominal parameters stay re-fitted (they
   // are the model's own), and are reported as the re-fit.
 
-  d.noise_std_mm = estimate_noise_std_mm(all_runs, nominal.model.dead_zone);
-  d.noise_floor_mm = noise_floor_mm(nominal.model, d.noise_std_mm, o.horizon);
   d.unexplained = unexplained(d, o);
   // 8. The sensor's resolution: readings on a grid whose rounding error (step / sqrt(12)) is at
   // least half the noise are a coarse sensor. A replay cannot predict the rounding, so this raises the

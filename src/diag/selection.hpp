@@ -2,14 +2,15 @@
 // Which effect explains the gap, and how far it shrinks: the diagnosis.
 //
 //  1. Baseline: the nominal model's held-out windowed gap.
-//  2. Re-fit: the nominal model's own parameters (drive gain, both break points) fitted on the
-//     training runs and scored held out; they stay free in every later fit, since on a rig much of
+//  2. Re-fit: the nominal model's own parameters (drive gain, its steady speed within the printed
+//     B's precision, both break points) fitted on the training runs and scored held out; they stay free in every later fit, since on a rig much of
 //     a gap is parameters that are off, and an effect fitted on wrong parameters is biased.
 //  3. Candidates: every structural effect (delay, lag, friction, ceiling, position dependence,
 //     quantisation) fitted with the nominal parameters on the training runs, scored held out.
 //  4. Forward selection: add the effect with the largest held-out reduction while that reduction
 //     beats its chance threshold (the reduction fitting that effect gives on effect-free data:
-//     chance_threshold.hpp), re-fitting on top of what is accepted; at most max_effects.
+//     chance_threshold.hpp) and the gap before it lies above the noise floor (below it a fit
+//     only takes noise away), re-fitting on top of what is accepted; at most max_effects.
 //     input_delay and valve_lag explain much the same; when the runner-up comes within
 //     confusable_ratio of the winner's reduction, the pair is reported as confusable.
 //  5. Pairs: the best pair_pool first-round candidates fitted two at a time, jointly; a pair

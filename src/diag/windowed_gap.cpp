@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 
+#include "plant/force_path.hpp"
+
 namespace epa::diag {
 
 double GapSum::rms_mm() const { return n ? std::sqrt(sse_mm2 / static_cast<double>(n)) : 0.0; }
@@ -49,12 +51,15 @@ WindowCount replay(const ReplayModel& m, const core::Run& run, std::size_t horiz
                              ? m.effects.param(plant::EffectKind::kSensorQuantization, 0) : 0.0;
 
   // The history-dependent input side, once over the whole run.
+  // The history-dependent input side, once over the whole run: the drive and the force on the
+  // piston (friction on the model's mechanical speed, which the command history gives).
   plant::ValveEffects valve(m.effects, model.Ts);
-  plant::DriveEffects drive(m.effects, model.dead_zone,
-                            plant::steady_speed_mm_s_per_V(model.A.coefficients(), model.B.coefficients(), model.Ts, mpv));
-  thread_local std::vector<double> pre;
-  pre.resize(n);
-  for (std::size_t k = 0; k < n; ++k) pre[k] = drive.drive_before_position(valve.apply(run.u_V[k]));
+  const auto path = plant::force_path(model);
+  plant::DriveEffects drive(m.effects, model.dead_zone, path.speed_mm_s_per_V, path.pole);
+  thread_local std::vector<double> pre, force;
+  pre.resize(n), force.resize(n);
+  for (std::size_t k = 0; k < n; ++k) pre[k] = drive.drive_before_position(valve.apply(run.u_V[k])), force[k] = drive.force();
+  const std::size_t nc = path.nc;
 
   const bool reads_position = drive.reads_position();  // else the replay need not know where the piston is
   const std::size_t where_samples = drive.where_samples();
@@ -83,6 +88,7 @@ WindowCount replay(const ReplayModel& m, const core::Run& run, std::size_t horiz
       double next = 0.0;
       for (std::size_t i = 1; i <= na; ++i) next -= a[i] * y[i - 1];
       for (std::size_t i = 1; i <= nb; ++i) next += b[i] * ud[i - 1];
+      for (std::size_t i = 1; i <= nc && i <= k + 1; ++i) next += path.c[i] * force[k + 1 - i];
       next = std::clamp(next, 0.0, max_v);
       for (std::size_t i = y.size() - 1; i > 0; --i) y[i] = y[i - 1], ud[i] = ud[i - 1];
       y[0] = next;

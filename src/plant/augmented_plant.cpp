@@ -22,8 +22,8 @@ core::Result<AugmentedPlant> AugmentedPlant::make(const core::HammersteinModel& 
   if (!(options.noise_std_mm >= 0.0)) return core::invalid_argument("plant: sensor noise must be >= 0 mm");
   AugmentedPlant p(std::move(*arx));
   p.valve_ = ValveEffects(effects, model.Ts);
-  p.drive_ = DriveEffects(effects, model.dead_zone,
-                          steady_speed_mm_s_per_V(model.A.coefficients(), model.B.coefficients(), model.Ts, model.mm_per_volt));
+  const auto path = force_path(model);
+  p.drive_ = DriveEffects(effects, model.dead_zone, path.speed_mm_s_per_V, path.pole);
   p.mm_per_volt_ = model.mm_per_volt;
   p.noise_std_v_ = options.noise_std_mm / model.mm_per_volt;
   p.step_mm_ = effects.on(EffectKind::kSensorQuantization) ? effects.param(EffectKind::kSensorQuantization, 0) : 0.0;
@@ -34,7 +34,8 @@ core::Result<AugmentedPlant> AugmentedPlant::make(const core::HammersteinModel& 
 
 void AugmentedPlant::step(double valve_v) noexcept {
   const double spool_v = valve_.apply(std::isfinite(valve_v) ? valve_v : 0.0);
-  arx_.step(drive_.apply(spool_v, arx_.mean_position_mm(drive_.where_samples())));
+  const double drive = drive_.apply(spool_v, arx_.mean_position_mm(drive_.where_samples()));
+  arx_.step(drive, drive_.force());
   sample_sensor();
 }
 

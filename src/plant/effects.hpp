@@ -4,11 +4,14 @@
 // named exactly as FORMATS.md (epa-gap-report/1) names them.
 //
 // Where each acts, in signal order (one sample, valve command u in V -> measured position):
-//   u -> input_delay -> valve_lag -> dead zone (+ deadzone_shift) -> static_friction
-//     -> gain_change -> position_dependent_gain -> flow_saturation -> ARX -> end stops
+//   u -> input_delay -> valve_lag -> dead zone (+ deadzone_shift) -> gain_change
+//     -> position_dependent_gain -> flow_saturation -> ARX (B) -> end stops
 //     -> sensor noise -> sensor_quantization
+// static_friction, and gain_change's steady_ratio, are a force on the piston: they enter the
+// ARX as a second input through the model's mechanical path (force_path.hpp), not through B.
 // Everything before the ARX part except position_dependent_gain depends on the command history
-// alone, so a replay can compute it once per run; position_dependent_gain reads the position,
+// alone (friction on the model's own mechanical speed, which the command history gives), so a
+// replay can compute it once per run; position_dependent_gain reads the position,
 // sensor_quantization the measurement.
 #include <array>
 #include <cstddef>
@@ -23,11 +26,11 @@
 namespace epa::plant {
 
 enum class EffectKind {
-  kGainChange,             // gain_ratio: the drive u_d scaled (supply pressure, valve gain)
+  kGainChange,             // gain_ratio: the drive u_d scaled (supply pressure, valve gain); steady_ratio
   kDeadzoneShift,          // shift_r_V, shift_l_V: break points moved
   kInputDelay,             // delay_samples: transport delay of the valve command
   kValveLag,               // tau_s: first-order spool dynamics
-  kStaticFriction,         // breakaway_V, coulomb_V: stiction and Coulomb friction (stick-slip)
+  kStaticFriction,         // breakaway_V, coulomb_V: stiction and Coulomb friction on the mechanical speed
   kFlowSaturation,         // ceiling_mm_s: choked flow, a velocity ceiling
   kPositionDependentGain,  // slope_per_100mm, chamber_slope_per_100mm, curvature: gain along the stroke
   kSensorQuantization,     // step_mm: a coarse position sensor
@@ -121,18 +124,34 @@ class ValveEffects {
 };
 
 // Effects between the valve and the ARX part, on the drive u_d (V after the dead zone):
-// dead zone with deadzone_shift, static_friction, gain_change, position_dependent_gain,
-// flow_saturation. `speed_mm_s_per_V` is the nominal model's steady piston speed per volt of u_d,
-// which turns the velocity ceiling into a drive limit.
+// dead zone with deadzone_shift, gain_change, position_dependent_gain, flow_saturation; and the
+// force on the piston (static_friction, steady_ratio), which the ARX takes through its
+// mechanical path (force_path.hpp). `speed_mm_s_per_V` is the nominal model's steady piston speed
+// per volt of u_d, which turns the velocity ceiling into a drive limit; `mechanical_pole` is that
+// path's pole, with which the friction follows the piston's mechanical speed.
+//
+// Friction acts on the mechanical speed v (the drive less the friction, through the pole): while
+// |v| exceeds the speed one sample of Coulomb friction takes away, the piston slides against
+// coulomb; below it, friction holds the drive up to breakaway (stick), and a drive beyond that
+// breaks the piston loose. The valve's flow still reaches B whatever friction does: a stuck
+// piston's chambers still fill.
 class DriveEffects {
  public:
   struct State {
-    bool stuck = true;  // static friction: at rest until the drive exceeds the breakaway level
+    double mechanical_speed_mm_s = 0.0;  // v: what friction opposes
+    double force_V = 0.0;                // the last sample's force on the piston, volts of drive
   };
   DriveEffects() = default;
-  DriveEffects(const EffectSet& effects, const core::DeadZone& nominal, double speed_mm_s_per_V);
-  // The drive before the position-dependent factor and the ceiling (history-dependent part).
+  DriveEffects(const EffectSet& effects, const core::DeadZone& nominal, double speed_mm_s_per_V,
+               double mechanical_pole = 0.0);
+  // The drive before the position-dependent factor and the ceiling (history-dependent part); also
+  // advances the force (force()).
   double drive_before_position(double spool_v) noexcept;
+  // The force on the piston at the sample drive_before_position last computed, volts of drive:
+  // minus the friction, plus (steady_ratio - 1) times the drive.
+  double force() const { return state_.force_V; }
+  // The friction force (volts of drive) at mechanical speed v with drive d: the form's shape.
+  double friction_V(double mechanical_speed_mm_s, double drive_V) const noexcept;
   // The position-dependent factor and the ceiling (memoryless part).
   double finish(double drive, double position_mm) const noexcept;
   // Whether finish() reads the position (position_dependent_gain is on and not neutral).
@@ -147,7 +166,8 @@ class DriveEffects {
   core::DeadZone dead_zone_;
   bool friction_ = false;
   double breakaway_ = 0, coulomb_ = 0;
-  double gain_ = 1.0, max_drive_ = 0.0;  // max_drive_ 0: no ceiling
+  double speed_mm_s_per_V_ = 0.0, pole_ = 0.0;
+  double gain_ = 1.0, steady_extra_ = 0.0, max_drive_ = 0.0;  // max_drive_ 0: no ceiling
   double slope_per_mm_ = 0.0, chamber_per_mm_ = 0.0, curvature_ = 0.0;  // position_dependent_gain
   std::size_t where_samples_ = kDefaultWherePositions;
   State state_;

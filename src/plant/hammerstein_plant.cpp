@@ -27,6 +27,7 @@ core::Result<HammersteinPlant> HammersteinPlant::make(const core::HammersteinMod
   p.nb_ = model.B.size() - 1;
   for (std::size_t i = 0; i <= p.na_; ++i) p.a_[i] = model.A[i];
   for (std::size_t i = 0; i <= p.nb_; ++i) p.b_[i] = model.B[i];
+  p.force_path_ = force_path(model);
   p.dead_zone_ = model.dead_zone;
   p.mm_per_volt_ = model.mm_per_volt;
   p.max_v_ = o.stroke_mm / model.mm_per_volt;
@@ -37,15 +38,18 @@ core::Result<HammersteinPlant> HammersteinPlant::make(const core::HammersteinMod
   return p;
 }
 
-void HammersteinPlant::step(double valve_v) noexcept {
+void HammersteinPlant::step(double valve_v, double force_v) noexcept {
   const double ud = dead_zone_.apply(std::isfinite(valve_v) ? valve_v : 0.0);
   // y(k+1) = -a1 y(k) - a2 y(k-1) - ... + b1 u_d(k) + b2 u_d(k-1) + ...  (b0 = 0, checked in make)
+  //          + c1 F(k) + c2 F(k-1) + ...                                  (force_path.hpp)
   auto& s = state_;
-  for (std::size_t i = s.ud_past.size() - 1; i > 0; --i) s.ud_past[i] = s.ud_past[i - 1];
+  for (std::size_t i = s.ud_past.size() - 1; i > 0; --i) s.ud_past[i] = s.ud_past[i - 1], s.force_past[i] = s.force_past[i - 1];
   s.ud_past[0] = ud;  // now u_d(k), u_d(k-1), ...
+  s.force_past[0] = std::isfinite(force_v) ? force_v : 0.0;
   double y = 0.0;
   for (std::size_t i = 1; i <= na_; ++i) y -= a_[i] * s.y_past[i - 1];
   for (std::size_t i = 1; i <= nb_; ++i) y += b_[i] * s.ud_past[i - 1];
+  for (std::size_t i = 1; i <= force_path_.nc; ++i) y += force_path_.c[i] * s.force_past[i - 1];
   // End stops: the piston cannot leave the stroke; the clamped value is what the model remembers,
   // so a piston held at a stop starts moving back as soon as the command reverses.
   y = std::clamp(y, 0.0, max_v_);

@@ -8,6 +8,7 @@
 #include "core/hammerstein_model.hpp"
 #include "core/random.hpp"
 #include "core/result.hpp"
+#include "plant/force_path.hpp"
 
 namespace epa::plant {
 
@@ -31,6 +32,7 @@ class HammersteinPlant {
   struct State {
     std::array<double, kRememberedPositions> y_past{};   // y(k), y(k-1), ... true position, V
     std::array<double, core::kMaxModelOrder> ud_past{};  // u_d(k-1), u_d(k-2), ... after the dead zone
+    std::array<double, core::kMaxModelOrder> force_past{};  // F(k-1), F(k-2), ...: a force on the piston, V of drive
     double measured_v = 0.0;                             // y(k) + noise, what the sensor reads
     core::Random rng;
   };
@@ -46,7 +48,9 @@ class HammersteinPlant {
   double mean_position_mm(std::size_t samples) const;
 
   // Applies valve command u(k) (V; non-finite is taken as 0 V, the centred valve) and advances.
-  void step(double valve_v) noexcept;
+  // `force_v`: a force on the piston over the sample, volts of drive, through the model's
+  // mechanical path (force_path.hpp; friction, for the effects of plant/effects.hpp).
+  void step(double valve_v, double force_v = 0.0) noexcept;
 
   const State& state() const { return state_; }
   void set_state(const State& state) { state_ = state; }
@@ -55,6 +59,7 @@ class HammersteinPlant {
   HammersteinPlant() = default;
   std::array<double, core::kMaxModelOrder + 1> a_{}, b_{};
   std::size_t na_ = 0, nb_ = 0;
+  ForcePath force_path_;
   core::DeadZone dead_zone_;
   double mm_per_volt_ = 50.0, max_v_ = 10.0, noise_std_v_ = 0.0;
   State state_;

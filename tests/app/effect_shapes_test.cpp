@@ -38,15 +38,16 @@ TEST(EffectShapes, AChamberSlopeFallsAlongTheStrokeEachWayAndIsMirrored) {
   EXPECT_NEAR(at(retracting, 350.0), 1.2, 1e-9);
 }
 
-TEST(EffectShapes, FrictionHoldsFromRestUpToBreakawayAndTakesCoulombOffWhileMoving) {
+TEST(EffectShapes, FrictionIsCoulombAgainstTheSpeedWhileSlidingAndHoldsUpToBreakawayWhileSticking) {
   const auto panels = epa::app::effect_shape_panels(diagnosis_naming(EffectKind::kStaticFriction, {0.6, 0.3, 0.0}));
   ASSERT_EQ(panels.size(), 1u);
-  const auto& from_rest = panels[0].series[0];
-  const auto& moving = panels[0].series[1];
-  EXPECT_EQ(at(from_rest, 0.5), 0.0);
-  EXPECT_NEAR(at(from_rest, 1.0), 0.7, 1e-9);
-  EXPECT_NEAR(at(moving, 0.5), 0.2, 1e-9);
-  EXPECT_NEAR(at(moving, -1.0), -0.7, 1e-9);
+  const auto& sliding = panels[0].series[0];
+  const auto& sticking = panels[0].series[1];
+  EXPECT_NEAR(at(sliding, 50.0), 0.3, 1e-9);
+  EXPECT_NEAR(at(sliding, -20.0), -0.3, 1e-9);
+  ASSERT_EQ(sticking.y.size(), 2u);
+  EXPECT_NEAR(sticking.y[0], -0.6, 1e-9);
+  EXPECT_NEAR(sticking.y[1], 0.6, 1e-9);
 }
 
 TEST(EffectShapes, ALagIsTheSpoolsStepAndQuantisationHasNoPanel) {

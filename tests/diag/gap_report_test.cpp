@@ -114,6 +114,26 @@ TEST_F(DiagnoseCli, NamesTheHiddenEffectAndWritesTheJsonAndTheReport) {
   EXPECT_NE(h.str().find("valve_lag"), std::string::npos);
 }
 
+TEST_F(DiagnoseCli, ReadingsThatDriftWhileTheValveRestsLeaveTheGapUnexplainedAndSaySo) {
+  // The same runs read by a sensor whose offset drifts 1.5 mm/s: the windowed gap barely moves
+  // (0.08 mm per 10-sample window), but no effect moves a piston while the valve rests.
+  auto drifting = [](epa::core::Run r) {
+    for (std::size_t k = 0; k < r.size(); ++k) r.y_mm[k] += 1.5 * r.t_s[k];
+    return r;
+  };
+  const auto& d = fixture().data;
+  const auto o = epa::testing::run_epa("diagnose " + write(drifting(d.train[0]), "a.csv") + " " +
+                                       write(drifting(d.train[1]), "b.csv") + " --holdout " +
+                                       write(drifting(d.heldout[0]), "c.csv") + " --json " + path("drift.json"));
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  std::ifstream in(path("drift.json"));
+  const json j = json::parse(in);
+  EXPECT_EQ(j.at("verdict").at("unexplained"), true) << j.dump(1);
+  EXPECT_EQ(j.at("rest_drift").at("readings_move"), true);
+  EXPECT_NEAR(j.at("rest_drift").at("median_speed_mm_s").get<double>(), 1.5, 0.3);
+  EXPECT_NE(j.at("verdict").at("text").get<std::string>().find("while the valve rests"), std::string::npos);
+}
+
 TEST_F(DiagnoseCli, WithoutHeldOutRunsItCrossValidatesByRun) {
   const auto& d = fixture().data;
   const auto o = epa::testing::run_epa("diagnose " + write(d.train[0], "a.csv") + " " + write(d.train[1], "b.csv") + " " +

@@ -2,6 +2,7 @@
 // direction; the augmented plant with no effects is the Hammerstein plant.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/paper_reference.hpp"
@@ -67,12 +68,51 @@ TEST(Effects, EachEffectChangesTheMotionTheWayItShould) {
   EXPECT_NEAR(std::fmod(q + 250.0, 5.0), 0.0, 1e-9);
 }
 
-TEST(Effects, StaticFrictionHoldsBelowBreakawayAndKeepsMovingAboveCoulomb) {
+// Steady piston speed (mm/s) over the last 100 of `samples` of a constant command, after
+// `before` samples of another command (a piston set sliding first, or left at rest).
+double steady_speed_mm_s(const EffectSet& e, double valve_v, double before_v = 0.0, int samples = 300) {
+  auto p = AugmentedPlant::make(epa::core::paper::model(), e, {.initial_position_mm = 100.0, .stroke_mm = 1e6});
+  EXPECT_TRUE(p.has_value());
+  for (int k = 0; k < 100; ++k) p->step(before_v);
+  for (int k = 0; k < samples - 100; ++k) p->step(valve_v);
+  const double from = p->measured_mm();
+  for (int k = 0; k < 100; ++k) p->step(valve_v);
+  return (p->measured_mm() - from) / (100 * 0.005);
+}
+
+TEST(Effects, StaticFrictionHoldsBelowBreakawayAndSlidesAgainstCoulombAbove) {
+  const double speed_per_V = epa::plant::steady_speed_mm_s_per_V(epa::core::paper::model().A.coefficients(),
+                                                                  epa::core::paper::model().B.coefficients(), 0.005, 50.0);
   EffectSet e;
   e.set(EffectKind::kStaticFriction, {1.0, 0.3});
   // Drive u_d = m_r (u - b_r): 1.7627 * 0.4 = 0.71 V, below breakaway: the piston stays.
-  EXPECT_NEAR(travel_mm(e, 1.232 + 0.4), 0.0, 1e-9);
-  EXPECT_GT(travel_mm(e, 1.232 + 0.8), 5.0);
+  EXPECT_NEAR(steady_speed_mm_s(e, 1.232 + 0.4), 0.0, 1e-6);
+  EXPECT_NEAR(steady_speed_mm_s(EffectSet{}, 1.232 + 0.4), 0.705 * speed_per_V, 1.0);  // without friction it moves
+  // 1.41 V breaks it loose; sliding, Coulomb friction takes 0.3 V of it.
+  EXPECT_NEAR(steady_speed_mm_s(e, 1.232 + 0.8), (1.7627 * 0.8 - 0.3) * speed_per_V, 1.0);
+  // Stick-slip: 0.71 V holds a piston at rest but keeps one sliding (above Coulomb).
+  EXPECT_NEAR(steady_speed_mm_s(e, 1.232 + 0.4, 1.232 + 0.8), (1.7627 * 0.4 - 0.3) * speed_per_V, 1.0);
+  // Below Coulomb a sliding piston stops.
+  EXPECT_NEAR(steady_speed_mm_s(e, 1.232 + 0.1, 1.232 + 0.8), 0.0, 1e-6);
+}
+
+TEST(Effects, FrictionIsAForceOnThePistonNotAChangeOfTheValvesFlow) {
+  // The valve's flow reaches B whatever friction does: a step of the drive held by friction still
+  // gives B's swing (the chambers fill) but no steady motion, where a drive that never passes the
+  // dead zone gives neither.
+  EffectSet e;
+  e.set(EffectKind::kStaticFriction, {1.0, 0.3});
+  auto p = AugmentedPlant::make(epa::core::paper::model(), e, {.initial_position_mm = 250.0});
+  ASSERT_TRUE(p.has_value());
+  double largest_swing_mm = 0.0;
+  for (int k = 0; k < 200; ++k) {
+    p->step(1.232 + 0.4);
+    largest_swing_mm = std::max(largest_swing_mm, std::abs(p->measured_mm() - 250.0));
+  }
+  EXPECT_GT(largest_swing_mm, 10.0);
+  const double settled = p->measured_mm();
+  for (int k = 0; k < 100; ++k) p->step(1.232 + 0.4);
+  EXPECT_NEAR(p->measured_mm(), settled, 1e-6);
 }
 
 TEST(Effects, ValidateNamesTheEffectAndParameter) {
