@@ -31,7 +31,13 @@ constexpr ParamSpec kLag[] = {{"tau_s", 0.0, 0.2, 0.0, false, "time constant of 
 constexpr ParamSpec kFriction[] = {
     {"breakaway_V", 0.0, 2.0, 0.0, false, "drive u_d friction holds while the piston sticks (stiction)"},
     {"coulomb_V", 0.0, 2.0, 0.0, false, "drive u_d friction takes while the piston slides"}};
-constexpr ParamSpec kSaturation[] = {{"ceiling_mm_s", 20.0, 5000.0, 5000.0, false, "largest piston speed (choked flow)"}};
+// A family: a ceiling on the drive's speed, reached softly or sharply (the knee: speed =
+// s / (1 + |s / ceiling|^n)^(1/n) of the unsaturated speed s, n the knee's sharpness; n = 64 is a
+// hard clip), and lower or higher one way (a rod side that chokes first).
+constexpr ParamSpec kSaturation[] = {
+    {"ceiling_mm_s", 20.0, 5000.0, 5000.0, false, "largest piston speed extending (choked flow)"},
+    {"retract_over_extend", 0.5, 2.0, 1.0, false, "the ceiling retracting over the ceiling extending", true},
+    {"knee_sharpness", 1.5, 64.0, 64.0, false, "how sharply the speed meets its ceiling: 64 a hard clip, 2 a soft knee", true}};
 // A family, not one form: a gain that changes along the stroke the same way in both directions
 // (slope), one that falls as the driving chamber lengthens (air compressibility: extending, the
 // cap-side chamber grows with the position; retracting, the rod side grows as it falls), and one
@@ -164,7 +170,8 @@ DriveEffects::DriveEffects(const EffectSet& e, const core::DeadZone& nominal, do
         std::clamp(std::lround(e.param(EffectKind::kPositionDependentGain, 3)), 1L, static_cast<long>(kMaxWherePositions)));
   }
   if (e.on(EffectKind::kFlowSaturation) && speed_mm_s_per_V > 0.0)
-    max_drive_ = e.param(EffectKind::kFlowSaturation, 0) / speed_mm_s_per_V;
+    max_drive_ = e.param(EffectKind::kFlowSaturation, 0) / speed_mm_s_per_V,
+    retract_ratio_ = e.param(EffectKind::kFlowSaturation, 1), knee_ = e.param(EffectKind::kFlowSaturation, 2);
 }
 
 double DriveEffects::friction_V(double v, double d) const noexcept {
@@ -198,7 +205,10 @@ double DriveEffects::finish(double drive, double position_mm) const noexcept {
     d *= std::max(kMinPositionFactor, 1.0 + slope_per_mm_ * from_mid_mm - chamber_per_mm_ * chamber_longer_mm +
                                           curvature_ * (xi * xi - 1.0 / 3.0));
   }
-  if (max_drive_ > 0.0) d = std::clamp(d, -max_drive_, max_drive_);
+  if (max_drive_ > 0.0) {
+    const double ceiling = d >= 0.0 ? max_drive_ : max_drive_ * retract_ratio_;
+    d = knee_ >= 64.0 ? std::clamp(d, -ceiling, ceiling) : d / std::pow(1.0 + std::pow(std::abs(d) / ceiling, knee_), 1.0 / knee_);
+  }
   return d;
 }
 

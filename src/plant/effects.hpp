@@ -168,6 +168,7 @@ class DriveEffects {
   double breakaway_ = 0, coulomb_ = 0;
   double speed_mm_s_per_V_ = 0.0, pole_ = 0.0;
   double gain_ = 1.0, steady_extra_ = 0.0, max_drive_ = 0.0;  // max_drive_ 0: no ceiling
+  double retract_ratio_ = 1.0, knee_ = 64.0;                   // flow_saturation's family
   double slope_per_mm_ = 0.0, chamber_per_mm_ = 0.0, curvature_ = 0.0;  // position_dependent_gain
   std::size_t where_samples_ = kDefaultWherePositions;
   State state_;

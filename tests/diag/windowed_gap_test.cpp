@@ -33,6 +33,23 @@ TEST(WindowedGap, IsZeroWithTheHiddenEffectSwitchedOnInTheReplay) {
   }
 }
 
+TEST(WindowedGap, TheFamiliesOtherMembersReplayExactlyToo) {
+  // A steady speed off B's, a soft per-direction flow knee, friction that sticks (breakaway well
+  // above Coulomb): the simulator and the replay share the forms and the force path.
+  const auto model = epa::core::paper::model();
+  std::vector<epa::plant::EffectSet> sets(3);
+  sets[0].set(epa::plant::EffectKind::kGainChange, {1.0, 0.85});
+  sets[1].set(epa::plant::EffectKind::kFlowSaturation, {150.0, 0.6, 2.5});
+  sets[2].set(epa::plant::EffectKind::kStaticFriction, {0.9, 0.2});
+  sets[2].set(epa::plant::EffectKind::kGainChange, {1.1, 1.15});
+  for (const auto& e : sets) {
+    const auto run = epa::testing::make_run(model, epa::testing::Hidden{e}, {.closed_loop = true, .duration_s = 10, .noise_std_mm = 0.0});
+    const std::vector<const epa::core::Run*> runs{&run};
+    EXPECT_GT(epa::diag::windowed_gap_mm({model, {}, 500}, runs, 10), 0.05) << e.describe();
+    EXPECT_LT(epa::diag::windowed_gap_mm({model, e, 500}, runs, 10), 1e-9) << e.describe();
+  }
+}
+
 TEST(WindowedGap, GrowsWithTheHorizonOnADriftingPlant) {
   epa::testing::Hidden h;
   h.effects.set(epa::plant::EffectKind::kGainChange, {0.8});

@@ -96,6 +96,22 @@ TEST(Effects, StaticFrictionHoldsBelowBreakawayAndSlidesAgainstCoulombAbove) {
   EXPECT_NEAR(steady_speed_mm_s(e, 1.232 + 0.1, 1.232 + 0.8), 0.0, 1e-6);
 }
 
+TEST(Effects, TheFlowCeilingIsPerDirectionAndItsKneeHardOrSoft) {
+  const auto model = epa::core::paper::model();
+  const double speed_per_V = epa::plant::steady_speed_mm_s_per_V(model.A.coefficients(), model.B.coefficients(), 0.005, 50.0);
+  EffectSet hard;
+  hard.set(EffectKind::kFlowSaturation, {60.0, 0.5});  // knee left out: a hard clip
+  EXPECT_NEAR(steady_speed_mm_s(hard, 1.232 + 2.0), 60.0, 0.5);
+  EXPECT_NEAR(steady_speed_mm_s(hard, -1.722 - 2.0), -30.0, 0.5);  // the rod side chokes at half
+  EXPECT_NEAR(steady_speed_mm_s(hard, 1.232 + 0.1), 1.7627 * 0.1 * speed_per_V, 0.5);  // below the ceiling: untouched
+  EffectSet soft;
+  soft.set(EffectKind::kFlowSaturation, {60.0, 1.0, 2.0});
+  // A drive whose unsaturated speed is the ceiling reaches 1/sqrt(2) of it through a knee of 2.
+  const double at_ceiling_v = 1.232 + 60.0 / speed_per_V / 1.7627;
+  EXPECT_NEAR(steady_speed_mm_s(soft, at_ceiling_v), 60.0 / std::sqrt(2.0), 0.5);
+  EXPECT_NEAR(steady_speed_mm_s(soft, 1.232 + 3.0), 60.0, 3.0);  // far beyond: near the ceiling
+}
+
 TEST(Effects, FrictionIsAForceOnThePistonNotAChangeOfTheValvesFlow) {
   // The valve's flow reaches B whatever friction does: a step of the drive held by friction still
   // gives B's swing (the chambers fill) but no steady motion, where a drive that never passes the
