@@ -5,16 +5,22 @@ truth forms were fixed before the diagnosis was changed, and are not to be chang
 
 How each truth form differs from the fitted one:
 
-  friction      fitted: stick/slip on the size of the drive (breakaway and Coulomb levels).
+  friction      fitted (since 2026-11-27): Coulomb against the model's mechanical speed while
+                sliding, holding the drive up to a breakaway level while sticking; a force through
+                the model's slow pole, the valve's flow still reaching B (before: stick/slip on the
+                size of the drive, cutting the drive that reaches B).
                 truth: Karnopp with a Stribeck curve and viscous term on the piston's velocity,
                 which freezes the piston while stuck; and LuGre bristles (presliding, no hard stick).
+                Shared: how a force enters the printed model (through its slow pole, not B), a
+                physical choice both sides make; the friction laws differ.
   position      fitted: one gain slope along the stroke, both directions alike.
                 truth: chamber compressibility, gain ~ 1/(dead volume + chamber length), mirrored
                 per direction; and a cosine dip of the gain around mid-stroke.
   spool         fitted: first-order lag.   truth: second-order spool (natural frequency,
                 damping); a slew-rate-limited spool.
   delay         fitted: whole samples.     truth: fractional delays, and a line delay with a lag.
-  flow          fitted: a symmetric hard ceiling on the drive.
+  flow          fitted: a ceiling per direction through a knee s / (1 + |s/c|^n)^(1/n)
+                (n from 1.5, soft, to 64, hard; since 2026-11-27; before: one symmetric hard ceiling).
                 truth: soft (tanh) saturation with a different knee each way; hard limits that
                 differ per direction.
   supply        fitted: one gain ratio.    truth: flow ~ sqrt of the pressure drop, rod-side area
