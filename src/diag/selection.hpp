@@ -16,8 +16,9 @@
 //  5. Pairs: the best pair_pool first-round candidates fitted two at a time, jointly; a pair
 //     replaces the forward set when it leaves a smaller gap and each of its effects beats its own
 //     chance threshold on top of the other (two effects that each explain little alone).
-//  6. The accepted set re-fitted jointly from the nominal model, then a backward check: an effect
-//     stays only while removing it (the rest re-fitted) costs more than its chance threshold.
+//  6. The accepted set re-fitted jointly (all free at once, from where the selection left them and
+//     from neutral), then a backward check: an effect stays only while removing it (the rest
+//     re-fitted from where they stand) costs more than its chance threshold.
 //  7. gain_change and deadzone_shift are named when their parameters, fitted with the accepted
 //     effects, lie beyond tolerances calibrated on effect-free data from slightly perturbed models
 //     and holding them nominal costs more than their chance threshold of the baseline gap (a
