@@ -143,6 +143,7 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
   const FitOptions fo{.horizon = o.horizon};
 
   Models current{std::vector<ReplayModel>(folds.size(), nominal), nominal};
+  std::array<Models, plant::kEffectCount> first_round;  // each candidate fitted alone (with the nominal parameters)
   d.nominal = nominal;
   // One replay of every run on the nominal model gives the training gap, the held-out baseline
   // (every fold tests its runs against this same model, each run once, so the pooled folds are
@@ -201,6 +202,7 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
     for (std::size_t i = 0; i < trials.size(); ++i) {
       d.evaluations += trials[i].evaluations;
       if (trials[i].heldout_gap_mm < trials[best].heldout_gap_mm) best = i;
+      if (round == 0) first_round[plant::index(remaining[i])] = trials[i].models;
       if (round == 0)
         d.candidates.push_back({remaining[i], trials[i].models.all.effects.params(remaining[i]), trials[i].heldout_gap_mm,
                                 reduction(d.baseline_gap_mm, trials[i].heldout_gap_mm),
@@ -255,10 +257,13 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
     for (std::size_t i = 0; i < firsts.size(); ++i)
       for (std::size_t j = i + 1; j < firsts.size(); ++j)
         pairs.emplace_back(firsts[i].kind, firsts[j].kind);  // partners too: a line delay with a lag is both
+    // Each pair starts from its better member fitted alone, the other added afresh: afresh from
+    // the nominal model the joint fit found worse optima than the better member alone (a
+    // second-order spool with a soft flow knee: every pair left more than the spool's lag alone).
     std::vector<std::future<Trial>> futures;
     for (const auto& pair : pairs)
       futures.push_back(std::async(std::launch::async, [&, a = pair.first, b = pair.second] {
-        return trial(nominal_models, with_nominal({a, b}), folds, train, all_is_fold0, fo);
+        return trial(first_round[plant::index(a)], with_nominal({a, b}), folds, train, all_is_fold0, fo);
       }));
     auto alone_gap = [&](EffectKind k) {
       for (const auto& c : d.candidates)

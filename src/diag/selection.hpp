@@ -13,7 +13,8 @@
 //     only takes noise away), re-fitting on top of what is accepted; at most max_effects.
 //     input_delay and valve_lag explain much the same; when the runner-up comes within
 //     confusable_ratio of the winner's reduction, the pair is reported as confusable.
-//  5. Pairs: the best pair_pool first-round candidates fitted two at a time, jointly; a pair
+//  5. Pairs: the best pair_pool first-round candidates fitted two at a time, jointly (from the
+//     better one fitted alone, the other added afresh, so no pair leaves more than it); a pair
 //     replaces the forward set when it leaves a smaller gap and each of its effects beats its own
 //     chance threshold on top of the other (two effects that each explain little alone).
 //  6. The accepted set re-fitted jointly (all free at once, from where the selection left them and
