@@ -169,9 +169,11 @@ DriveEffects::DriveEffects(const EffectSet& e, const core::DeadZone& nominal, do
     where_samples_ = static_cast<std::size_t>(
         std::clamp(std::lround(e.param(EffectKind::kPositionDependentGain, 3)), 1L, static_cast<long>(kMaxWherePositions)));
   }
-  if (e.on(EffectKind::kFlowSaturation) && speed_mm_s_per_V > 0.0)
-    max_drive_ = e.param(EffectKind::kFlowSaturation, 0) / speed_mm_s_per_V,
-    retract_ratio_ = e.param(EffectKind::kFlowSaturation, 1), knee_ = e.param(EffectKind::kFlowSaturation, 2);
+  if (e.on(EffectKind::kFlowSaturation) && speed_mm_s_per_V > 0.0) {
+    max_drive_ = e.param(EffectKind::kFlowSaturation, 0) / speed_mm_s_per_V;
+    retract_ratio_ = e.param(EffectKind::kFlowSaturation, 1);
+    knee_ = e.param(EffectKind::kFlowSaturation, 2);
+  }
 }
 
 double DriveEffects::friction_V(double v, double d) const noexcept {
