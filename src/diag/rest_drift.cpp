@@ -8,8 +8,10 @@ namespace epa::diag {
 namespace {
 
 struct Line {
-  double speed = 0;  // per second
+  double speed = 0;                // per second
+  double mean_t = 0, mean_y = 0;   // the line passes through (mean_t, mean_y); t from the first sample
   std::size_t used = 0;
+  double at(double t) const { return mean_y + speed * (t - mean_t); }
 };
 
 // Least-squares line through y[first, last) at times k Ts, leaving out the samples `keep` rejects.
@@ -23,7 +25,7 @@ Line fit_line(const std::vector<double>& y, std::size_t first, std::size_t last,
   }
   const double det = n * stt - st * st;
   if (n < 3 || det <= 0) return {};
-  return {(n * sty - st * sy) / det, static_cast<std::size_t>(n)};
+  return {(n * sty - st * sy) / det, st / n, sy / n, static_cast<std::size_t>(n)};
 }
 
 double median(std::vector<double> v) {
@@ -57,15 +59,8 @@ RestDrift rest_drift(const std::vector<const core::Run*>& runs, const core::Dead
       if (first >= end || end - first < min_length) continue;
       // Twice: the second fit leaves out readings far off the first line (a sensor's spikes).
       const Line rough = fit_line(y, first, end, Ts, [](std::size_t) { return true; });
-      double mean_y = 0;
-      for (std::size_t i = first; i < end; ++i) mean_y += y[i];
-      mean_y /= static_cast<double>(end - first);
-      const double mid_t = 0.5 * static_cast<double>(end - 1 - first) * Ts;
       const double limit = o.outlier_sigmas * std::max(noise_std_mm, 1e-6);
-      auto near_line = [&](std::size_t i) {
-        const double t = static_cast<double>(i - first) * Ts;
-        return std::abs(y[i] - (mean_y + rough.speed * (t - mid_t))) <= limit;
-      };
+      auto near_line = [&](std::size_t i) { return std::abs(y[i] - rough.at(static_cast<double>(i - first) * Ts)) <= limit; };
       const Line line = fit_line(y, first, end, Ts, near_line);
       if (line.used < min_length) continue;
       const double n = static_cast<double>(line.used);

@@ -79,6 +79,7 @@ double reduction(double before, double after) { return before > 0 ? 100.0 * (1.0
 // has exactly the library's form, so the named effects leave a residue that is theirs, not a
 // further cause. Without a named effect, any significant gap is unexplained.
 bool unexplained(const Diagnosis& d, const DiagnosisOptions& o) {
+  if (d.rest_drift.moving) return true;  // outside the vocabulary whatever the gap (rest_drift.hpp)
   const bool significant = d.final_gap_mm > o.unexplained_factor * d.noise_floor_mm;
   if (d.effects.empty()) return significant;
   return significant && d.final_gap_mm > o.unexplained_share * d.baseline_gap_mm;
@@ -383,6 +384,19 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
   // The final model carries only what is named: unnamed nominal parameters stay re-fitted (they
   // are the model's own), and are reported as the re-fit.
 
+  // Readings that move at rest, where the final model holds the piston still (part of the verdict).
+  {
+    core::DeadZone band = nominal.model.dead_zone;
+    if (d.final_model.effects.on(EffectKind::kDeadzoneShift)) {
+      band.b_r += d.final_model.effects.param(EffectKind::kDeadzoneShift, 0);
+      band.b_l += d.final_model.effects.param(EffectKind::kDeadzoneShift, 1);
+    }
+    d.rest_drift = rest_drift(all_runs, band, d.noise_std_mm);
+    std::snprintf(buf, sizeof buf, "at rest inside the dead band: the readings move %.3f mm/s (median of %zu rests; noise stays below %.3f)%s",
+                  d.rest_drift.median_speed_mm_s, d.rest_drift.rests, d.rest_drift.threshold_mm_s,
+                  d.rest_drift.moving ? ": outside the vocabulary (a drifting sensor, a leak, a load)" : "");
+    say(buf);
+  }
   d.unexplained = unexplained(d, o);
   // 8. The sensor's resolution: readings on a grid whose rounding error (step / sqrt(12)) is at
   // least half the noise are a coarse sensor. A replay cannot predict the rounding, so this raises the
@@ -402,20 +416,6 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
     d.unexplained = unexplained(d, o);
     for (auto& c : d.candidates)
       if (c.kind == EffectKind::kSensorQuantization) c.params = plant::EffectParams{*step, 0.0, 0.0}, c.accepted = true;
-  }
-  // 9. Readings that move at rest, where the final model holds the piston still.
-  {
-    core::DeadZone band = nominal.model.dead_zone;
-    if (d.final_model.effects.on(EffectKind::kDeadzoneShift)) {
-      band.b_r += d.final_model.effects.param(EffectKind::kDeadzoneShift, 0);
-      band.b_l += d.final_model.effects.param(EffectKind::kDeadzoneShift, 1);
-    }
-    d.rest_drift = rest_drift(all_runs, band, d.noise_std_mm);
-    std::snprintf(buf, sizeof buf, "at rest inside the dead band: the readings move %.3f mm/s (median of %zu rests; noise stays below %.3f)%s",
-                  d.rest_drift.median_speed_mm_s, d.rest_drift.rests, d.rest_drift.threshold_mm_s,
-                  d.rest_drift.moving ? ": outside the vocabulary (a drifting sensor, a leak, a load)" : "");
-    say(buf);
-    d.unexplained = d.unexplained || d.rest_drift.moving;
   }
   std::snprintf(buf, sizeof buf, "verdict: %s; held-out gap %.3f -> %.3f mm; noise floor %.3f mm (sensor noise %.3f mm)%s",
                 d.effects.empty() ? "no effect accepted" : names(d.effects).c_str(), d.baseline_gap_mm,

@@ -50,7 +50,6 @@ WindowCount replay(const ReplayModel& m, const core::Run& run, std::size_t horiz
   const double step_mm = m.effects.on(plant::EffectKind::kSensorQuantization)
                              ? m.effects.param(plant::EffectKind::kSensorQuantization, 0) : 0.0;
 
-  // The history-dependent input side, once over the whole run.
   // The history-dependent input side, once over the whole run: the drive and the force on the
   // piston (friction on the model's mechanical speed, which the command history gives).
   plant::ValveEffects valve(m.effects, model.Ts);

@@ -22,7 +22,7 @@ core::Result<AugmentedPlant> AugmentedPlant::make(const core::HammersteinModel& 
   if (!(options.noise_std_mm >= 0.0)) return core::invalid_argument("plant: sensor noise must be >= 0 mm");
   AugmentedPlant p(std::move(*arx));
   p.valve_ = ValveEffects(effects, model.Ts);
-  const auto path = force_path(model);
+  const auto& path = p.arx_.mechanical_path();
   p.drive_ = DriveEffects(effects, model.dead_zone, path.speed_mm_s_per_V, path.pole);
   p.mm_per_volt_ = model.mm_per_volt;
   p.noise_std_v_ = options.noise_std_mm / model.mm_per_volt;

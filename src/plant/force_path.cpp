@@ -1,35 +1,21 @@
 #include "plant/force_path.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
+#include "core/polynomial.hpp"
 #include "plant/effects.hpp"
 
 namespace epa::plant {
 
 namespace {
 
-// A'(z) = z^n + a'_1 z^(n-1) + ... + a'_n at z.
-double evaluate(const std::vector<double>& a_prime, double z) {
-  double v = 0.0;
-  for (double c : a_prime) v = v * z + c;
-  return v;
-}
-
-// The largest real root of A' in (0, 1), or 0: a scan for sign changes, then bisection.
+// The largest real root of A' in (0, 1), or 0.
 double slowest_real_pole(const std::vector<double>& a_prime) {
-  constexpr int kSteps = 1000;
   double pole = 0.0;
-  for (int i = 0; i < kSteps; ++i) {
-    double lo = static_cast<double>(i) / kSteps, hi = static_cast<double>(i + 1) / kSteps;
-    if (hi >= 1.0) hi = 1.0 - 1e-9;
-    if ((evaluate(a_prime, lo) > 0.0) == (evaluate(a_prime, hi) > 0.0)) continue;
-    for (int j = 0; j < 60; ++j) {
-      const double mid = 0.5 * (lo + hi);
-      ((evaluate(a_prime, lo) > 0.0) == (evaluate(a_prime, mid) > 0.0) ? lo : hi) = mid;
-    }
-    pole = 0.5 * (lo + hi);
-  }
+  for (const auto& z : core::Polynomial(a_prime).z_roots())
+    if (std::abs(z.imag()) <= 1e-9 && z.real() > 0.0 && z.real() < 1.0) pole = std::max(pole, z.real());
   return pole;
 }
 

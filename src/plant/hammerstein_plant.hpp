@@ -54,6 +54,8 @@ class HammersteinPlant {
 
   const State& state() const { return state_; }
   void set_state(const State& state) { state_ = state; }
+  // How a force on the piston enters (step's force_v), from the model.
+  const ForcePath& mechanical_path() const { return force_path_; }
 
  private:
   HammersteinPlant() = default;
