@@ -27,7 +27,10 @@ constexpr ParamSpec kGain[] = {
 constexpr ParamSpec kShift[] = {{"shift_r_V", -1.0, 1.0, 0.0, false, "right break point b_r moved by"},
                                 {"shift_l_V", -1.0, 1.0, 0.0, false, "left break point b_l moved by"}};
 constexpr ParamSpec kDelay[] = {{"delay_samples", 0.0, 40.0, 0.0, true, "transport delay of the valve command, samples of Ts"}};
-constexpr ParamSpec kLag[] = {{"tau_s", 0.0, 0.2, 0.0, false, "time constant of the spool's first-order lag"}};
+// A family: first order (tau_s), or second order with two real poles (second_tau_s > 0: a
+// spool with its amplifier, critically or over-damped).
+constexpr ParamSpec kLag[] = {{"tau_s", 0.0, 0.2, 0.0, false, "time constant of the spool's first-order lag"},
+                              {"second_tau_s", 0.0, 0.2, 0.0, false, "time constant of a second lag in series (0: first order)", true}};
 constexpr ParamSpec kFriction[] = {
     {"breakaway_V", 0.0, 2.0, 0.0, false, "drive u_d friction holds while the piston sticks (stiction)"},
     {"coulomb_V", 0.0, 2.0, 0.0, false, "drive u_d friction takes while the piston slides"}};
@@ -129,6 +132,8 @@ ValveEffects::ValveEffects(const EffectSet& e, double Ts) {
   if (e.on(EffectKind::kValveLag)) {
     const double tau_s = e.param(EffectKind::kValveLag, 0);
     lag_alpha_ = tau_s > 0.0 ? 1.0 - std::exp(-Ts / tau_s) : 1.0;
+    const double second_s = e.param(EffectKind::kValveLag, 1);
+    second_alpha_ = second_s > 0.0 ? 1.0 - std::exp(-Ts / second_s) : 1.0;
   }
 }
 
@@ -142,7 +147,9 @@ double ValveEffects::apply(double valve_v) noexcept {
     s.head = (s.head + 1) % n;
   }
   state_.spool_v += lag_alpha_ * (u - state_.spool_v);
-  return lag_alpha_ >= 1.0 ? u : state_.spool_v;
+  const double first = lag_alpha_ >= 1.0 ? u : state_.spool_v;
+  state_.second_v += second_alpha_ * (first - state_.second_v);
+  return second_alpha_ >= 1.0 ? first : state_.second_v;
 }
 
 DriveEffects::DriveEffects(const EffectSet& e, const core::DeadZone& nominal, double speed_mm_s_per_V,

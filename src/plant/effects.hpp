@@ -108,7 +108,8 @@ class ValveEffects {
   struct State {
     std::array<double, kMaxDelaySamples + 1> past{};  // ring of past commands
     std::size_t head = 0;
-    double spool_v = 0.0;  // the lag's output
+    double spool_v = 0.0;   // the lag's output
+    double second_v = 0.0;  // the second lag's output
   };
   ValveEffects() = default;
   ValveEffects(const EffectSet& effects, double Ts);
@@ -119,7 +120,8 @@ class ValveEffects {
 
  private:
   std::size_t delay_ = 0;
-  double lag_alpha_ = 1.0;  // 1 - exp(-Ts/tau): 1 is no lag
+  double lag_alpha_ = 1.0;     // 1 - exp(-Ts/tau): 1 is no lag
+  double second_alpha_ = 1.0;  // the same for the second lag
   State state_;
 };
 

@@ -1,6 +1,9 @@
 // Fitting an effect's parameters: a shape parameter whose grid runs after the rest
-// (position_dependent_gain's where_samples) is found where the data put it.
+// (position_dependent_gain's where_samples) is found where the data put it; a family's second
+// member (a spool's second lag) is found when the data hold it.
 #include <gtest/gtest.h>
+
+#include <algorithm>
 
 #include "diag/effect_fit.hpp"
 #include "diag_test_data.hpp"
@@ -26,6 +29,21 @@ TEST(EffectFit, TheAveragingLengthOfAPositionGainIsFoundAfterItsSlopes) {
     EXPECT_EQ(p[3], where_samples);
     EXPECT_NEAR(p[0], 0.25, 0.05) << "where_samples " << where_samples;
   }
+}
+
+// A spool of two lags in series (a plant hiding 30 and 12 ms), fitted afresh: both time
+// constants come back, in either order, not one lag of their sum.
+TEST(EffectFit, ASpoolOfTwoLagsIsFittedAsTwoLags) {
+  const auto model = epa::core::paper::model();
+  epa::testing::Hidden h;
+  h.effects.set(EffectKind::kValveLag, {0.03, 0.012});
+  std::vector<epa::core::Run> runs;
+  for (std::uint64_t seed : {1u, 2u, 3u})
+    runs.push_back(epa::testing::make_run(model, h, {.closed_loop = seed != 2, .duration_s = 10, .noise_std_mm = 0.05, .seed = seed}));
+  const auto fit = epa::diag::fit_effect({model, {}, 500}, EffectKind::kValveLag, epa::testing::pointers(runs), {});
+  const auto& p = fit.model.effects.params(EffectKind::kValveLag);
+  EXPECT_NEAR(std::max(p[0], p[1]), 0.03, 0.004);
+  EXPECT_NEAR(std::min(p[0], p[1]), 0.012, 0.004);
 }
 
 }  // namespace

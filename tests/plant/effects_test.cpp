@@ -112,6 +112,32 @@ TEST(Effects, TheFlowCeilingIsPerDirectionAndItsKneeHardOrSoft) {
   EXPECT_NEAR(steady_speed_mm_s(soft, 1.232 + 3.0), 60.0, 3.0);  // far beyond: near the ceiling
 }
 
+
+// The spool family against the continuous-time step responses it stands for: one lag,
+// 1 - exp(-t/tau); two in series, 1 - (t1 exp(-t/t1) - t2 exp(-t/t2)) / (t1 - t2), which starts
+// flat (a spool and its amplifier). Sample k is the spool at the end of that sample.
+TEST(Effects, TheSpoolIsOneLagOrTwoInSeries) {
+  constexpr double Ts = 0.005;
+  auto step = [](std::initializer_list<double> p, int k) {
+    EffectSet e;
+    e.set(EffectKind::kValveLag, p);
+    epa::plant::ValveEffects v(e, Ts);
+    double s = 0;
+    for (int i = 0; i <= k; ++i) s = v.apply(1.0);
+    return s;
+  };
+  const double t1 = 0.03, t2 = 0.012;
+  for (int k : {0, 2, 5, 10, 20, 40}) {
+    const double t = Ts * (k + 1);
+    EXPECT_NEAR(step({t1}, k), 1.0 - std::exp(-t / t1), 1e-9) << k;
+    EXPECT_NEAR(step({t1, 0.0}, k), step({t1}, k), 1e-12) << "second_tau_s 0 is first order";
+    // The discrete cascade updates the second lag from the first's new value, which leads the
+    // continuous one by up to about a sample's share of the second lag.
+    EXPECT_NEAR(step({t1, t2}, k), 1.0 - (t1 * std::exp(-t / t1) - t2 * std::exp(-t / t2)) / (t1 - t2), 0.05) << k;
+  }
+  EXPECT_LT(step({t1, t2}, 0), 0.5 * step({t1 + t2}, 0));  // second order starts flat
+  EXPECT_NEAR(step({t1, t2}, 400), 1.0, 1e-6);
+}
 TEST(Effects, FrictionIsAForceOnThePistonNotAChangeOfTheValvesFlow) {
   // The valve's flow reaches B whatever friction does: a step of the drive held by friction still
   // gives B's swing (the chambers fill) but no steady motion, where a drive that never passes the
