@@ -16,8 +16,9 @@ How each truth form differs from the fitted one:
   position      fitted: one gain slope along the stroke, both directions alike.
                 truth: chamber compressibility, gain ~ 1/(dead volume + chamber length), mirrored
                 per direction; and a cosine dip of the gain around mid-stroke.
-  spool         fitted: first-order lag.   truth: second-order spool (natural frequency,
-                damping); a slew-rate-limited spool.
+  spool         fitted: one lag, or two real lags in series (since 2026-11-27; critically or
+                over-damped).   truth: second-order spool (natural frequency,
+                damping 0.7-0.8: under-damped); a slew-rate-limited spool.
   delay         fitted: whole samples.     truth: fractional delays, and a line delay with a lag.
   flow          fitted: a ceiling per direction through a knee s / (1 + |s/c|^n)^(1/n)
                 (n from 1.5, soft, to 64, hard; since 2026-11-27; before: one symmetric hard ceiling).
