@@ -29,7 +29,7 @@ constexpr ParamSpec kShift[] = {{"shift_r_V", -1.0, 1.0, 0.0, false, "right brea
 constexpr ParamSpec kDelay[] = {{"delay_samples", 0.0, 40.0, 0.0, true, "transport delay of the valve command, samples of Ts"}};
 // A family: first order (tau_s), or second order with two real poles (second_tau_s > 0: a
 // spool with its amplifier, critically or over-damped).
-constexpr ParamSpec kLag[] = {{"tau_s", 0.0, 0.2, 0.0, false, "time constant of the spool's first-order lag"},
+constexpr ParamSpec kLag[] = {{"tau_s", 0.0, 0.2, 0.0, false, "time constant of the spool's lag"},
                               {"second_tau_s", 0.0, 0.2, 0.0, false, "time constant of a second lag in series (0: first order)", true}};
 constexpr ParamSpec kFriction[] = {
     {"breakaway_V", 0.0, 2.0, 0.0, false, "drive u_d friction holds while the piston sticks (stiction)"},

@@ -29,7 +29,7 @@ enum class EffectKind {
   kGainChange,             // gain_ratio: the drive u_d scaled (supply pressure, valve gain); steady_ratio
   kDeadzoneShift,          // shift_r_V, shift_l_V: break points moved
   kInputDelay,             // delay_samples: transport delay of the valve command
-  kValveLag,               // tau_s: first-order spool dynamics
+  kValveLag,               // tau_s, second_tau_s: spool dynamics, one lag or two in series
   kStaticFriction,         // breakaway_V, coulomb_V: stiction and Coulomb friction on the mechanical speed
   kFlowSaturation,         // ceiling_mm_s: choked flow, a velocity ceiling
   kPositionDependentGain,  // slope_per_100mm, chamber_slope_per_100mm, curvature: gain along the stroke
