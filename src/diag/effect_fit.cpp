@@ -173,6 +173,28 @@ EffectFit fit_effects(const ReplayModel& base, std::span<const EffectKind> kinds
       }
     }
     if (!continuous.empty()) gap = local_fit(fit, continuous, o);
+    // The grid chose its value with the continuous parameters where they stood (a fresh lag at
+    // zero, whose share of the timing the grid then gives the delay); with them fitted, another
+    // value can be better (a line of 2.5 samples' transport and a 10 ms lag: 3 samples alone, 2
+    // with the lag beside them). From the grid's value the fit walks a sample at a time, each
+    // way, re-fitting the continuous parameters at each from the last fit,
+    // while the gap falls.
+    for (const auto& s : grid) {
+      if (!s.spec.integer || continuous.empty()) continue;
+      const ReplayModel at_grid = fit.model;
+      ReplayModel best_model = fit.model;
+      for (double direction : {-1.0, 1.0}) {
+        ReplayModel from = at_grid;
+        for (double v = at_grid.effects.params(s.kind)[s.i] + direction; v >= s.spec.lo && v <= s.spec.hi; v += direction) {
+          fit.model = from;
+          put(fit.model, s, v);
+          const double g = local_fit(fit, continuous, o, true);
+          if (g >= gap) break;
+          gap = g, best_model = from = fit.model;
+        }
+      }
+      fit.model = best_model;
+    }
     // A shape parameter on its grid, the rest re-fitted at each value from where the first fit left
     // them: the gap can be far more sensitive to the shape than to the rest (a position gain's
     // averaging length: 0.04 mm at the right length, 3-24 mm one or more away, slopes alike).

@@ -21,9 +21,12 @@ namespace epa::testing {
 
 // What the simulator hides. `periodic_mm` > 0 adds an oscillation of that amplitude to the
 // measurement: a 4 Hz disturbance no effect in the library describes.
+// `fractional_delay_samples` > 0 delays the command by that many samples, interpolated between
+// the two whole delays around it (the library's delay is whole samples).
 struct Hidden {
   plant::EffectSet effects;
   double periodic_mm = 0.0;
+  double fractional_delay_samples = 0.0;
 };
 
 // The paper's model as a rig might differ from it within what identification gives back: B
@@ -83,6 +86,14 @@ inline core::Run make_run(const core::HammersteinModel& truth, const Hidden& hid
     run.t_s.push_back(t);
     run.y_mm.push_back(y_mm);
     run.u_V.push_back(u);
+    if (hidden.fractional_delay_samples > 0.0) {
+      const double d = hidden.fractional_delay_samples, whole = std::floor(d);
+      auto past = [&](double samples) {
+        const auto i = static_cast<std::size_t>(samples);
+        return i <= k ? run.u_V[k - i] : 0.0;
+      };
+      u = (1.0 - (d - whole)) * past(whole) + (d - whole) * past(whole + 1.0);
+    }
     plant->step(u);
   }
   return run;

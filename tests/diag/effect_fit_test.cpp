@@ -46,4 +46,25 @@ TEST(EffectFit, ASpoolOfTwoLagsIsFittedAsTwoLags) {
   EXPECT_NEAR(std::min(p[0], p[1]), 0.012, 0.004);
 }
 
+// A pneumatic line: 2.5 samples of transport (the command interpolated between 2 and 3 samples
+// back), then a 10 ms lag, fitted as a whole delay with a lag beside it. The grid alone, with the
+// lag still at zero, takes 3 samples, and then no lag makes up the half sample that came too
+// late; 2 samples with a lag do.
+TEST(EffectFit, AFractionalDelayWithALagIsTheWholeDelayBeforeItNotTheOneAfter) {
+  const auto model = epa::core::paper::model();
+  epa::testing::Hidden h;
+  h.fractional_delay_samples = 2.5;
+  h.effects.set(EffectKind::kValveLag, {0.01});
+  std::vector<epa::core::Run> runs;
+  for (std::uint64_t seed : {1u, 2u, 3u})
+    runs.push_back(epa::testing::make_run(model, h, {.closed_loop = seed != 2, .duration_s = 10, .noise_std_mm = 0.05, .seed = seed}));
+  const auto alone = epa::diag::fit_effect({model, {}, 500}, EffectKind::kInputDelay, epa::testing::pointers(runs), {});
+  ASSERT_EQ(alone.model.effects.param(EffectKind::kInputDelay, 0), 3.0) << "the case must be one the grid alone takes late";
+  const EffectKind kinds[] = {EffectKind::kInputDelay, EffectKind::kValveLag};
+  const auto fit = epa::diag::fit_effects({model, {}, 500}, kinds, epa::testing::pointers(runs), {});
+  EXPECT_EQ(fit.model.effects.param(EffectKind::kInputDelay, 0), 2.0);
+  EXPECT_GT(fit.model.effects.param(EffectKind::kValveLag, 0) + fit.model.effects.param(EffectKind::kValveLag, 1), 0.001);
+  EXPECT_LT(fit.train_gap_mm, 0.7 * alone.train_gap_mm);
+}
+
 }  // namespace
