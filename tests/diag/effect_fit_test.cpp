@@ -1,6 +1,7 @@
 // Fitting an effect's parameters: a shape parameter whose grid runs after the rest
 // (position_dependent_gain's where_samples) is found where the data put it; a family's second
-// member (a spool's second lag) is found when the data hold it.
+// member (a spool's second lag) is found when the data hold it; a delay the grid chose with a
+// fresh lag at zero is walked to where it lies with the lag fitted beside it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
