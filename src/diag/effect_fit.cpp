@@ -177,8 +177,7 @@ EffectFit fit_effects(const ReplayModel& base, std::span<const EffectKind> kinds
     // zero, whose share of the timing the grid then gives the delay); with them fitted, another
     // value can be better (a line of 2.5 samples' transport and a 10 ms lag: 3 samples alone, 2
     // with the lag beside them). From the grid's value the fit walks a sample at a time, each
-    // way, re-fitting the continuous parameters at each from the last fit,
-    // while the gap falls.
+    // way, re-fitting the continuous parameters at each from the last fit, while the gap falls.
     for (const auto& s : grid) {
       if (!s.spec.integer || continuous.empty()) continue;
       const ReplayModel at_grid = fit.model;

@@ -55,7 +55,11 @@ constexpr ParamSpec kPosition[] = {
 constexpr ParamSpec kQuantization[] = {{"step_mm", 0.0, 10.0, 0.0, false, "position sensor resolution"}};
 
 constexpr double kMidStrokeMm = 250.0;
+
 constexpr double kMinPositionFactor = 0.05;  // the drive never reverses along the stroke
+
+// A first-order lag's step per sample, 1 - exp(-Ts/tau): 1 (no lag) for tau 0.
+double lag_alpha(double tau_s, double Ts) { return tau_s > 0.0 ? 1.0 - std::exp(-Ts / tau_s) : 1.0; }
 
 }  // namespace
 
@@ -130,10 +134,8 @@ ValveEffects::ValveEffects(const EffectSet& e, double Ts) {
   if (e.on(EffectKind::kInputDelay))
     delay_ = std::min<std::size_t>(kMaxDelaySamples, static_cast<std::size_t>(std::llround(std::max(0.0, e.param(EffectKind::kInputDelay, 0)))));
   if (e.on(EffectKind::kValveLag)) {
-    const double tau_s = e.param(EffectKind::kValveLag, 0);
-    lag_alpha_ = tau_s > 0.0 ? 1.0 - std::exp(-Ts / tau_s) : 1.0;
-    const double second_s = e.param(EffectKind::kValveLag, 1);
-    second_alpha_ = second_s > 0.0 ? 1.0 - std::exp(-Ts / second_s) : 1.0;
+    lag_alpha_ = lag_alpha(e.param(EffectKind::kValveLag, 0), Ts);
+    second_alpha_ = lag_alpha(e.param(EffectKind::kValveLag, 1), Ts);
   }
 }
 
