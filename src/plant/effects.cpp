@@ -55,7 +55,6 @@ constexpr ParamSpec kPosition[] = {
 constexpr ParamSpec kQuantization[] = {{"step_mm", 0.0, 10.0, 0.0, false, "position sensor resolution"}};
 
 constexpr double kMidStrokeMm = 250.0;
-
 constexpr double kMinPositionFactor = 0.05;  // the drive never reverses along the stroke
 
 // A first-order lag's step per sample, 1 - exp(-Ts/tau): 1 (no lag) for tau 0.
