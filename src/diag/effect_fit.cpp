@@ -12,13 +12,13 @@ namespace {
 using plant::EffectKind;
 
 // One free parameter: which effect and slot, and how it maps to [0, 1] for the optimiser
-// (logarithmic for the velocity ceiling, which spans two decades).
+// (logarithmic where its spec says so: a range of decades).
 struct Slot {
   EffectKind kind;
   std::size_t i;
   plant::ParamSpec spec;
   bool fresh = true;  // the effect was off in the base model: search its range from several starts
-  bool log_scale() const { return kind == EffectKind::kFlowSaturation; }
+  bool log_scale() const { return spec.log_scale; }
   double to_unit(double v) const {
     return log_scale() ? std::log(v / spec.lo) / std::log(spec.hi / spec.lo) : (v - spec.lo) / (spec.hi - spec.lo);
   }
@@ -51,23 +51,25 @@ void put(ReplayModel& m, const Slot& s, double value) {
 double minimise_from(Objective& obj, const std::vector<Slot>& slots, const FitOptions& o,
                      const std::vector<std::vector<double>>& starts);
 
-// Minimises over the continuous slots by BOBYQA from a few starts (only from where they stand
-// when `from_current_only`); leaves the best in obj.model.
-double local_fit(Objective& obj, const std::vector<Slot>& slots, const FitOptions& o, bool from_current_only = false) {
-  if (slots.empty()) return obj.gap();
+std::vector<double> units_now(const Objective& obj, const std::vector<Slot>& slots) {
+  std::vector<double> x(slots.size());
+  for (std::size_t i = 0; i < slots.size(); ++i) x[i] = slots[i].to_unit(obj.model.effects.params(slots[i].kind)[slots[i].i]);
+  return x;
+}
+
+// BOBYQA over `slots` from where they stand and, for a new effect, from several starts; leaves
+// the best in obj.model.
+double fit_from_starts(Objective& obj, const std::vector<Slot>& slots, const FitOptions& o) {
   const std::size_t n = slots.size();
-  std::vector<std::vector<double>> starts;
-  std::vector<double> neutral(n);
-  for (std::size_t i = 0; i < n; ++i) neutral[i] = slots[i].to_unit(obj.model.effects.params(slots[i].kind)[slots[i].i]);
-  starts.push_back(neutral);
-  if (from_current_only) return minimise_from(obj, slots, o, starts);
+  const std::vector<double> now = units_now(obj, slots);
+  std::vector<std::vector<double>> starts{now};
   // Parameters already fitted (the nominal ones, accepted effects) start where they are; a new
   // effect's parameters from its neutral value and from two points across their range.
   // Also with the fitted ones back at their neutral values: a re-fitted dead zone can have
   // absorbed part of, say, friction, and the joint fit must be able to give it back.
   for (bool reset : {false, true})
     for (double f : {0.3, 0.7}) {
-      auto x = neutral;
+      auto x = now;
       bool any = false;
       for (std::size_t i = 0; i < n; ++i) {
         if (slots[i].fresh) x[i] = f, any = true;
@@ -79,8 +81,47 @@ double local_fit(Objective& obj, const std::vector<Slot>& slots, const FitOption
   // an unmodelled effect) must not be every start's starting point.
   std::vector<double> all_neutral(n);
   for (std::size_t i = 0; i < n; ++i) all_neutral[i] = slots[i].to_unit(slots[i].spec.neutral);
-  if (all_neutral != neutral) starts.push_back(all_neutral);
+  if (all_neutral != now) starts.push_back(all_neutral);
   return minimise_from(obj, slots, o, starts);
+}
+
+// Minimises over the continuous slots by BOBYQA from a few starts (only from where they stand
+// when `from_current_only`); leaves the best in obj.model.
+// A new effect's parameter that is a member of its family of its own (starts_alone: a spool's
+// speed limit, which does nothing while a lag beside it smooths the command) is fitted apart:
+// the rest first with it neutral, then it alone with the rest of its effect neutral, from a third
+// of its range with the fitted parameters where they stand and back at neutral; the better fit
+// stays. Apart, each search has fewer dimensions, and costs less.
+// Once its effect is fitted, such a member left at its neutral value stays out of later fits.
+double local_fit(Objective& obj, const std::vector<Slot>& all_slots, const FitOptions& o, bool from_current_only = false) {
+  std::vector<Slot> slots;
+  for (const auto& s : all_slots)
+    if (s.fresh || !s.spec.starts_alone || obj.model.effects.params(s.kind)[s.i] != s.spec.neutral) slots.push_back(s);
+  if (slots.empty()) return obj.gap();
+  if (from_current_only) return minimise_from(obj, slots, o, {units_now(obj, slots)});
+  std::vector<Slot> rest, alone, fitted;
+  for (const auto& s : slots) {
+    (s.fresh && s.spec.starts_alone ? alone : rest).push_back(s);
+    if (!s.fresh) fitted.push_back(s);
+  }
+  const ReplayModel before = obj.model;
+  double best = rest.empty() ? obj.gap() : fit_from_starts(obj, rest, o);
+  ReplayModel best_model = obj.model;
+  for (const auto& a : alone) {
+    obj.model = before;
+    auto member = fitted;
+    member.push_back(a);
+    std::vector<std::vector<double>> starts;
+    for (bool reset : {false, true}) {
+      auto x = units_now(obj, member);
+      for (std::size_t i = 0; reset && i + 1 < member.size(); ++i) x[i] = member[i].to_unit(member[i].spec.neutral);
+      x.back() = 0.3;
+      starts.push_back(x);
+    }
+    if (const double g = minimise_from(obj, member, o, starts); g < best) best = g, best_model = obj.model;
+  }
+  obj.model = best_model;
+  return best;
 }
 
 double minimise_from(Objective& obj, const std::vector<Slot>& slots, const FitOptions& o,

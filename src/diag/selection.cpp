@@ -334,6 +334,23 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
       }
     }
   }
+  // An effect whose fitted parameters all came back neutral does nothing, whatever it was
+  // accepted for (a delay of 0 samples, accepted with the better re-fit of a lag beside it): it
+  // is not named.
+  for (std::size_t i = 0; i < d.effects.size();) {
+    const auto specs = plant::param_specs(d.effects[i]);
+    bool neutral = true;
+    for (std::size_t j = 0; j < specs.size(); ++j) neutral = neutral && current.all.effects.param(d.effects[i], j) == specs[j].neutral;
+    if (!neutral) {
+      ++i;
+      continue;
+    }
+    std::snprintf(buf, sizeof buf, "%s fitted to its neutral values does nothing: not named", std::string(plant::to_string(d.effects[i])).c_str());
+    say(buf);
+    current = without(current, d.effects[i]);
+    d.effects.erase(d.effects.begin() + static_cast<std::ptrdiff_t>(i));
+    gap = heldout_gap(current.per_fold, folds, o.horizon);
+  }
   d.final_model = current.all;
   d.final_gap_mm = gap;
 

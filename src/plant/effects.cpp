@@ -30,7 +30,10 @@ constexpr ParamSpec kDelay[] = {{"delay_samples", 0.0, 40.0, 0.0, true, "transpo
 // A family: first order (tau_s), or second order with two real poles (second_tau_s > 0: a
 // spool with its amplifier, critically or over-damped).
 constexpr ParamSpec kLag[] = {{"tau_s", 0.0, 0.2, 0.0, false, "time constant of the spool's lag"},
-                              {"second_tau_s", 0.0, 0.2, 0.0, false, "time constant of a second lag in series (0: first order)", true}};
+                              {"second_tau_s", 0.0, 0.2, 0.0, false, "time constant of a second lag in series (0: first order)", true},
+                              {.name = "rate_V_per_s", .lo = 5.0, .hi = 5000.0, .neutral = 5000.0,
+                               .meaning = "largest speed of the spool (a solenoid's force limit)", .optional = true,
+                               .log_scale = true, .starts_alone = true}};
 constexpr ParamSpec kFriction[] = {
     {"breakaway_V", 0.0, 2.0, 0.0, false, "drive u_d friction holds while the piston sticks (stiction)"},
     {"coulomb_V", 0.0, 2.0, 0.0, false, "drive u_d friction takes while the piston slides"}};
@@ -38,9 +41,12 @@ constexpr ParamSpec kFriction[] = {
 // s / (1 + |s / ceiling|^n)^(1/n) of the unsaturated speed s, n the knee's sharpness; n = 64 is a
 // hard clip), and lower or higher one way (a rod side that chokes first).
 constexpr ParamSpec kSaturation[] = {
-    {"ceiling_mm_s", 20.0, 5000.0, 5000.0, false, "largest piston speed extending (choked flow)"},
-    {"retract_over_extend", 0.5, 2.0, 1.0, false, "the ceiling retracting over the ceiling extending", true},
-    {"knee_sharpness", 1.5, 64.0, 64.0, false, "how sharply the speed meets its ceiling: 64 a hard clip, 2 a soft knee", true}};
+    {.name = "ceiling_mm_s", .lo = 20.0, .hi = 5000.0, .neutral = 5000.0, .meaning = "largest piston speed extending (choked flow)",
+     .log_scale = true},
+    {.name = "retract_over_extend", .lo = 0.5, .hi = 2.0, .neutral = 1.0,
+     .meaning = "the ceiling retracting over the ceiling extending", .optional = true, .log_scale = true},
+    {.name = "knee_sharpness", .lo = 1.5, .hi = 64.0, .neutral = 64.0,
+     .meaning = "how sharply the speed meets its ceiling: 64 a hard clip, 2 a soft knee", .optional = true, .log_scale = true}};
 // A family, not one form: a gain that changes along the stroke the same way in both directions
 // (slope), one that falls as the driving chamber lengthens (air compressibility: extending, the
 // cap-side chamber grows with the position; retracting, the rod side grows as it falls), and one
@@ -56,6 +62,16 @@ constexpr ParamSpec kQuantization[] = {{"step_mm", 0.0, 10.0, 0.0, false, "posit
 
 constexpr double kMidStrokeMm = 250.0;
 constexpr double kMinPositionFactor = 0.05;  // the drive never reverses along the stroke
+// How sharply the spool's speed meets its limit (the flow ceiling's knee, soft_ceiling): 16 rounds
+// only the last few per cent, as a solenoid's force runs out. Fitted, it went to its sharpest
+// end on every speed-limited rig, so it is not a parameter.
+constexpr double kSpoolRateKnee = 16.0;
+
+// The knee both ceilings share (the spool's speed, the piston's): s / (1 + |s / c|^n)^(1/n) of
+// the unlimited s, n the knee's sharpness; n >= 64 is a hard clip.
+double soft_ceiling(double s, double c, double n) {
+  return n >= 64.0 ? std::clamp(s, -c, c) : s / std::pow(1.0 + std::pow(std::abs(s) / c, n), 1.0 / n);
+}
 
 // A first-order lag's step per sample, 1 - exp(-Ts/tau): 1 (no lag) for tau 0.
 double lag_alpha(double tau_s, double Ts) { return tau_s > 0.0 ? 1.0 - std::exp(-Ts / tau_s) : 1.0; }
@@ -135,6 +151,8 @@ ValveEffects::ValveEffects(const EffectSet& e, double Ts) {
   if (e.on(EffectKind::kValveLag)) {
     lag_alpha_ = lag_alpha(e.param(EffectKind::kValveLag, 0), Ts);
     second_alpha_ = lag_alpha(e.param(EffectKind::kValveLag, 1), Ts);
+    const double rate = e.param(EffectKind::kValveLag, 2);
+    if (rate < param_specs(EffectKind::kValveLag)[2].neutral) rate_step_v_ = rate * Ts;
   }
 }
 
@@ -147,8 +165,9 @@ double ValveEffects::apply(double valve_v) noexcept {
     u = s.past[(s.head + n - delay_) % n];
     s.head = (s.head + 1) % n;
   }
-  state_.spool_v += lag_alpha_ * (u - state_.spool_v);
-  const double first = lag_alpha_ >= 1.0 ? u : state_.spool_v;
+  const double step = lag_alpha_ * (u - state_.spool_v);
+  state_.spool_v += rate_step_v_ > 0.0 ? soft_ceiling(step, rate_step_v_, kSpoolRateKnee) : step;
+  const double first = lag_alpha_ >= 1.0 && rate_step_v_ <= 0.0 ? u : state_.spool_v;
   state_.second_v += second_alpha_ * (first - state_.second_v);
   return second_alpha_ >= 1.0 ? first : state_.second_v;
 }
@@ -217,7 +236,7 @@ double DriveEffects::finish(double drive, double position_mm) const noexcept {
   }
   if (max_drive_ > 0.0) {
     const double ceiling = d >= 0.0 ? max_drive_ : max_drive_ * retract_ratio_;
-    d = knee_ >= 64.0 ? std::clamp(d, -ceiling, ceiling) : d / std::pow(1.0 + std::pow(std::abs(d) / ceiling, knee_), 1.0 / knee_);
+    d = soft_ceiling(d, ceiling, knee_);
   }
   return d;
 }

@@ -58,6 +58,10 @@ struct ParamSpec {
   // A shape parameter that matters only once the others are fitted (with them neutral it changes
   // nothing): its grid runs after them, and only when the effect is fitted afresh.
   bool grid_after_the_rest = false;
+  bool log_scale = false;  // fitted on a logarithmic scale (a range of decades)
+  // A member of its family of its own (a spool limited by its speed, not by a lag): a fit afresh
+  // also starts with this parameter alone moved from its neutral value, the others neutral.
+  bool starts_alone = false;
 };
 std::span<const ParamSpec> param_specs(EffectKind kind);
 
@@ -122,6 +126,7 @@ class ValveEffects {
   std::size_t delay_ = 0;
   double lag_alpha_ = 1.0;     // 1 - exp(-Ts/tau): 1 is no lag
   double second_alpha_ = 1.0;  // the same for the second lag
+  double rate_step_v_ = 0.0;   // the spool's largest step per sample, V (0: no limit)
   State state_;
 };
 

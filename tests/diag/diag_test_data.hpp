@@ -3,6 +3,7 @@
 // hidden in the simulator (or none, or one outside the library), seeded sensor noise, closed-loop
 // (the paper's FF-IDZ controller on a sequence of setpoints) and open-loop (the excitation of
 // `epa excite`). Shared by the diag tests, the self-check and the benchmark.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -23,10 +24,13 @@ namespace epa::testing {
 // measurement: a 4 Hz disturbance no effect in the library describes.
 // `fractional_delay_samples` > 0 delays the command by that many samples, interpolated between
 // the two whole delays around it (the library's delay is whole samples).
+// `slew_V_per_s` > 0 moves the spool toward the command by at most that much, a hard clip (the
+// library's speed limit has a rounded knee).
 struct Hidden {
   plant::EffectSet effects;
   double periodic_mm = 0.0;
   double fractional_delay_samples = 0.0;
+  double slew_V_per_s = 0.0;
 };
 
 // The paper's model as a rig might differ from it within what identification gives back: B
@@ -66,6 +70,7 @@ inline core::Run make_run(const core::HammersteinModel& truth, const Hidden& hid
   auto gen = ident::ExcitationGenerator::make(eo);
   double setpoint_mm = 250.0;
   std::size_t next_setpoint = 0;
+  double spool_V = 0.0;  // slew_V_per_s's spool
   for (std::size_t k = 0; k < n; ++k) {
     const double t = static_cast<double>(k) * truth.Ts;
     double y_mm = plant->measured_mm();
@@ -93,6 +98,11 @@ inline core::Run make_run(const core::HammersteinModel& truth, const Hidden& hid
         return i <= k ? run.u_V[k - i] : 0.0;
       };
       u = (1.0 - (d - whole)) * past(whole) + (d - whole) * past(whole + 1.0);
+    }
+    if (hidden.slew_V_per_s > 0.0) {
+      const double most_V = hidden.slew_V_per_s * truth.Ts;
+      spool_V += std::clamp(u - spool_V, -most_V, most_V);
+      u = spool_V;
     }
     plant->step(u);
   }

@@ -47,6 +47,24 @@ TEST(EffectFit, ASpoolOfTwoLagsIsFittedAsTwoLags) {
   EXPECT_NEAR(std::min(p[0], p[1]), 0.012, 0.004);
 }
 
+// A spool that moves toward its command at no more than 25 V/s, hard, where the family's limit
+// has a rounded knee; its lags are first fitted as a lag, so the speed limit is found only from
+// its own start.
+TEST(EffectFit, ASpoolLimitedByItsSpeedIsFittedAsThatSpeedNotAsALag) {
+  const auto model = epa::core::paper::model();
+  epa::testing::Hidden h;
+  h.slew_V_per_s = 25.0;
+  std::vector<epa::core::Run> runs;
+  for (std::uint64_t seed : {1u, 2u, 3u})
+    runs.push_back(epa::testing::make_run(model, h, {.closed_loop = seed != 2, .duration_s = 10, .noise_std_mm = 0.05, .seed = seed}));
+  const auto fit = epa::diag::fit_effect({model, {}, 500}, EffectKind::kValveLag, epa::testing::pointers(runs), {});
+  const auto& p = fit.model.effects.params(EffectKind::kValveLag);
+  EXPECT_NEAR(p[2], 25.0, 2.5) << fit.model.effects.describe();
+  EXPECT_LT(p[0] + p[1], 0.005) << "no lag beside it";
+  const double nominal_gap = epa::diag::windowed_gap_mm({model, {}, 500}, epa::testing::pointers(runs), 10);
+  EXPECT_LT(fit.train_gap_mm, 0.1 * nominal_gap);
+}
+
 // A pneumatic line: 2.5 samples of transport (the command interpolated between 2 and 3 samples
 // back), then a 10 ms lag, fitted as a whole delay with a lag beside it. The grid alone, with the
 // lag still at zero, takes 3 samples, and then no lag makes up the half sample that came too

@@ -138,6 +138,32 @@ TEST(Effects, TheSpoolIsOneLagOrTwoInSeries) {
   EXPECT_LT(step({t1, t2}, 0), 0.5 * step({t1 + t2}, 0));  // second order starts flat
   EXPECT_NEAR(step({t1, t2}, 400), 1.0, 1e-6);
 }
+// The spool limited by its speed (a solenoid's force runs out): a large step is followed at the
+// limit, a ramp a little short of it, while a step smaller than one sample's travel passes at once
+// and a slower command is followed as if there were no limit.
+TEST(Effects, ASpoolLimitedByItsSpeedRampsAtThatSpeed) {
+  constexpr double Ts = 0.01, rate_V_per_s = 20.0;
+  EffectSet e;
+  e.set(EffectKind::kValveLag, {0.0, 0.0, rate_V_per_s});
+  epa::plant::ValveEffects v(e, Ts);
+  double spool = 0.0;
+  for (int k = 1; k <= 25; ++k) {
+    spool = v.apply(10.0);
+    EXPECT_NEAR(spool, rate_V_per_s * Ts * k, 0.01 * rate_V_per_s * Ts * k) << k;  // 0.2 V a sample
+  }
+  for (int k = 0; k < 40; ++k) spool = v.apply(10.0);
+  EXPECT_NEAR(spool, 10.0, 1e-6) << "it reaches the command";
+  const double small = 0.2 * rate_V_per_s * Ts;
+  EXPECT_NEAR(v.apply(10.0 + small), 10.0 + small, 1e-9) << "a step well inside one sample's travel passes whole";
+  epa::plant::ValveEffects free_spool(e, Ts);
+  for (int k = 0; k < 50; ++k) EXPECT_NEAR(free_spool.apply(0.5 * rate_V_per_s * Ts * k), 0.5 * rate_V_per_s * Ts * k, 1e-6);
+  // Left out, the limit is the neutral value: the spool follows any step at once.
+  EffectSet lag_only;
+  lag_only.set(EffectKind::kValveLag, {0.0});
+  epa::plant::ValveEffects unlimited(lag_only, Ts);
+  EXPECT_EQ(unlimited.apply(5.0), 5.0);
+}
+
 TEST(Effects, FrictionIsAForceOnThePistonNotAChangeOfTheValvesFlow) {
   // The valve's flow reaches B whatever friction does: a step of the drive held by friction still
   // gives B's swing (the chambers fill) but no steady motion, where a drive that never passes the
