@@ -28,7 +28,9 @@ constexpr ParamSpec kShift[] = {{"shift_r_V", -1.0, 1.0, 0.0, false, "right brea
                                 {"shift_l_V", -1.0, 1.0, 0.0, false, "left break point b_l moved by"}};
 constexpr ParamSpec kDelay[] = {{"delay_samples", 0.0, 40.0, 0.0, true, "transport delay of the valve command, samples of Ts"}};
 // A family: first order (tau_s), or second order with two real poles (second_tau_s > 0: a
-// spool with its amplifier, critically or over-damped).
+// spool with its amplifier, critically or over-damped); and a spool limited by its speed
+// (rate_V_per_s below its neutral 5000: a solenoid whose force runs out), met through a rounded
+// knee (kSpoolRateKnee) on the first lag's step (on the command's own steps when tau_s is 0).
 constexpr ParamSpec kLag[] = {{"tau_s", 0.0, 0.2, 0.0, false, "time constant of the spool's lag"},
                               {"second_tau_s", 0.0, 0.2, 0.0, false, "time constant of a second lag in series (0: first order)", true},
                               {.name = "rate_V_per_s", .lo = 5.0, .hi = 5000.0, .neutral = 5000.0,

@@ -29,7 +29,7 @@ enum class EffectKind {
   kGainChange,             // gain_ratio: the drive u_d scaled (supply pressure, valve gain); steady_ratio
   kDeadzoneShift,          // shift_r_V, shift_l_V: break points moved
   kInputDelay,             // delay_samples: transport delay of the valve command
-  kValveLag,               // tau_s, second_tau_s: spool dynamics, one lag or two in series
+  kValveLag,               // tau_s, second_tau_s, rate_V_per_s: spool dynamics, one lag or two in series, a speed limit
   kStaticFriction,         // breakaway_V, coulomb_V: stiction and Coulomb friction on the mechanical speed
   kFlowSaturation,         // ceiling_mm_s: choked flow, a velocity ceiling
   kPositionDependentGain,  // slope_per_100mm, chamber_slope_per_100mm, curvature: gain along the stroke
@@ -60,7 +60,8 @@ struct ParamSpec {
   bool grid_after_the_rest = false;
   bool log_scale = false;  // fitted on a logarithmic scale (a range of decades)
   // A member of its family of its own (a spool limited by its speed, not by a lag): a fit afresh
-  // also starts with this parameter alone moved from its neutral value, the others neutral.
+  // fits it apart, the rest of its effect neutral, and keeps the better member; later fits leave
+  // it out while it stays neutral (diag/effect_fit.cpp).
   bool starts_alone = false;
 };
 std::span<const ParamSpec> param_specs(EffectKind kind);
