@@ -47,9 +47,9 @@ TEST(EffectFit, ASpoolOfTwoLagsIsFittedAsTwoLags) {
   EXPECT_NEAR(std::min(p[0], p[1]), 0.012, 0.004);
 }
 
-// A spool that moves toward its command at no more than 25 V/s, hard, where the family's limit
-// has a rounded knee; its lags are first fitted as a lag, so the speed limit is found only from
-// its own start.
+// A spool that moves toward its command at no more than 25 V/s, a hard clip where the family's
+// limit has a rounded knee. Searched together with the lags, the limit ends beside a long lag
+// (67 ms); it is found when it is fitted apart from them.
 TEST(EffectFit, ASpoolLimitedByItsSpeedIsFittedAsThatSpeedNotAsALag) {
   const auto model = epa::core::paper::model();
   epa::testing::Hidden h;

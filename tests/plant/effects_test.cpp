@@ -138,9 +138,11 @@ TEST(Effects, TheSpoolIsOneLagOrTwoInSeries) {
   EXPECT_LT(step({t1, t2}, 0), 0.5 * step({t1 + t2}, 0));  // second order starts flat
   EXPECT_NEAR(step({t1, t2}, 400), 1.0, 1e-6);
 }
+
 // The spool limited by its speed (a solenoid's force runs out): a large step is followed at the
-// limit, a ramp a little short of it, while a step smaller than one sample's travel passes at once
-// and a slower command is followed as if there were no limit.
+// limit (the rounded knee gives a little less once the spool is near the command); a step well
+// inside one sample's travel passes whole, and a ramp at half the limit is followed as if there
+// were none.
 TEST(Effects, ASpoolLimitedByItsSpeedRampsAtThatSpeed) {
   constexpr double Ts = 0.01, rate_V_per_s = 20.0;
   EffectSet e;
