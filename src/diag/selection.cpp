@@ -338,10 +338,7 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
   // accepted for (a delay of 0 samples, accepted with the better re-fit of a lag beside it): it
   // is not named.
   for (std::size_t i = 0; i < d.effects.size();) {
-    const auto specs = plant::param_specs(d.effects[i]);
-    bool neutral = true;
-    for (std::size_t j = 0; j < specs.size(); ++j) neutral = neutral && current.all.effects.param(d.effects[i], j) == specs[j].neutral;
-    if (!neutral) {
+    if (!current.all.effects.at_neutral(d.effects[i])) {
       ++i;
       continue;
     }

@@ -118,6 +118,13 @@ std::vector<EffectKind> EffectSet::kinds() const {
   return k;
 }
 
+bool EffectSet::at_neutral(EffectKind kind) const {
+  const auto specs = param_specs(kind);
+  for (std::size_t i = 0; i < specs.size(); ++i)
+    if (params(kind)[i] != specs[i].neutral) return false;
+  return true;
+}
+
 core::Status EffectSet::validate() const {
   for (auto kind : kinds()) {
     const auto specs = param_specs(kind);
@@ -154,7 +161,7 @@ ValveEffects::ValveEffects(const EffectSet& e, double Ts) {
     lag_alpha_ = lag_alpha(e.param(EffectKind::kValveLag, 0), Ts);
     second_alpha_ = lag_alpha(e.param(EffectKind::kValveLag, 1), Ts);
     const double rate = e.param(EffectKind::kValveLag, 2);
-    if (rate < param_specs(EffectKind::kValveLag)[2].neutral) rate_step_v_ = rate * Ts;
+    if (rate < kLag[2].neutral) rate_step_v_ = rate * Ts;
   }
 }
 

@@ -79,6 +79,8 @@ class EffectSet {
   const EffectParams& params(EffectKind kind) const { return params_[index(kind)]; }
   double param(EffectKind kind, std::size_t i) const { return params_[index(kind)][i]; }
   std::vector<EffectKind> kinds() const;  // switched on, in signal order
+  // Every parameter at its neutral value: the effect, though on, does nothing.
+  bool at_neutral(EffectKind kind) const;
   bool empty() const { return kinds().empty(); }
   // Parameters within their bounds (the message names the effect and parameter), finite.
   core::Status validate() const;
