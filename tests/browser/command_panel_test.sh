@@ -70,17 +70,29 @@ wait_status() {  # wait_status <seconds> <python path> <awk condition on v>
 near() { awk -v a="$1" -v b="$2" -v d="$3" 'BEGIN { x = a - b; if (x < 0) x = -x; exit !(a != "" && x <= d) }'; }
 
 # The panel driven by the probe through the steps given ("token=...;mode=run;..."), the DOM after
-# it; <budget> is Chromium's virtual time, which runs well ahead of real time.
+# it; <budget> is Chromium's virtual time, which runs well ahead of real time. The probe stops the
+# page's timers when it has reported, so the budget only bounds a probe that hangs: it is longer
+# than the probe's own waits (10 s each), which report what they waited for.
+# A Chromium that exits without a page (no <body> on stdout: it crashed or was killed) has not run
+# the probe at all, so nothing was clicked: it is started once more, and that is said.
 probe() {  # probe <steps> [budget_ms]
-  local t0=$(now_ms)
-  browser --virtual-time-budget="${2:-30000}" --window-size=1280,900 --dump-dom "$url#$1"
-  echo "probe '${1//$token/TOKEN}': $(( $(now_ms) - t0 )) ms" >&2
+  local t0=$(now_ms) dom attempt
+  for attempt in 1 2; do
+    dom=$(browser --virtual-time-budget="${2:-60000}" --window-size=1280,900 --dump-dom "$url#$1")
+    echo "probe '${1//$token/TOKEN}': $(( $(now_ms) - t0 )) ms" >&2
+    grep -q "<body" <<<"$dom" && break
+    echo "probe: Chromium gave no page (${#dom} bytes of output); the end of its log:" >&2
+    tail -n 5 "$tmp/chromium.log" >&2
+    [ "$attempt" = 1 ] && echo "probe: once more" >&2
+  done
+  printf '%s\n' "$dom"
 }
 probe_ok() {  # probe_ok <label> <dom>: the probe finished its steps
   local state
   state=$(body_attr data-probe <<<"$2")
   [ "$state" = done ] && return 0
-  fail "$1: the probe did not finish: '${state:-no report}' (answers: $(body_attr data-answers <<<"$2"))"
+  fail "$1: the probe did not finish: '${state:-no report}' (answers: $(body_attr data-answers <<<"$2"); ${#2} bytes of DOM)"
+  tail -n 5 "$tmp/chromium.log" >&2
   return 1
 }
 
