@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/reading_slope.hpp"
 #include "core/units.hpp"
 
 namespace epa::control {
@@ -19,8 +20,7 @@ double mean_reading(const ApproachState& s) noexcept {
 // Least-squares slope of the last 4 readings (V/s); 0 until there are 4.
 double reading_slope(const ApproachState& s, double Ts) noexcept {
   if (s.reading_count < 4) return 0.0;
-  const auto& y = s.readings;
-  return (3.0 * y[0] + y[1] - y[2] - 3.0 * y[3]) / (10.0 * Ts);
+  return core::slope_of_last_four(s.readings, Ts);
 }
 
 void hold(ApproachState& s, double at_v) noexcept {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/first_order_lag.hpp"
 #include "core/format.hpp"
 
 namespace epa::control {
@@ -119,7 +120,7 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   p.integral_gain = c.integral_gain_per_s > 0.0 ? c.integral_gain_per_s : 0.75 * p.proportional_gain * c.feedback_bandwidth_rad_s;
   p.integrator_band_v = c.integrator_band_v;
   p.hold_band_v = c.hold_band_v;
-  p.filter_alpha = c.error_filter_s > 0.0 ? 1.0 - std::exp(-Ts / c.error_filter_s) : 1.0;
+  p.filter_alpha = core::lag_step_share(c.error_filter_s, Ts);
   p.idz_ramp = c.idz_ramp;
   p.creep_margin_v = c.creep_margin_v;
   p.creep_margin_step_v = c.creep_margin_v / std::max(1.0, std::round(c.creep_blend_s / Ts));

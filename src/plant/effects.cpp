@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "core/first_order_lag.hpp"
 #include "core/format.hpp"
 
 namespace epa::plant {
@@ -75,8 +76,6 @@ double soft_ceiling(double s, double c, double n) {
   return n >= 64.0 ? std::clamp(s, -c, c) : s / std::pow(1.0 + std::pow(std::abs(s) / c, n), 1.0 / n);
 }
 
-// A first-order lag's step per sample, 1 - exp(-Ts/tau): 1 (no lag) for tau 0.
-double lag_alpha(double tau_s, double Ts) { return tau_s > 0.0 ? 1.0 - std::exp(-Ts / tau_s) : 1.0; }
 
 }  // namespace
 
@@ -158,8 +157,8 @@ ValveEffects::ValveEffects(const EffectSet& e, double Ts) {
   if (e.on(EffectKind::kInputDelay))
     delay_ = std::min<std::size_t>(kMaxDelaySamples, static_cast<std::size_t>(std::llround(std::max(0.0, e.param(EffectKind::kInputDelay, 0)))));
   if (e.on(EffectKind::kValveLag)) {
-    lag_alpha_ = lag_alpha(e.param(EffectKind::kValveLag, 0), Ts);
-    second_alpha_ = lag_alpha(e.param(EffectKind::kValveLag, 1), Ts);
+    lag_alpha_ = core::lag_step_share(e.param(EffectKind::kValveLag, 0), Ts);
+    second_alpha_ = core::lag_step_share(e.param(EffectKind::kValveLag, 1), Ts);
     const double rate = e.param(EffectKind::kValveLag, 2);
     if (rate < kLag[2].neutral) rate_step_v_ = rate * Ts;
   }

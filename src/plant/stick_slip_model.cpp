@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/format.hpp"
+#include "core/reading_slope.hpp"
 
 namespace epa::plant {
 
@@ -96,7 +97,7 @@ double coast_time_s(const StickSlipParams& params, double Ts, double speed_mm_s)
       for (std::size_t i = y.size() - 1; i > 0; --i) y[i] = y[i - 1];
       y[0] = model->step(u);
     }
-    const double speed = direction * (3.0 * y[0] + y[1] - y[2] - 3.0 * y[3]) / (10.0 * Ts);
+    const double speed = direction * core::slope_of_last_four(y, Ts);
     if (!(speed > 0.0)) continue;
     for (int k = 0; k < steady_samples && !(model->stuck() && k > params.delay_samples); ++k) model->step(0.0);
     sum_s += direction * (model->position_mm() - y[0]) / speed;

@@ -3,8 +3,9 @@
 // delay of whole samples (a slow fieldbus, a computation that misses its slot) and a first-order
 // lag (a valve slower than the model). Fixed storage, allocation-free.
 #include <array>
-#include <cmath>
 #include <cstddef>
+
+#include "core/first_order_lag.hpp"
 
 namespace epa::sim {
 
@@ -17,7 +18,7 @@ struct ValveLineOptions {
 
 class ValveLine {
  public:
-  ValveLine(const ValveLineOptions& o, double Ts) : delay_(o.delay_samples), alpha_(o.lag_s > 0.0 ? 1.0 - std::exp(-Ts / o.lag_s) : 1.0) {}
+  ValveLine(const ValveLineOptions& o, double Ts) : delay_(o.delay_samples), alpha_(core::lag_step_share(o.lag_s, Ts)) {}
 
   // The command the valve sees this sample, given the controller's command now.
   double pass(double command_v) noexcept {

@@ -6,6 +6,7 @@
 // law's model, for the tests that check the coast the law assumes.
 #include <array>
 
+#include "core/reading_slope.hpp"
 #include "plant/pneumatic_plant.hpp"
 
 namespace epa::testing {
@@ -25,7 +26,7 @@ PhysicsCoast measure_physics_coast(plant::PneumaticPlant& physics, double valve_
     y = {physics.position_mm(), y[0], y[1], y[2]};
   }
   PhysicsCoast c;
-  c.speed_mm_s = direction * (3.0 * y[0] + y[1] - y[2] - 3.0 * y[3]) / (10.0 * kTs);
+  c.speed_mm_s = direction * core::slope_of_last_four(y, kTs);
   for (int k = 0; k < 200; ++k) physics.step(0.0);
   c.coast_s = direction * (physics.position_mm() - y[0]) / c.speed_mm_s;
   return c;
