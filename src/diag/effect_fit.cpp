@@ -89,9 +89,13 @@ double fit_from_starts(Objective& obj, const std::vector<Slot>& slots, const Fit
 // when `from_current_only`); leaves the best in obj.model.
 // A new effect's parameter that is a member of its family of its own (starts_alone: a spool's
 // speed limit, which does nothing while a lag beside it smooths the command) is fitted apart:
-// the rest first with it neutral, then it alone with the rest of its effect neutral, from a third
-// of its range with the fitted parameters where they stand and back at neutral; the better fit
-// stays. Apart, each search has fewer dimensions, and costs less.
+// the rest first with it neutral, then it alone with the rest of its effect neutral, with the
+// fitted parameters where they stand and back at neutral; the better fit stays. Apart, each
+// search has fewer dimensions, and costs less. Its own fit starts from a third of its range with
+// the fitted parameters, and also from where a one-dimensional fit of it alone (those held)
+// placed it: moved together from the start, the fitted parameters can walk back to where they had
+// absorbed its effect (a gain of 0.3 for a slow spool) before it acts, and either start alone
+// missed some spool speeds (tests/diag/effect_fit_test.cpp).
 // Once its effect is fitted, such a member left at its neutral value stays out of later fits.
 double local_fit(Objective& obj, const std::vector<Slot>& all_slots, const FitOptions& o, bool from_current_only = false) {
   std::vector<Slot> slots;
@@ -113,11 +117,15 @@ double local_fit(Objective& obj, const std::vector<Slot>& all_slots, const FitOp
     member.push_back(a);
     std::vector<std::vector<double>> starts;
     for (bool reset : {false, true}) {
+      obj.model = before;
+      for (std::size_t i = 0; reset && i < fitted.size(); ++i) put(obj.model, fitted[i], fitted[i].spec.neutral);
       auto x = units_now(obj, member);
-      for (std::size_t i = 0; reset && i + 1 < member.size(); ++i) x[i] = member[i].to_unit(member[i].spec.neutral);
       x.back() = 0.3;
       starts.push_back(x);
+      minimise_from(obj, {a}, o, {{0.3}});
+      starts.push_back(units_now(obj, member));
     }
+    obj.model = before;
     if (const double g = minimise_from(obj, member, o, starts); g < best) best = g, best_model = obj.model;
   }
   obj.model = best_model;
