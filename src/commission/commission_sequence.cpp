@@ -29,6 +29,40 @@ nlohmann::json move_json(const JudgedMove& m) {
           {"why", m.why}};
 }
 
+// The model kept from the cross-validation's splits (each run held out once). Which model describes
+// the axis, Hammerstein or stick-slip, is judged on each kind's best held-out fit over the splits,
+// not on the one split the Hammerstein model fits best: picking the split by one kind's fit and
+// then comparing the kinds on it favours that kind (on the physics rig through a jittery I/O path
+// the Hammerstein model won a split by 0.3 points where the other split gave the stick-slip model
+// 10 more, and the law deployed without its sliding arrival overshot 7-9 mm). Each kind's best,
+// not its mean: a stick-slip fit that failed on one split (-20 % held out, where the other split
+// gave 95 %) must not outvote it. The split kept is the one whose held-out run the describing kind
+// follows best. A stick-slip verdict needs a stick-slip model from every split.
+IdentifiedModel keep_cross_validated(std::vector<IdentifiedModel> candidates) {
+  std::size_t best_hammerstein = 0, best_stick_slip = 0;
+  bool every_split_has_stick_slip = true;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const auto& c = candidates[i];
+    if (c.validation_fit_pct > candidates[best_hammerstein].validation_fit_pct) best_hammerstein = i;
+    if (c.stick_slip_validation_fit_pct > candidates[best_stick_slip].stick_slip_validation_fit_pct) best_stick_slip = i;
+    every_split_has_stick_slip = every_split_has_stick_slip && c.stick_slip.has_value();
+  }
+  const double hammerstein_pct = candidates[best_hammerstein].validation_fit_pct;
+  const double stick_slip_pct = candidates[best_stick_slip].stick_slip_validation_fit_pct;
+  const bool stick_slip = every_split_has_stick_slip && stick_slip_pct > hammerstein_pct;
+  const std::size_t splits = candidates.size();
+  IdentifiedModel kept = std::move(candidates[stick_slip ? best_stick_slip : best_hammerstein]);
+  kept.axis_model = stick_slip ? core::AxisModel::kStickSlip : core::AxisModel::kHammerstein;
+  if (splits > 1 && every_split_has_stick_slip) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "; over the %zu splits the %s model describes the axis (best held-out fit %.1f %%, the %s model's %.1f %%)",
+                  splits, stick_slip ? "stick-slip" : "Hammerstein", stick_slip ? stick_slip_pct : hammerstein_pct,
+                  stick_slip ? "Hammerstein" : "stick-slip", stick_slip ? hammerstein_pct : stick_slip_pct);
+    kept.summary += buf;
+  }
+  return kept;
+}
+
 }  // namespace
 
 std::string_view to_string(Stage s) {
@@ -143,11 +177,12 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
   }
 
   // 2. Identification, cross-validated: each run is held out once while the others estimate, and
-  // the model that predicts its held-out run best is kept. One short run can leave the search in
+  // the model that predicts its held-out run best is kept (keep_cross_validated: of the kind that
+  // describes the axis). One short run can leave the search in
   // a model that fits it and nothing else (held-out fits of 24 % and 88 % were seen on the same
   // rig); trying each split costs seconds of computation, not another experiment.
   step(Stage::kIdentifying, pct(), "identifying the Hammerstein model", out);
-  std::optional<IdentifiedModel> identified;
+  std::vector<IdentifiedModel> candidates;
   std::string first_error;
   for (std::size_t held = out.experiment.size(); held-- > 0;) {
     std::vector<core::Run> estimation;
@@ -164,9 +199,10 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
     candidate->held_out_run = held;
     out.log.push_back("identified, " + which + candidate->summary);
     if (log_) log_("commission: identified, " + which + candidate->summary);
-    if (!identified || candidate->validation_fit_pct > identified->validation_fit_pct) identified = std::move(*candidate);
+    candidates.push_back(std::move(*candidate));
   }
-  if (!identified) return finish(Verdict::kRolledBack, "identification: " + first_error, out);
+  if (candidates.empty()) return finish(Verdict::kRolledBack, "identification: " + first_error, out);
+  std::optional<IdentifiedModel> identified = keep_cross_validated(std::move(candidates));
   identified->model.Ts = old_model.Ts;  // the runs were recorded by this loop, at its period
   out.identified = *identified;
   out.log.push_back("identified: " + identified->summary);
@@ -184,13 +220,18 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
   set.F = design->F, set.G = design->G, set.H = design->H;
   set.dead_zone = identified->model.dead_zone;
   // pp-traj arrives while sliding on an axis that a stick-slip model describes (its coast from it),
-  // and approaches again when a stop is further off than half the verification's e_ss limit: a stop
-  // it accepts then passes with margin, and it does not back off for precision nobody asked for.
+  // and approaches again when a stop is further off than 3/4 of the verification's e_ss limit: a
+  // stop it accepts passes with a quarter of the limit to spare, and it does not back off for
+  // precision nobody asked for. Each retry costs about 1 s and draws the stop again from the same
+  // scatter; with half the limit, commissioning through a remote I/O path whose commands reach
+  // the valve a cycle late 30-50 % of the time retried stops already within the limit until the
+  // last approach fell into the metrics' window, and rolled back 12 runs of 80 that 3/4 deploys
+  // (tests/commission/commission_physics_sweep.cpp, README "Commissioning").
   const auto coast = plant::sliding_arrival_coast_s(
       core::ModelFile{identified->model, "", identified->stick_slip, identified->axis_model}, set.trajectory.approach_speed_mm_s);
   if (!coast) return finish(Verdict::kRolledBack, "design: " + coast.error().message, out);
   set.trajectory.coast_s = *coast;
-  set.trajectory.retry_band_mm = 0.5 * spec.limits.ess_mm;
+  set.trajectory.retry_band_mm = 0.75 * spec.limits.ess_mm;
   set.model_id = 0;
   set.source = "epa commission: " + identified->summary;
   set.design_json = format_commission_spec(spec);

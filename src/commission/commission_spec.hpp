@@ -32,7 +32,8 @@ struct MoveLimits {
 
 struct CommissionSpec {
   // The experiment: runs of the excitation (ramps through the dead band, then pulses); each is
-  // held out once to validate the model the others identify (the best held-out fit is kept).
+  // held out once to validate the model the others identify (the best held-out fit of the kind
+  // of model that describes the axis is kept: commission_sequence.cpp).
   int excitation_runs = 2;
   double excitation_s = 60.0;
   std::uint64_t seed = 1;           // of the first run's pulses; run i uses seed + i
