@@ -1,11 +1,6 @@
-// The whole commissioning sequence, offline, on a rig that is not any model it fits: the physics
-// plant with tests/integration/commission_test.py's hidden perturbations (orifice 3.2 mm2, spool
-// overlap +1.4/-1.5 V), behind a remote I/O path whose commands reach the valve a cycle late with a
-// given probability (physics_rig_axis.hpp), over sensor-noise seeds. Before commissioning the
-// axis makes the integration test's ten HMI moves with the paper's tuning: the chambers' pressures
-// a working axis has, which the excitation's response depends on (from a fresh 3 bar in both
-// chambers the identified models followed their held-out runs 15-25 points worse than those the
-// real appliance identifies on that rig). Real time is not needed: one run takes about 5 s.
+// The whole commissioning sequence, offline, on the physics rig of tests/integration/commission_test.py
+// (physics_rig_commissioning.hpp) through a remote I/O path whose commands reach the valve a cycle
+// late with a given probability, over sensor-noise seeds: a deploy rate (bench/commission_physics.sh).
 //
 //   commission_physics_sweep [--seeds N] [--first S] [--late P,P,...] [--keep DIR]
 //
@@ -21,34 +16,12 @@
 #include <iostream>
 #include <map>
 
-#include "app/commission_identify.hpp"
-#include "commission/commission_sequence.hpp"
-#include "commission/commission_spec.hpp"
-#include "core/paper_reference.hpp"
 #include "core/run_file.hpp"
-#include "physics_rig_axis.hpp"
-#include "plant/pneumatic_params.hpp"
+#include "physics_rig_commissioning.hpp"
 
 using namespace epa;
 
 namespace {
-
-commission::RunningTuning paper_tuning() {
-  commission::RunningTuning paper;
-  paper.model.name = "paper";
-  paper.model.model = core::paper::model();
-  paper.set.name = "paper";
-  paper.set.controller = control::ControllerKind::kPpFfidz;
-  paper.set.F = core::paper::F(), paper.set.G = core::paper::G(), paper.set.H = core::paper::G();
-  paper.set.dead_zone = paper.model.model.dead_zone;
-  return paper;
-}
-
-// tests/integration/commission_test.py's spec for the deployed case: pp-traj, issue 19's limits.
-constexpr const char* kSpec = R"({"excitation_runs": 2, "excitation_s": 40, "seed": 3, "controller": "pp-traj",
-  "settling_s": 0.3, "overshoot_pct": 0, "moves_mm": [150, 350, 250, 225, 275], "move_hold_s": 6, "name": "rig-1",
-  "limits": {"ess_mm": 1, "overshoot_pct": 5, "overshoot_mm": 0, "settling_s": 0}})";
-constexpr double kHmiTargetsMm[] = {225, 275, 175, 275, 125, 325, 250, 50, 250, 450};
 
 void keep(const std::filesystem::path& dir, const std::string& name, const commission::CommissionOutcome& out) {
   std::filesystem::create_directories(dir);
@@ -77,23 +50,13 @@ int main(int argc, char** argv) {
   app.add_option("--keep", keep_dir, "Write each failed run's outcome, experiment and moves here");
   CLI11_PARSE(app, argc, argv);
 
-  plant::PneumaticParams rig;
-  rig.orifice_area_mm2 = 3.2, rig.overlap_pos_v = 1.4, rig.overlap_neg_v = -1.5;
-  const auto spec = commission::parse_commission_spec(kSpec);
-  if (!spec) return std::cerr << "commission_physics_sweep: " << spec.error().message << "\n", 1;
-  const auto paper = paper_tuning();
-
   std::map<double, std::pair<int, int>> deployed_of;  // lateness -> (deployed, runs)
   std::map<std::string, int> failures_by_stage;
   for (double late : lates)
     for (int seed = first; seed < first + seeds; ++seed) {
-      testing::PhysicsRigAxis axis(rig, static_cast<std::uint64_t>(seed), late, paper);
-      const std::atomic<bool> no_abort{false};
-      for (double target : kHmiTargetsMm)
-        if (auto moved = axis.move(target, 5.0, no_abort); !moved) return std::cerr << moved.error().message << "\n", 1;
-      axis.stop();
-      commission::CommissionSequence sequence(axis, app::identify_for_commissioning(paper.model.model.mm_per_volt));
-      const auto out = sequence.run(*spec);
+      const auto run = testing::commission_physics_rig(static_cast<std::uint64_t>(seed), late);
+      if (!run) return std::cerr << "commission_physics_sweep: " << run.error().message << "\n", 1;
+      const auto& out = *run;
       const bool deployed = out.verdict == commission::Verdict::kDeployed;
       auto& [ok, runs] = deployed_of[late];
       ok += deployed, ++runs;
