@@ -6,7 +6,8 @@
 //
 // One line per run (seed, lateness, verdict, reason, the identification's summary), then a table:
 // runs deployed per lateness, and the failures by where they stopped. --keep writes each failed
-// run's epa-commission/1 JSON, its experiment and its axis moves (epa-run/1 CSV) into DIR.
+// run's epa-commission/1 JSON, its experiment and its axis moves (epa-run/1 CSV), and the positions
+// of each simulated move that failed (one per line, mm), into DIR.
 // Exit 0 when every run ended (whatever its verdict), 1 on a usage or harness error.
 #include <CLI/CLI.hpp>
 
@@ -30,6 +31,13 @@ void keep(const std::filesystem::path& dir, const std::string& name, const commi
     std::ofstream f(dir / (name + "-excitation" + std::to_string(i + 1) + ".csv"));
     core::write_run(f, out.experiment[i]);
   }
+  if (out.simulation)  // each failed simulated move's positions, one per sample, mm
+    for (std::size_t c = 0; c < out.simulation->cases.size(); ++c)
+      for (std::size_t i = 0; i < out.simulation->cases[c].moves.size(); ++i) {
+        if (out.simulation->cases[c].moves[i].passed) continue;
+        std::ofstream f(dir / (name + "-simulated-case" + std::to_string(c + 1) + "-move" + std::to_string(i + 1) + ".txt"));
+        for (double y : out.simulation->cases[c].positions_mm[i]) f << y << "\n";
+      }
   for (std::size_t i = 0; i < out.measured_moves.size(); ++i) {
     std::ofstream f(dir / (name + "-move" + std::to_string(i + 1) + ".csv"));
     core::write_run(f, out.measured_moves[i]);

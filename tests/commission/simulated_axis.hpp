@@ -1,6 +1,11 @@
 #pragma once
-// A simulated axis for the commissioning tests: a Hammerstein plant stepped in the calling thread
-// (no real time), tuning sets kept in memory, every switch recorded for the assertions.
+// Simulated axes for the commissioning tests: a plant stepped in the calling thread (no real time),
+// tuning sets kept in memory, every switch recorded for the assertions. The experiment runs as the
+// appliance's EXCITE mode does (app/appliance_axis.cpp, runtime/excitation_run.cpp): a piston
+// outside the guard lines is first moved to the middle with the set that runs and held 3 s; the
+// generator's defaults over the soft limits' span (-2..502 mm), 100 mm guards.
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <vector>
 
@@ -13,11 +18,12 @@
 
 namespace epa::testing {
 
-class SimulatedAxis final : public commission::Axis {
+// `Plant` has measured_mm() (the sensor at k) and step(valve_v) (holds it over one sample, to k+1).
+template <typename Plant>
+class SimulatedAxisOn : public commission::Axis {
  public:
-  // `plant_model` is the axis; `running` the set (with its model) it runs at first, id 1.
-  SimulatedAxis(const core::HammersteinModel& plant_model, commission::RunningTuning running)
-      : plant_(*plant::HammersteinPlant::make(plant_model, {.initial_position_mm = 250.0, .noise_std_mm = 0.05})) {
+  // `running` is the set (with its model) the loop runs at first, id 1.
+  SimulatedAxisOn(Plant plant, commission::RunningTuning running) : plant_(std::move(plant)) {
     running.set.id = 1;
     running.model.id = 1;
     sets_[1] = running;
@@ -29,17 +35,18 @@ class SimulatedAxis final : public commission::Axis {
 
   core::Result<core::Run> excite(const commission::ExcitationRequest& r, const std::atomic<bool>& abort) override {
     ++excitations;
-    auto gen = ident::ExcitationGenerator::make({.duration_s = r.duration_s, .amplitude_max_v = r.amplitude_max_v, .seed = r.seed});
+    if (const double y = plant_.measured_mm(); y < kSoftMinMm + kGuardMm || y > kSoftMaxMm - kGuardMm)
+      if (auto placed = move(0.5 * (kSoftMinMm + kSoftMaxMm), 3.0, abort); !placed) return placed.error();
+    auto gen = ident::ExcitationGenerator::make({.Ts = kTs, .duration_s = r.duration_s, .amplitude_max_v = r.amplitude_max_v,
+                                                 .stroke_mm = kSoftMaxMm - kSoftMinMm, .guard_mm = kGuardMm, .seed = r.seed});
     if (!gen) return gen.error();
     core::Run run;
-    run.Ts = 0.005;
+    run.Ts = kTs;
     run.set_meta("controller", "open-loop");
     run.set_meta("excitation_seed", std::to_string(r.seed));
     for (std::size_t k = 0; !gen->done() && !abort; ++k) {
-      const double y = plant_.measured_mm(), u = gen->next(y);
-      run.t_s.push_back(static_cast<double>(k) * run.Ts), run.r_mm.push_back(0.0), run.y_mm.push_back(y);
-      run.u_V.push_back(u), run.uc_V.push_back(u);
-      max_abs_valve_v = std::max(max_abs_valve_v, std::abs(u));
+      const double y = plant_.measured_mm(), u = gen->next(y - kSoftMinMm);
+      record(run, k, 0.0, y, u, u);
       plant_.step(u);
     }
     return run;
@@ -69,14 +76,12 @@ class SimulatedAxis final : public commission::Axis {
     if (!params) return params.error();
     control::ControllerState state;
     core::Run run;
-    run.Ts = 0.005;
+    run.Ts = kTs;
     const double mpv = t.model.model.mm_per_volt;
     for (std::size_t k = 0; k < static_cast<std::size_t>(hold_s / run.Ts) && !abort; ++k) {
       const double y = plant_.measured_mm();
       const auto out = control::controller_step(*params, state, target_mm / mpv, y / mpv);
-      run.t_s.push_back(static_cast<double>(k) * run.Ts), run.r_mm.push_back(target_mm), run.y_mm.push_back(y);
-      run.u_V.push_back(out.valve_v), run.uc_V.push_back(out.controller_v);
-      max_abs_valve_v = std::max(max_abs_valve_v, std::abs(out.valve_v));
+      record(run, k, target_mm, y, out.valve_v, out.controller_v);
       plant_.step(out.valve_v);
       if (abort_after_samples && --abort_after_samples == 0) abort_target->abort();  // the operator, mid-move
     }
@@ -99,8 +104,24 @@ class SimulatedAxis final : public commission::Axis {
   std::size_t abort_after_samples = 0;  // >0: abort_target is aborted after this many samples of moves
 
  private:
-  plant::HammersteinPlant plant_;
+  static constexpr double kTs = 0.005, kSoftMinMm = -2.0, kSoftMaxMm = 502.0, kGuardMm = 100.0;
+
+  void record(core::Run& run, std::size_t k, double r, double y, double u, double uc) {
+    run.t_s.push_back(static_cast<double>(k) * run.Ts), run.r_mm.push_back(r), run.y_mm.push_back(y);
+    run.u_V.push_back(u), run.uc_V.push_back(uc);
+    max_abs_valve_v = std::max(max_abs_valve_v, std::abs(u));
+  }
+
+  Plant plant_;
   std::map<std::int64_t, commission::RunningTuning> sets_;
+};
+
+// The paper's Hammerstein plant (or any model) as the axis, starting at rest at 250 mm.
+class SimulatedAxis final : public SimulatedAxisOn<plant::HammersteinPlant> {
+ public:
+  SimulatedAxis(const core::HammersteinModel& plant_model, commission::RunningTuning running)
+      : SimulatedAxisOn(*plant::HammersteinPlant::make(plant_model, {.initial_position_mm = 250.0, .noise_std_mm = 0.05}),
+                        std::move(running)) {}
 };
 
 }  // namespace epa::testing
