@@ -137,7 +137,7 @@ TEST(CommissionSequence, WhichModelDescribesTheAxisIsJudgedOverAllSplits) {
   const std::vector<Case> cases = {
       // Seen on the physics rig through a jittery I/O path: the split the Hammerstein model fits best
       // (by 0.3 points) is the one split where it also beats the stick-slip model.
-      {"stick-slip on average, Hammerstein on its own best split", {{"1", {84.1, 83.8}}, {"2", {83.8, 93.7}}},
+      {"stick-slip on its best split, Hammerstein on its own", {{"1", {84.1, 83.8}}, {"2", {83.8, 93.7}}},
        core::AxisModel::kStickSlip, "2"},
       // A stick-slip fit that failed on one split (seen there too) does not outvote the other.
       {"a stick-slip fit that failed on one split", {{"1", {92.0, 94.7}}, {"2", {66.5, -20.3}}}, core::AxisModel::kStickSlip, "1"},
