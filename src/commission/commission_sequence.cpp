@@ -178,9 +178,9 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
 
   // 2. Identification, cross-validated: each run is held out once while the others estimate, and
   // the model that predicts its held-out run best is kept (keep_cross_validated: of the kind that
-  // describes the axis). One short run can leave the search in
-  // a model that fits it and nothing else (held-out fits of 24 % and 88 % were seen on the same
-  // rig); trying each split costs seconds of computation, not another experiment.
+  // describes the axis). One short run can leave the search in a model that fits it and nothing
+  // else (held-out fits of 24 % and 88 % were seen on the same rig); trying each split costs
+  // seconds of computation, not another experiment.
   step(Stage::kIdentifying, pct(), "identifying the Hammerstein model", out);
   std::vector<IdentifiedModel> candidates;
   std::string first_error;
