@@ -16,19 +16,6 @@
 namespace epa::commission {
 namespace {
 
-RunningTuning paper_tuning() {
-  RunningTuning t;
-  t.model.name = "paper";
-  t.model.model = core::paper::model();
-  t.set.name = "paper";
-  t.set.controller = control::ControllerKind::kPpFfidz;
-  t.set.F = core::paper::F();
-  t.set.G = core::paper::G();
-  t.set.H = core::paper::G();
-  t.set.dead_zone = t.model.model.dead_zone;
-  return t;
-}
-
 // Identification stand-in: the sequence's logic is under test here, not the fit (tests/ident).
 Identify returns(const core::HammersteinModel& model) {
   return [model](const std::vector<core::Run>& estimation, const core::Run&) -> core::Result<IdentifiedModel> {
@@ -52,7 +39,7 @@ CommissionSpec short_spec() {
 
 TEST(CommissionSequence, DeploysASetThatPassesEveryCheck) {
   const auto plant = core::paper::model();
-  testing::SimulatedAxis axis(plant, paper_tuning());
+  testing::SimulatedAxis axis(plant, testing::paper_running_tuning());
   CommissionSequence seq(axis, returns(plant));
   const auto out = seq.run(short_spec());
   ASSERT_EQ(out.verdict, Verdict::kDeployed) << out.reason;
@@ -96,7 +83,7 @@ Identify bad_when_estimated_on(std::uint64_t bad_seed, std::vector<std::string>&
 TEST(CommissionSequence, EachRunIsHeldOutOnceAndTheBestHeldOutFitIsKept) {
   for (const std::uint64_t bad_seed : {1u, 2u}) {  // spec seed 1: runs of seeds 1 and 2
     const auto plant = core::paper::model();
-    testing::SimulatedAxis axis(plant, paper_tuning());
+    testing::SimulatedAxis axis(plant, testing::paper_running_tuning());
     std::vector<std::string> held_out;
     CommissionSequence seq(axis, bad_when_estimated_on(bad_seed, held_out));
     const auto out = seq.run(short_spec());
@@ -145,7 +132,7 @@ TEST(CommissionSequence, WhichModelDescribesTheAxisIsJudgedOverAllSplits) {
       {"a split without a stick-slip model", {{"1", {80.0, 0.0, false}}, {"2", {79.0, 95.0}}}, core::AxisModel::kHammerstein, "1"},
   };
   for (const auto& c : cases) {
-    testing::SimulatedAxis axis(core::paper::model(), paper_tuning());
+    testing::SimulatedAxis axis(core::paper::model(), testing::paper_running_tuning());
     CommissionSequence seq(axis, with_fits(c.fits));
     const auto out = seq.run(short_spec());
     ASSERT_TRUE(out.identified) << c.what << ": " << out.reason;
@@ -161,7 +148,7 @@ TEST(CommissionSequence, WhichModelDescribesTheAxisIsJudgedOverAllSplits) {
 }
 
 TEST(CommissionSequence, AnIdentificationThatFailsOnEverySplitRollsBackWithTheReason) {
-  testing::SimulatedAxis axis(core::paper::model(), paper_tuning());
+  testing::SimulatedAxis axis(core::paper::model(), testing::paper_running_tuning());
   Identify failing = [](const std::vector<core::Run>&, const core::Run&) -> core::Result<IdentifiedModel> {
     return core::numerical_error("the excitation never left the dead band");
   };
@@ -177,7 +164,7 @@ TEST(CommissionSequence, AVerificationLimitTheAxisCannotMeetRollsBackAtOnce) {
   // simulation on the model passes, the axis stops short.
   auto plant = core::paper::model();
   plant.dead_zone.b_r += 0.6, plant.dead_zone.b_l -= 0.6;
-  testing::SimulatedAxis axis(plant, paper_tuning());
+  testing::SimulatedAxis axis(plant, testing::paper_running_tuning());
   CommissionSequence seq(axis, returns(core::paper::model()));
   auto spec = short_spec();
   spec.limits.ess_mm = 0.3;
@@ -199,7 +186,7 @@ TEST(CommissionSequence, AVerificationLimitTheAxisCannotMeetRollsBackAtOnce) {
 
 TEST(CommissionSequence, ASpecTheSimulationCannotMeetNeverReachesTheAxis) {
   const auto plant = core::paper::model();
-  testing::SimulatedAxis axis(plant, paper_tuning());
+  testing::SimulatedAxis axis(plant, testing::paper_running_tuning());
   CommissionSequence seq(axis, returns(plant));
   auto spec = short_spec();
   spec.limits.settling_s = 0.05;  // no pneumatic axis settles a 100 mm move in 50 ms
@@ -214,7 +201,7 @@ TEST(CommissionSequence, ASpecTheSimulationCannotMeetNeverReachesTheAxis) {
 
 TEST(CommissionSequence, AbortMidMoveStopsTheValveAndRunsThePreviousSet) {
   const auto plant = core::paper::model();
-  testing::SimulatedAxis axis(plant, paper_tuning());
+  testing::SimulatedAxis axis(plant, testing::paper_running_tuning());
   CommissionSequence seq(axis, returns(plant));
   axis.abort_target = &seq;
   axis.abort_after_samples = 300;  // 1.5 s into the first verification move
@@ -228,7 +215,7 @@ TEST(CommissionSequence, AbortMidMoveStopsTheValveAndRunsThePreviousSet) {
 }
 
 TEST(CommissionSequence, AFailedIdentificationLeavesEverythingAsItWas) {
-  testing::SimulatedAxis axis(core::paper::model(), paper_tuning());
+  testing::SimulatedAxis axis(core::paper::model(), testing::paper_running_tuning());
   CommissionSequence seq(axis, [](const std::vector<core::Run>&, const core::Run&) -> core::Result<IdentifiedModel> {
     return core::numerical_error("the right side of the dead zone is not identified");
   });

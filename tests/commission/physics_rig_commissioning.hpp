@@ -17,17 +17,6 @@
 
 namespace epa::testing {
 
-inline commission::RunningTuning paper_running_tuning() {
-  commission::RunningTuning paper;
-  paper.model.name = "paper";
-  paper.model.model = core::paper::model();
-  paper.set.name = "paper";
-  paper.set.controller = control::ControllerKind::kPpFfidz;
-  paper.set.F = core::paper::F(), paper.set.G = core::paper::G(), paper.set.H = core::paper::G();
-  paper.set.dead_zone = paper.model.model.dead_zone;
-  return paper;
-}
-
 // `late_probability`: that a command reaches the valve a cycle late; `seed`: the sensor noise's and
 // the I/O path's. Errors: the spec does not parse, or an HMI move failed (a harness error).
 inline core::Result<commission::CommissionOutcome> commission_physics_rig(std::uint64_t seed, double late_probability) {

@@ -116,6 +116,20 @@ class SimulatedAxisOn : public commission::Axis {
   std::map<std::int64_t, commission::RunningTuning> sets_;
 };
 
+// The paper's model and tuning (pp-ffidz, eq 12-13), the set an axis runs before commissioning.
+inline commission::RunningTuning paper_running_tuning() {
+  commission::RunningTuning t;
+  t.model.name = "paper";
+  t.model.model = core::paper::model();
+  t.set.name = "paper";
+  t.set.controller = control::ControllerKind::kPpFfidz;
+  t.set.F = core::paper::F();
+  t.set.G = core::paper::G();
+  t.set.H = core::paper::G();
+  t.set.dead_zone = t.model.model.dead_zone;
+  return t;
+}
+
 // The paper's Hammerstein plant (or any model) as the axis, starting at rest at 250 mm.
 class SimulatedAxis final : public SimulatedAxisOn<plant::HammersteinPlant> {
  public:
