@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "app/svg_chart.hpp"
 #include "core/format.hpp"
@@ -34,10 +35,11 @@ std::string coefficients(const core::Polynomial& p) {
   return s + "]";
 }
 
-void row(std::ostream& out, const char* name, double ours, double paper, const char* unit = "") {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "  %-34s %12.4f %12.4f %s\n", name, ours, paper, unit);
-  out << buf;
+void row(std::ostream& out, std::string label, double ours, double paper, const char* unit = "") {
+  if (label.size() < 34) label.resize(34, ' ');
+  char numbers[64];
+  std::snprintf(numbers, sizeof numbers, " %12.4f %12.4f ", ours, paper);
+  out << "  " << label << numbers << unit << "\n";
 }
 
 }  // namespace

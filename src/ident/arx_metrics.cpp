@@ -7,7 +7,7 @@ namespace epa::ident {
 
 namespace {
 
-constexpr double kDivergedV = 1e12;  // a simulation beyond this has diverged
+constexpr double kSimulationDivergedV = 1e12;  // a simulation beyond this has diverged
 
 // sum_i a_i yhat(k-i) + sum_j b_j u(k-nk-j): the right-hand side of y(k) = -A' y + B u.
 template <typename Past>
@@ -33,8 +33,8 @@ std::vector<double> simulate_free_run(const ArxModel& m, const Segment& s, std::
   std::vector<double> yhat = s.y;
   for (std::size_t k = first; k < s.size(); ++k) {
     const double y = arx_output(m, s, k, [&](std::size_t i) { return yhat[i]; });
-    if (!(std::abs(y) <= kDivergedV)) {
-      std::fill(yhat.begin() + static_cast<std::ptrdiff_t>(k), yhat.end(), std::copysign(kDivergedV, y));
+    if (!(std::abs(y) <= kSimulationDivergedV)) {
+      std::fill(yhat.begin() + static_cast<std::ptrdiff_t>(k), yhat.end(), std::copysign(kSimulationDivergedV, y));
       break;
     }
     yhat[k] = y;

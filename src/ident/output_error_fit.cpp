@@ -14,7 +14,7 @@ namespace {
 
 using core::format_number;
 
-constexpr double kDivergedV = 1e6;           // |yhat| beyond this: the simulation has diverged
+constexpr double kFitDivergedV = 1e6;        // |yhat| beyond this: the simulation has diverged
 constexpr double kLambdaStart = 1e-3;        // Marquardt damping, relative to diag(J'J)
 constexpr double kLambdaMax = 1e12;          // damping this large: no step helps any more
 constexpr double kRelativeDecrease = 1e-9;   // an accepted step gaining less than this ends the fit
@@ -177,7 +177,7 @@ class Simulation {
         double y = 0.0;
         for (std::size_t i = 1; i <= na; ++i) y -= m.a[i - 1] * past(k - i);
         for (std::size_t j = 0; j < nb; ++j) y += m.b[j] * ud_[k - nk - j];
-        if (!(std::abs(y) <= kDivergedV)) return INFINITY;
+        if (!(std::abs(y) <= kFitDivergedV)) return INFINITY;
         yhat_[k] = y;
         const double r = y - s.y[k];
         sse += r * r;

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "core/version.hpp"
+#include "modbus/exception_codes.hpp"
 
 namespace epa::modbus {
 
@@ -11,7 +12,6 @@ namespace {
 
 constexpr std::uint8_t kFunction = 0x2B;
 constexpr std::uint8_t kConformity = 0x82;  // regular identification, stream and individual access
-constexpr std::uint8_t kIllegalFunction = 0x01, kIllegalAddress = 0x02, kIllegalValue = 0x03;
 constexpr std::uint8_t kBasic = 1, kIndividual = 4;  // 2 regular, 3 extended
 constexpr std::uint8_t kLastBasic = 0x02, kLastRegular = 0x06;
 

@@ -21,8 +21,11 @@ namespace epa::modbus {
 namespace {
 constexpr int kMbapLength = 6;       // bytes before the MBAP length field's count starts
 constexpr int kMaxAdu = MODBUS_TCP_MAX_ADU_LENGTH;
+}  // namespace
 
-struct Client {
+// One connected client. Not in the anonymous namespace: ModbusServer::Impl holds them, and a member
+// whose type has internal linkage is an error in the unity build (-Wsubobject-linkage).
+struct ClientConnection {
   int fd = -1;
   Session session;   // address, "ip:port", this connection's unlock
   std::vector<std::uint8_t> buffer;
@@ -32,12 +35,13 @@ struct Client {
   short revents = 0;                     // of this round's poll
 };
 
+namespace {
 // Which client makes room for a new one: those that never completed a request first (a crowd of
 // fresh idle sockets cannot push out a working HMI), then the one idle the longest.
-std::size_t eviction_candidate(const std::vector<Client>& clients) {
+std::size_t eviction_candidate(const std::vector<ClientConnection>& clients) {
   std::size_t pick = 0;
   for (std::size_t i = 1; i < clients.size(); ++i) {
-    const Client &a = clients[i], &b = clients[pick];
+    const ClientConnection &a = clients[i], &b = clients[pick];
     if (a.served != b.served ? !a.served : a.idle_since_ns < b.idle_since_ns) pick = i;
   }
   return pick;
@@ -50,7 +54,7 @@ struct ModbusServer::Impl {
   modbus_t* ctx = nullptr;
   modbus_mapping_t* image = nullptr;
   int listener = -1;
-  std::vector<Client> clients;
+  std::vector<ClientConnection> clients;
   runtime::MonotonicClock clock;
   Log log;
 
@@ -136,7 +140,7 @@ void ModbusServer::serve() {
 
     // Clients in reverse, so dropping one does not disturb the indices still to visit.
     for (std::size_t i = m.clients.size(); i-- > 0;) {
-      Client& cl = m.clients[i];
+      ClientConnection& cl = m.clients[i];
       const short revents = cl.revents;
       if (revents & (POLLERR | POLLHUP | POLLNVAL)) { drop(i, "connection closed"); continue; }
       if (revents & POLLIN) {

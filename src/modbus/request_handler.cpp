@@ -5,15 +5,16 @@
 #include <algorithm>
 #include <cmath>
 
+#include "modbus/exception_codes.hpp"
+
 namespace epa::modbus {
+
+static_assert(kIllegalFunction == MODBUS_EXCEPTION_ILLEGAL_FUNCTION && kIllegalAddress == MODBUS_EXCEPTION_ILLEGAL_DATA_ADDRESS &&
+              kIllegalValue == MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE && kCannotApply == MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE &&
+              kOtherUnit == MODBUS_EXCEPTION_GATEWAY_TARGET, "the exception codes are libmodbus's");
 
 namespace {
 
-constexpr std::uint8_t kIllegalFunction = MODBUS_EXCEPTION_ILLEGAL_FUNCTION;          // 01
-constexpr std::uint8_t kIllegalAddress = MODBUS_EXCEPTION_ILLEGAL_DATA_ADDRESS;       // 02
-constexpr std::uint8_t kIllegalValue = MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE;           // 03
-constexpr std::uint8_t kCannotApply = MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE;       // 04
-constexpr std::uint8_t kOtherUnit = MODBUS_EXCEPTION_GATEWAY_TARGET;                  // 0B
 constexpr int kHeader = 7;  // MBAP: transaction, protocol, length, unit
 constexpr int kDeviceIdentification = 0x2B;  // FC43, encapsulated interface transport: libmodbus does not answer it
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/paper_reference.hpp"
+#include "../support/text_contains.hpp"
 
 namespace epa::control {
 namespace {
@@ -26,10 +27,7 @@ const Polynomial kA{1.0, -0.9094, -0.6110, 0.5204};
 const Polynomial kB{0.0, 1.024, -2.046, 1.029};
 const Polynomial kT{1.0, -2.865, 2.7344, -0.8694};
 
-::testing::AssertionResult contains(const std::string& text, const std::string& part) {
-  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << part << "' not found in: " << text;
-}
+using epa::test::contains;
 
 void expect_coefficients(const Polynomial& p, const std::vector<double>& expected, double tol) {
   ASSERT_EQ(p.size(), expected.size()) << p.to_string();

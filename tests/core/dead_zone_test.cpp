@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include "../support/text_contains.hpp"
 
 namespace epa::core {
 namespace {
@@ -16,10 +17,7 @@ constexpr double kTolV = 1e-12;
 // Paper eq 10 (m_l = 1.0707, NOTES.md).
 constexpr DeadZone kPaper{.m_r = 1.7627, .m_l = 1.0707, .b_r = 1.232, .b_l = -1.722};
 
-::testing::AssertionResult contains(const std::string& text, const std::string& part) {
-  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << part << "' not found in: " << text;
-}
+using epa::test::contains;
 
 TEST(DeadZone, ApplyInsideTheBandIsZero) {
   for (double u : {-1.7, -1.0, -0.5, 0.0, 0.3, 1.0, 1.23}) EXPECT_EQ(kPaper.apply(u), 0.0) << "u = " << u;

@@ -11,16 +11,15 @@
 #include <vector>
 
 #include "core/paper_reference.hpp"
+#include "../support/temp_path.hpp"
+#include "../support/text_contains.hpp"
 
 namespace epa::core {
 namespace {
 
 const std::string kPaperModelPath = std::string(EPA_SOURCE_DIR) + "/config/paper-model.toml";
 
-::testing::AssertionResult contains(const std::string& text, const std::string& part) {
-  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << part << "' not found in: " << text;
-}
+using epa::test::contains;
 
 // Field-by-field equality (HammersteinModel has no operator==), exact: every value in these
 // files is a short decimal that parses to the same double as the C++ literal.
@@ -60,10 +59,6 @@ std::string replaced(std::string text, const std::string& from, const std::strin
   return text;
 }
 
-std::string temp_path(const std::string& stem) {
-  const auto ticks = std::chrono::steady_clock::now().time_since_epoch().count();
-  return (std::filesystem::temp_directory_path() / (stem + "-" + std::to_string(ticks) + ".toml")).string();
-}
 
 TEST(ModelFile, PaperModelFileEqualsThePaperReference) {
   const auto file = read_model_file(kPaperModelPath);
@@ -321,7 +316,7 @@ TEST(ModelFile, InvalidDeadZoneIsRefusedNamingTheField) {
 }
 
 TEST(ModelFile, WriteThenReadGivesTheSameModel) {
-  const std::string path = temp_path("epa-model-test");
+  const std::string path = epa::test::unique_temp_path("epa-model-test.toml").string();
   const ModelFile original{paper::model(), "written by model_file_test"};
   const Status written = write_model_file(path, original);
   ASSERT_TRUE(written.has_value()) << written.error().message;
@@ -334,7 +329,7 @@ TEST(ModelFile, WriteThenReadGivesTheSameModel) {
 }
 
 TEST(ModelFile, WriteReplacesAnExistingFile) {
-  const std::string path = temp_path("epa-model-replace");
+  const std::string path = epa::test::unique_temp_path("epa-model-replace.toml").string();
   ModelFile first{paper::model(), "first"};
   ASSERT_TRUE(write_model_file(path, first).has_value());
   ModelFile second = first;

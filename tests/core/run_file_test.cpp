@@ -7,16 +7,15 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include "../support/temp_path.hpp"
+#include "../support/text_contains.hpp"
 
 namespace epa::core {
 namespace {
 
 // Inside TEST bodies `Run` alone names testing::Test::Run, hence core::Run throughout.
 // Failure output shows the whole text, so a wrong message is easy to read.
-::testing::AssertionResult contains(const std::string& text, const std::string& part) {
-  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << part << "' not found in: " << text;
-}
+using epa::test::contains;
 
 core::Run make_run(std::size_t n, bool optional_columns) {
   core::Run run;
@@ -55,13 +54,7 @@ std::string parse_error_of(const std::string& text, std::optional<double> expect
   return result.error().message;
 }
 
-// A fresh path in the temp folder, unique per process and call (tests may run in parallel).
-std::filesystem::path temp_path(const std::string& name) {
-  static int counter = 0;
-  const auto now = std::chrono::system_clock::now().time_since_epoch().count();
-  return std::filesystem::temp_directory_path() /
-         ("epa_run_file_test_" + std::to_string(now) + "_" + std::to_string(counter++) + "_" + name);
-}
+using epa::test::unique_temp_path;
 
 // Removes a temp file or folder even when an ASSERT leaves the test early.
 struct RemoveOnExit {
@@ -325,7 +318,7 @@ TEST(RunFile, WriteRunFileRefusesRunsItCouldNotReadBack) {
 
 TEST(RunFile, WriteThenReadFileGivesSameRunAndLeavesNoTempFile) {
   namespace fs = std::filesystem;
-  const fs::path dir = temp_path("dir");
+  const fs::path dir = unique_temp_path("dir");
   const RemoveOnExit cleanup{dir};
   ASSERT_TRUE(fs::create_directories(dir));
   const std::string path = (dir / "run.csv").string();
@@ -346,7 +339,7 @@ TEST(RunFile, ReadRunFileErrorsNameThePath) {
   EXPECT_TRUE(contains(missing.error().message, "/nonexistent-dir/x.csv"));
 
   namespace fs = std::filesystem;
-  const fs::path path = temp_path("bad.csv");
+  const fs::path path = unique_temp_path("bad.csv");
   const RemoveOnExit cleanup{path};
   std::ofstream(path) << "# Ts=0.005\nt_s,y_mm,u_V\n0,0,0\n0.005,x,0\n";
   const auto bad = read_run_file(path.string());

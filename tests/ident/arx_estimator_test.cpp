@@ -10,14 +10,9 @@
 namespace epa::ident {
 namespace {
 
-constexpr double kNoiseFreeTol = 1e-6;  // the check for noise-free data
-constexpr double kExactTol = 1e-9;      // hand-derived examples: only rounding error
-
-double max_abs_diff(const core::Polynomial& a, const core::Polynomial& b) {
-  double m = 0.0;
-  for (std::size_t i = 0; i < std::max(a.size(), b.size()); ++i) m = std::max(m, std::abs(a[i] - b[i]));
-  return m;
-}
+using testdata::kNoiseFreeTol;
+using testdata::kExactTol;
+using testdata::max_abs_diff;
 
 TEST(ArxEstimator, FirstOrderHandExample) {
   // y(k) = 0.5 y(k-1) + 2 u(k-1): A = 1 - 0.5q, B = 2q, so a_1 = -0.5, b_1 = 2.

@@ -10,7 +10,7 @@
 namespace epa::ident {
 namespace {
 
-constexpr double kExactTol = 1e-9;
+using testdata::kExactTol;
 
 // y(k) = 0.5 y(k-1) + u(k-1)
 const ArxModel kFirstOrder{.orders = {.na = 1, .nb = 1, .nk = 1}, .a = {-0.5}, .b = {1.0}};

@@ -9,10 +9,12 @@
 #include "core/paper_reference.hpp"
 #include "plant/plant_adapter.hpp"
 
+#include "ident_test_data.hpp"
+
 namespace epa::ident {
 namespace {
 
-const core::DeadZone kPaperDz = core::paper::model().dead_zone;
+using testdata::kPaperDz;
 
 ExcitationResult paper_run(std::uint64_t seed, double duration_s, double noise_mm, ExcitationOptions o = {}) {
   o.seed = seed;

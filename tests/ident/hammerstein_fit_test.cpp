@@ -11,13 +11,15 @@
 namespace epa::ident {
 namespace {
 
+using testdata::kNoiseFreeTol;
+using testdata::kEq9;
+using testdata::max_abs_diff;
+
 // The checks on data from the paper's plant with 0.1 mm sensor noise.
 constexpr double kBreakPointTolV = 0.02;
 constexpr double kSlopeRatioRelTol = 0.02;
 constexpr double kValidationFitMinPct = 95.0;
-constexpr double kNoiseFreeTol = 1e-6;  // ARX coefficients from noise-free data
 
-const ArxOrders kEq9{.na = 3, .nb = 3, .nk = 1};
 const double kPaperRatio = core::paper::model().dead_zone.m_r / core::paper::model().dead_zone.m_l;
 
 // Small budgets keep the tests fast; the polish does the fine work.
@@ -28,12 +30,6 @@ HammersteinFitOptions small_budget(ArxOrders orders = kEq9) {
   o.generations = 25;
   o.polish_evaluations = 400;
   return o;
-}
-
-double max_abs_diff(const core::Polynomial& a, const core::Polynomial& b) {
-  double m = 0.0;
-  for (std::size_t i = 0; i < std::max(a.size(), b.size()); ++i) m = std::max(m, std::abs(a[i] - b[i]));
-  return m;
 }
 
 // One 40 s noisy run for estimation, another for validation; built once for the whole suite.

@@ -11,12 +11,12 @@
 namespace epa::ident {
 namespace {
 
+using testdata::kPaperDz;
+
 // The paper's plant with 0.1 mm sensor noise: the refinement must keep what the one-step fit had.
 constexpr double kBreakPointTolV = 0.001;
 constexpr double kSlopeRatioRelTol = 0.005;
 constexpr double kValidationFitMinPct = 99.0;
-
-const core::DeadZone kPaperDz = core::paper::model().dead_zone;
 
 IdentificationOptions small_budget(FitCriterion criterion = FitCriterion::kSimulation) {
   IdentificationOptions o;

@@ -1,14 +1,28 @@
 #pragma once
 // Data with a known generating model for the identification tests.
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "core/paper_reference.hpp"
 #include "core/polynomial.hpp"
 #include "core/random.hpp"
+#include "ident/arx_estimator.hpp"
 #include "ident/excitation.hpp"
 #include "ident/ident_data.hpp"
 
 namespace epa::ident::testdata {
+
+inline constexpr double kNoiseFreeTol = 1e-6;  // ARX coefficients from noise-free data (the check)
+inline constexpr double kExactTol = 1e-9;      // hand-derived examples: only rounding error
+inline const ArxOrders kEq9{.na = 3, .nb = 3, .nk = 1};  // the paper's orders
+inline const core::DeadZone kPaperDz = core::paper::model().dead_zone;
+
+inline double max_abs_diff(const core::Polynomial& a, const core::Polynomial& b) {
+  double m = 0.0;
+  for (std::size_t i = 0; i < std::max(a.size(), b.size()); ++i) m = std::max(m, std::abs(a[i] - b[i]));
+  return m;
+}
 
 // y(k) from A y = B u exactly (no noise, no end stops), y = 0 before the first input; u is a
 // seeded random multi-level signal held for a few samples, so every order is excited.

@@ -11,9 +11,10 @@
 namespace epa::ident {
 namespace {
 
-const ArxOrders kEq9{.na = 3, .nb = 3, .nk = 1};
-const core::DeadZone kPaperDz = core::paper::model().dead_zone;
-constexpr double kNoiseFreeTol = 1e-6;
+using testdata::kNoiseFreeTol;
+using testdata::kEq9;
+using testdata::kPaperDz;
+using testdata::max_abs_diff;
 
 ArxModel paper_arx() {
   const auto m = core::paper::model();
@@ -30,12 +31,6 @@ ArxModel perturbed_arx() {
   a.a[0] *= 1.02, a.a[1] *= 0.97;
   for (double& b : a.b) b *= 1.05;
   return a;
-}
-
-double max_abs_diff(const core::Polynomial& a, const core::Polynomial& b) {
-  double m = 0.0;
-  for (std::size_t i = 0; i < std::max(a.size(), b.size()); ++i) m = std::max(m, std::abs(a[i] - b[i]));
-  return m;
 }
 
 const std::vector<Segment>& noise_free() {

@@ -10,7 +10,8 @@
 namespace epa::ident {
 namespace {
 
-const core::DeadZone kPaperDz = core::paper::model().dead_zone;
+using testdata::kPaperDz;
+
 constexpr double kBandWidthMaxV = 0.15;  // the readings sit close around a static break point
 
 TEST(RampReading, TheBandOfAHammersteinPlantHoldsItsBreakPoints) {

@@ -20,15 +20,16 @@
 #include "plant/plant_adapter.hpp"
 #include "runtime/recorder.hpp"
 #include "runtime/scan_cycle.hpp"
+#include "paper_loop.hpp"
 
 namespace epa::runtime {
 namespace {
 
-constexpr std::int64_t kPeriodNs = 5'000'000;
-constexpr double kTs = 0.005;
-constexpr double kSafeV = 0.0;
+using testing::kPeriodNs;
+using testing::kSafeV;
+using testing::paper_tuning;
 
-Tuning paper_tuning() { return *make_tuning(control::paper_controller_config(control::ControllerKind::kPpFfidz)); }
+constexpr double kTs = 0.005;
 
 // Remembers the largest |command| the loop wrote, in front of any DAQ.
 class Tracking final : public hal::Daq {

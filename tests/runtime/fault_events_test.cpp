@@ -13,11 +13,14 @@
 #include "control/paper_controller.hpp"
 #include "fake_daq.hpp"
 #include "runtime/scan_cycle.hpp"
+#include "paper_loop.hpp"
 
 namespace epa::runtime {
 namespace {
 
-constexpr std::int64_t kPeriodNs = 5'000'000;
+using testing::kPeriodNs;
+using testing::paper_tuning;
+
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 class FaultEvents : public ::testing::Test {
@@ -29,8 +32,7 @@ class FaultEvents : public ::testing::Test {
     c.soft_min_mm = c.setpoint_min_mm = 50.0;
     c.soft_max_mm = c.setpoint_max_mm = 450.0;
     daq_.sensor_v = 2.0;  // 100 mm at 50 mm/V
-    loop_ = std::make_unique<ScanCycle>(c, *make_tuning(control::paper_controller_config(control::ControllerKind::kPpFfidz)),
-                                        daq_, clock_, ch_);
+    loop_ = std::make_unique<ScanCycle>(c, paper_tuning(), daq_, clock_, ch_);
     cycles(5);
   }
   void cycles(int n) {
@@ -154,7 +156,7 @@ TEST_F(FaultEvents, AFaultLatchedBeforeTheStartIsAnEventWithNothingReadYet) {
   RuntimeConfig c;
   c.start_fault = FaultCode::kStoreDamaged;
   c.start_setpoint_mm = 120.0;
-  ScanCycle loop(c, *make_tuning(control::paper_controller_config(control::ControllerKind::kPpFfidz)), daq_, clock_, ch_);
+  ScanCycle loop(c, paper_tuning(), daq_, clock_, ch_);
   const auto events = drain();
   ASSERT_EQ(events.size(), 1u);
   EXPECT_EQ(events[0].code, FaultCode::kStoreDamaged);

@@ -8,12 +8,14 @@
 #include "control/paper_controller.hpp"
 #include "fake_daq.hpp"
 #include "runtime/scan_cycle.hpp"
+#include "paper_loop.hpp"
 
 namespace epa::runtime {
 namespace {
 
-constexpr std::int64_t kPeriodNs = 5'000'000;
-constexpr double kSafeV = 0.0;
+using testing::kPeriodNs;
+using testing::kSafeV;
+using testing::paper_tuning;
 
 class Faults : public ::testing::Test {
  protected:
@@ -23,8 +25,7 @@ class Faults : public ::testing::Test {
     c.start_setpoint_mm = c.start_setpoint_mm == 0.0 ? 300.0 : c.start_setpoint_mm;
     config_ = c;
     daq_.sensor_v = 2.0;  // 100 mm
-    loop_ = std::make_unique<ScanCycle>(c, *make_tuning(control::paper_controller_config(control::ControllerKind::kPpFfidz)),
-                                        daq_, clock_, ch_);
+    loop_ = std::make_unique<ScanCycle>(c, paper_tuning(), daq_, clock_, ch_);
     cycles(3);
     ASSERT_EQ(snap().mode, Mode::kRun);
     if (expect_moving) { ASSERT_NE(daq_.last_written_v, kSafeV); }  // moving: the valve is open
@@ -113,7 +114,7 @@ TEST_F(Faults, RepeatedOverruns) {
     }
     void close() noexcept override {}
   } stopper(daq_, stop);
-  ScanCycle loop(c, *make_tuning(control::paper_controller_config(control::ControllerKind::kPpFfidz)), stopper, clock_, ch_);
+  ScanCycle loop(c, paper_tuning(), stopper, clock_, ch_);
   loop.run(stop);
   EXPECT_EQ(loop.last_snapshot().mode, Mode::kFault);
   EXPECT_EQ(loop.last_snapshot().fault, FaultCode::kOverruns);

@@ -12,12 +12,14 @@
 #include "hal/sim_daq.hpp"
 #include "runtime/axis_words.hpp"
 #include "runtime/scan_cycle.hpp"
+#include "paper_loop.hpp"
 
 namespace epa::runtime {
 namespace {
 
+using testing::kPeriodNs;
+
 using control::ControllerKind;
-constexpr std::int64_t kPeriodNs = 5'000'000;
 constexpr int kCyclesPerSecond = 200;
 
 struct Axis {

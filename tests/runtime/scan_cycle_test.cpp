@@ -14,14 +14,15 @@
 #include "plant/plant_adapter.hpp"
 #include "runtime/recorder.hpp"
 #include "sim/closed_loop.hpp"
+#include "paper_loop.hpp"
 
 namespace epa::runtime {
 namespace {
 
-using control::ControllerKind;
-constexpr std::int64_t kPeriodNs = 5'000'000;
+using testing::kPeriodNs;
+using testing::paper_tuning;
 
-Tuning paper_tuning() { return *make_tuning(control::paper_controller_config(ControllerKind::kPpFfidz)); }
+using control::ControllerKind;
 
 // Runs `n` cycles at virtual times k * Ts.
 void run_cycles(ScanCycle& loop, VirtualClock& clock, int n) {
@@ -101,7 +102,6 @@ struct Rig {
   void cycles(int n) { run_cycles(*loop, clock, n); }
   const Snapshot& snap() const { return loop->last_snapshot(); }
 };
-
 
 TEST(ScanCycle, StopHoldsTheValveSafeAndRunMovesIt) {
   Rig rig;

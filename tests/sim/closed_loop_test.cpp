@@ -8,17 +8,19 @@
 
 #include "control/paper_controller.hpp"
 #include "core/paper_reference.hpp"
+#include "paper_steps.hpp"
 
 namespace epa::sim {
 namespace {
 
 using control::ControllerKind;
 
-constexpr double kSteps[] = {25, 50, 100, 200};
+using testing::kPaperStepsMm;
+using testing::sign_changes_in_last_10s;
 constexpr double kFfidzEssMm = 1.1;    // "FF-IDZ steady-state error within about 1 mm"
 constexpr double kReachedMm = 2.0;     // "reaches the target": final value within 2 mm
 
-StepRun run(ControllerKind kind, double step_mm, double noise_mm = 0.0, double lc_mm = 5.0) {
+StepRun paper_step(ControllerKind kind, double step_mm, double noise_mm = 0.0, double lc_mm = 5.0) {
   auto config = control::paper_controller_config(kind);
   config.lc_v = lc_mm / 50.0;
   auto params = control::ControllerParams::make(config);
@@ -29,11 +31,9 @@ StepRun run(ControllerKind kind, double step_mm, double noise_mm = 0.0, double l
   return *r;
 }
 
-std::size_t sign_changes_in_last_10s(const StepRun& r) { return valve_sign_changes_in_last(r, 10.0); }
-
 TEST(PaperClosedLoop, PlainPpStallsInsideTheDeadZoneAndNeverReachesNinetyPercent) {
-  for (double step : kSteps) {
-    const auto r = run(ControllerKind::kPp, step);
+  for (double step : kPaperStepsMm) {
+    const auto r = paper_step(ControllerKind::kPp, step);
     const double peak = *std::max_element(r.run.y_mm.begin(), r.run.y_mm.end());
     EXPECT_LT(peak, 0.9 * step) << step << " mm";
     const double last_valve = r.run.u_V.back();  // stalled: the command rests inside the band
@@ -44,7 +44,7 @@ TEST(PaperClosedLoop, PlainPpStallsInsideTheDeadZoneAndNeverReachesNinetyPercent
 }
 
 TEST(PaperClosedLoop, PlainPpNeverLeavesRestOnTheSmallestStep) {
-  const auto r = run(ControllerKind::kPp, 25);  // u -> 1.625 e = 0.81 V < b_r: never moves
+  const auto r = paper_step(ControllerKind::kPp, 25);  // u -> 1.625 e = 0.81 V < b_r: never moves
   EXPECT_FALSE(r.metrics.moved);
   EXPECT_FALSE(r.metrics.rise_s.has_value());
   EXPECT_NEAR(r.metrics.ess_mm, 25.0, 1e-9);
@@ -52,8 +52,8 @@ TEST(PaperClosedLoop, PlainPpNeverLeavesRestOnTheSmallestStep) {
 
 TEST(PaperClosedLoop, BothCompensatedControllersReachTheTarget) {
   for (ControllerKind kind : {ControllerKind::kPpNgidz, ControllerKind::kPpFfidz}) {
-    for (double step : kSteps) {
-      const auto r = run(kind, step);
+    for (double step : kPaperStepsMm) {
+      const auto r = paper_step(kind, step);
       EXPECT_NEAR(r.metrics.final_mm, step, kReachedMm) << control::to_string(kind) << " " << step << " mm";
       EXPECT_TRUE(r.metrics.rise_s.has_value());
       EXPECT_TRUE(r.metrics.settling_s.has_value());
@@ -62,36 +62,36 @@ TEST(PaperClosedLoop, BothCompensatedControllersReachTheTarget) {
 }
 
 TEST(PaperClosedLoop, FfidzRisesFasterThanNgidzAtEveryStepSize) {
-  for (double step : kSteps) {
-    const auto ng = run(ControllerKind::kPpNgidz, step);
-    const auto ff = run(ControllerKind::kPpFfidz, step);
+  for (double step : kPaperStepsMm) {
+    const auto ng = paper_step(ControllerKind::kPpNgidz, step);
+    const auto ff = paper_step(ControllerKind::kPpFfidz, step);
     ASSERT_TRUE(ng.metrics.rise_s && ff.metrics.rise_s);
     EXPECT_LT(*ff.metrics.rise_s, *ng.metrics.rise_s) << step << " mm";
   }
 }
 
 TEST(PaperClosedLoop, FfidzSteadyStateErrorIsWithinAboutOneMillimetre) {
-  for (double step : kSteps) EXPECT_LE(run(ControllerKind::kPpFfidz, step).metrics.ess_mm, kFfidzEssMm) << step << " mm";
+  for (double step : kPaperStepsMm) EXPECT_LE(paper_step(ControllerKind::kPpFfidz, step).metrics.ess_mm, kFfidzEssMm) << step << " mm";
 }
 
 TEST(PaperClosedLoop, WithSensorNoiseNgidzChattersAndFfidzDoesNot) {
-  for (double step : kSteps) {
-    const auto ng = run(ControllerKind::kPpNgidz, step, /*noise_mm=*/0.1);
-    const auto ff = run(ControllerKind::kPpFfidz, step, /*noise_mm=*/0.1, /*lc_mm=*/5.0);
+  for (double step : kPaperStepsMm) {
+    const auto ng = paper_step(ControllerKind::kPpNgidz, step, /*noise_mm=*/0.1);
+    const auto ff = paper_step(ControllerKind::kPpFfidz, step, /*noise_mm=*/0.1, /*lc_mm=*/5.0);
     EXPECT_GE(sign_changes_in_last_10s(ng), 200u) << step << " mm";  // one every ~50 ms or faster
     EXPECT_LE(sign_changes_in_last_10s(ff), 2u) << step << " mm";
   }
 }
 
 TEST(PaperClosedLoop, SeededRunsAreReproducible) {
-  const auto a = run(ControllerKind::kPpFfidz, 50, 0.1);
-  const auto b = run(ControllerKind::kPpFfidz, 50, 0.1);
+  const auto a = paper_step(ControllerKind::kPpFfidz, 50, 0.1);
+  const auto b = paper_step(ControllerKind::kPpFfidz, 50, 0.1);
   EXPECT_EQ(a.run.y_mm, b.run.y_mm);
   EXPECT_EQ(a.run.u_V, b.run.u_V);
 }
 
 TEST(PaperClosedLoop, RunRecordsTimingAndMetadata) {
-  const auto r = run(ControllerKind::kPpNgidz, 50);
+  const auto r = paper_step(ControllerKind::kPpNgidz, 50);
   ASSERT_EQ(r.run.size(), 4000u);  // 20 s at 5 ms
   EXPECT_DOUBLE_EQ(r.run.t_s[1], 0.005);
   EXPECT_EQ(r.run.meta("controller"), "pp-ngidz");

@@ -12,13 +12,15 @@
 #include "plant/plant_adapter.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/model_perturbation.hpp"
+#include "paper_steps.hpp"
 
 namespace epa::sim {
 namespace {
 
 using control::ControllerKind;
 
-constexpr double kSteps[] = {25, 50, 100, 200};
+using testing::kPaperStepsMm;
+using testing::sign_changes_in_last_10s;
 
 control::ControllerParams params_of(ControllerKind kind) {
   auto p = control::ControllerParams::make(control::paper_controller_config(kind));
@@ -26,7 +28,7 @@ control::ControllerParams params_of(ControllerKind kind) {
   return *p;
 }
 
-StepRun run(ControllerKind kind, double step_mm, const ModelPerturbation& plant = {}, const ValveLineOptions& line = {},
+StepRun step_on(ControllerKind kind, double step_mm, const ModelPerturbation& plant = {}, const ValveLineOptions& line = {},
             double noise_mm = 0.0) {
   auto simulator = plant::make_hammerstein_simulator(perturbed(core::paper::model(), plant), {.noise_std_mm = noise_mm, .seed = 7});
   EXPECT_TRUE(simulator.has_value());
@@ -36,13 +38,11 @@ StepRun run(ControllerKind kind, double step_mm, const ModelPerturbation& plant 
   return *r;
 }
 
-std::size_t sign_changes_in_last_10s(const StepRun& r) { return valve_sign_changes_in_last(r, 10.0); }
-
 TEST(PpTraj, BeatsFfIdzOnThePrintedModelOnEveryCriterionOfIssue17) {
-  for (double step : kSteps) {
+  for (double step : kPaperStepsMm) {
     SCOPED_TRACE("step " + std::to_string(step) + " mm");
-    const StepRun ff = run(ControllerKind::kPpFfidz, step);
-    const StepRun traj = run(ControllerKind::kPpTraj, step);
+    const StepRun ff = step_on(ControllerKind::kPpFfidz, step);
+    const StepRun traj = step_on(ControllerKind::kPpTraj, step);
     const auto& m = traj.metrics;
     ASSERT_TRUE(m.rise_s && m.settling_s && m.overshoot_pct && ff.metrics.rise_s && ff.metrics.settling_s);
     EXPECT_LE(*m.overshoot_pct, 0.5);
@@ -56,8 +56,8 @@ TEST(PpTraj, BeatsFfIdzOnThePrintedModelOnEveryCriterionOfIssue17) {
 }
 
 TEST(PpTraj, WithSensorNoiseItStaysWithinTheNoiseAndHoldsTheValve) {
-  for (double step : kSteps) {
-    const StepRun traj = run(ControllerKind::kPpTraj, step, {}, {}, 0.1);
+  for (double step : kPaperStepsMm) {
+    const StepRun traj = step_on(ControllerKind::kPpTraj, step, {}, {}, 0.1);
     EXPECT_LE(traj.metrics.ess_mm, 0.2) << step;
     EXPECT_LE(sign_changes_in_last_10s(traj), 2u) << step;
   }
@@ -81,9 +81,9 @@ const RobustnessCase kRobustnessCases[] = {{"gain x0.8", {.gain_factor = 0.8}, {
 // next test, for every case but the 20 ms valve lag, whose short moves still exceed it (README).
 TEST(PpTraj, OnPlantsItsModelGetsWrongItHoldsTheTargetWithoutChatterAndSettlesInTime) {
   for (const auto& c : kRobustnessCases) {
-    for (double step : kSteps) {
+    for (double step : kPaperStepsMm) {
       SCOPED_TRACE(std::string(c.name) + ", step " + std::to_string(step) + " mm");
-      const StepRun traj = run(ControllerKind::kPpTraj, step, c.plant, c.line);
+      const StepRun traj = step_on(ControllerKind::kPpTraj, step, c.plant, c.line);
       EXPECT_NEAR(traj.metrics.final_mm, step, 0.15);
       EXPECT_LE(traj.metrics.ess_mm, 0.15);
       EXPECT_LE(sign_changes_in_last_10s(traj), 2u);
@@ -99,9 +99,9 @@ TEST(PpTraj, OnPlantsItsModelGetsWrongItHoldsTheTargetWithoutChatterAndSettlesIn
 // step of its drive with a spike (gain x1.2 at 25 mm: 30.6 %, dead band 0.1 V narrower: 40.2 %).
 TEST(PpTraj, OnPlantsItsModelGetsWrongShortAndLongMovesOvershootAtMost30Percent) {
   for (const auto& c : kRobustnessCases) {
-    for (double step : kSteps) {
+    for (double step : kPaperStepsMm) {
       SCOPED_TRACE(std::string(c.name) + ", step " + std::to_string(step) + " mm");
-      const StepRun traj = run(ControllerKind::kPpTraj, step, c.plant, c.line);
+      const StepRun traj = step_on(ControllerKind::kPpTraj, step, c.plant, c.line);
       ASSERT_TRUE(traj.metrics.overshoot_pct.has_value());
       EXPECT_LE(*traj.metrics.overshoot_pct, 30.0);
     }
