@@ -19,6 +19,7 @@
 #include "plant/plant_adapter.hpp"
 #include "plant/pneumatic_params.hpp"
 #include "plant/pneumatic_plant.hpp"
+#include "../support/sanitizer_run.hpp"
 
 namespace epa::ident {
 namespace {
@@ -122,13 +123,17 @@ void check_plant(const plant::PneumaticParams& params) {
 
 TEST(PhysicsIdentification, DefaultPlant) { check_plant({}); }
 
+// The two other plants take the default plant's paths with other numbers (67 s each under ASan):
+// under the sanitizers (tests/support/sanitizer_run.hpp) the default plant alone.
 TEST(PhysicsIdentification, LowerSupplyPressure) {
+  if (epa::test::sanitizer_run()) GTEST_SKIP() << "the sanitizer run identifies the default plant only";
   plant::PneumaticParams p;
   p.supply_pressure_bar = 4.8;
   check_plant(p);
 }
 
 TEST(PhysicsIdentification, WiderSpoolOverlap) {
+  if (epa::test::sanitizer_run()) GTEST_SKIP() << "the sanitizer run identifies the default plant only";
   plant::PneumaticParams p;
   p.overlap_pos_v = 1.4;
   p.overlap_neg_v = -1.9;

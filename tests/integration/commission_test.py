@@ -17,6 +17,11 @@ Checks, each printed with its figures:
     experiment); the previous set runs again and is still the stored active set, a switch to the
     new set and back is in the audit trail, and the valve command never left its +-5 V limits;
   * a wrong spec is refused before anything moves (HTTP 400, exit 1).
+Under the sanitizers (EPA_SANITIZER_RUN=1, set by the asan test preset) only the wrong spec and the
+deployment run, with their checks: that run reaches every part of the appliance the others do
+(excitation, identification, design, simulation, the switch to the new set and the store), and the
+sanitizers judge memory and undefined behaviour, not figures; the HMI moves and the roll-back are
+behaviour, judged by the release run (they took about 250 of 430 s under ASan).
 Exit 1 on any failure. A run that failed while the machine itself stalled
 (tests/support/stall_monitor.py) is run once more; failing again on a machine as stalled, it has
 no verdict: exit 77, which ctest reports as skipped.
@@ -35,6 +40,7 @@ from epa_appliance import Appliance, free_port, stop_process  # noqa: E402
 from stall_monitor import SKIP_RETURN_CODE, StallMonitor  # noqa: E402
 
 TOKEN = "commissioning-test-token-0123"
+SANITIZER_RUN = os.environ.get("EPA_SANITIZER_RUN") == "1"
 FAILURES = []
 
 
@@ -161,8 +167,9 @@ def run_once(epa, src):
                 "overshoot_pct": 0, "moves_mm": [150, 350, 250, 225, 275], "move_hold_s": 6,
                 "limits": {"ess_mm": 1, "overshoot_pct": 5, "overshoot_mm": 0, "settling_s": 0}}
         before = http(app, "GET", "/api/status")[1]["store"]["tuning_set"]
-        paper_moves = hmi_moves(app)  # the paper's tuning, which the appliance starts with
-        print(f"      before commissioning ({before}): {summary(paper_moves)}")
+        if not SANITIZER_RUN:
+            paper_moves = hmi_moves(app)  # the paper's tuning, which the appliance starts with
+            print(f"      before commissioning ({before}): {summary(paper_moves)}")
 
         # A wrong spec: refused before anything moves.
         r, outcome, _, _ = commission(epa, app, dict(base, limits={"ess_mm": -1}), folder, "wrong")
@@ -185,6 +192,9 @@ def run_once(epa, src):
         listing = subprocess.run([epa, "tuning", "--db", app.db, "list"], capture_output=True, text=True).stdout
         active = [line for line in listing.splitlines() if line.startswith("*")]
         check(any("rig-1" in line for line in active), f"the new set is the stored active set: {active or listing}")
+        if SANITIZER_RUN:
+            print("      under the sanitizers: the HMI moves and the roll-back are left to the release run")
+            return
         if outcome and outcome["verdict"] == "deployed":
             # What the verification promised, held by the moves an HMI commands afterwards.
             deployed_moves = hmi_moves(app)
