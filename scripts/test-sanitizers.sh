@@ -13,7 +13,8 @@
 #    and the integration tests (write gate, faults, records, commissioning) call them over HTTP;
 #  - figures from more of the same paths (EPA_SANITIZER_RUN=1 in the preset; its tests say which,
 #    tests/support/sanitizer_run.hpp): the self-check's three seeds (one here), the two other
-#    physics plants' identification, the commissioning test's HMI moves and its roll-back.
+#    physics plants' identification, the commissioning test's HMI moves after the deployment
+#    and its roll-back.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh test

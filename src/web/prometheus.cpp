@@ -85,19 +85,19 @@ std::string prometheus_text(const runtime::Snapshot& s, const ModbusStats& modbu
   server.clients = modbus.clients;
   const points::PointContext ctx{s, server};
   Writer w(ctx);
-  using P = points::PointId;
+  using Id = points::PointId;  // not P: json_api.cpp has that at file scope, and a unity batch holds both
   w.metric("epa_build_info", "gauge", "The running epa's version (project VERSION in CMakeLists.txt), in the label; always 1.", 1.0,
            "{version=\"" + std::string(core::kVersion) + "\"}");
-  for (const P id : {P::kPosition, P::kSetpoint, P::kError, P::kValve, P::kSensor, P::kMode, P::kFaultCode, P::kController,
-                     P::kUptime, P::kLoopJitterP99, P::kLoopWakeP50, P::kLoopWakeP99, P::kLoopWakeMax, P::kLoopComputeP99})
+  for (const Id id : {Id::kPosition, Id::kSetpoint, Id::kError, Id::kValve, Id::kSensor, Id::kMode, Id::kFaultCode, Id::kController,
+                      Id::kUptime, Id::kLoopJitterP99, Id::kLoopWakeP50, Id::kLoopWakeP99, Id::kLoopWakeMax, Id::kLoopComputeP99})
     w.point(id);
   w.metric("epa_loop_jitter_max_seconds", "gauge", "scan period jitter, maximum.", s.loop.jitter_max_us * 1e-6);
-  for (const P id : {P::kCycles, P::kLoopOverruns, P::kFaults, P::kIoErrors, P::kMoves, P::kCommandsApplied, P::kCommandsRejected,
-                     P::kModbusRequests})
+  for (const Id id : {Id::kCycles, Id::kLoopOverruns, Id::kFaults, Id::kIoErrors, Id::kMoves, Id::kCommandsApplied, Id::kCommandsRejected,
+                      Id::kModbusRequests})
     w.point(id, "counter");
   w.metric("epa_modbus_exceptions_total", "counter", "Modbus requests answered with an exception since start.",
            static_cast<double>(modbus.exceptions));
-  w.point(P::kModbusClients);
+  w.point(Id::kModbusClients);
   w.metric("epa_web_requests_total", "counter", "HTTP requests served since start.", static_cast<double>(web_requests));
   return w.take();
 }
