@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+
 #include "../support/text_contains.hpp"
 
 namespace epa::core {

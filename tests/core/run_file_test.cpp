@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
 #include "../support/temp_path.hpp"
 #include "../support/text_contains.hpp"
 
