@@ -7,10 +7,13 @@
 #include "control/paper_controller.hpp"
 #include "core/paper_reference.hpp"
 #include "hal/sim_daq.hpp"
+#include "paper_loop.hpp"
 #include "runtime/scan_cycle.hpp"
 
 namespace epa::runtime {
 namespace {
+
+using testing::paper_tuning;
 
 TEST(RuntimeAllocation, TenThousandScanCyclesAllocateNothing) {
   auto daq = *hal::SimDaq::make(core::paper::model(), {.noise_std_mm = 0.1});
@@ -21,7 +24,7 @@ TEST(RuntimeAllocation, TenThousandScanCyclesAllocateNothing) {
   config.start_setpoint_mm = 50.0;
   config.move_window_s = 2.0;
   LoopChannels ch(20000);
-  ScanCycle loop(config, *make_tuning(control::paper_controller_config(control::ControllerKind::kPpFfidz)), daq, clock, ch);
+  ScanCycle loop(config, paper_tuning(), daq, clock, ch);
   const Command setpoints[] = {setpoint_command(120.0),
                                controller_command(control::ControllerKind::kPpNgidz),
                                setpoint_command(60.0)};
@@ -63,7 +66,7 @@ TEST(RuntimeAllocation, AnExcitationExperimentAllocatesNothing) {
   } daq(sim);
   VirtualClock clock;
   LoopChannels ch(record_capacity_samples(config));
-  ScanCycle loop(config, *make_tuning(control::paper_controller_config(control::ControllerKind::kPpFfidz)), daq, clock, ch);
+  ScanCycle loop(config, paper_tuning(), daq, clock, ch);
   ExcitationSettings next = config.excitation;
   next.seed = 9;
   next.duration_s = 5.0;
