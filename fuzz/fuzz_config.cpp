@@ -4,10 +4,10 @@
 #include <cstdint>
 #include <string>
 
-#include "app/appliance_config.hpp"
+#include "config/appliance_config.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
-  (void)epa::app::parse_appliance_config(text, EPA_SOURCE_DIR "/config/fuzz.toml");
+  (void)epa::config::parse_appliance_config(text, EPA_SOURCE_DIR "/config/fuzz.toml");
   return 0;
 }

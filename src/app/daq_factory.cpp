@@ -25,36 +25,36 @@ core::Result<std::unique_ptr<plant::PlantSimulator>> make_physics_plant(const st
   return plant::make_pneumatic_simulator(params, options);
 }
 
-core::Result<std::unique_ptr<hal::Daq>> make_daq(const ApplianceConfig& config, const core::HammersteinModel& model) {
-  switch (config.backend) {
-    case HalBackend::kSim: {
-      if (config.sim_plant == "physics") {
+core::Result<std::unique_ptr<hal::Daq>> make_daq(const config::ApplianceConfig& appliance, const core::HammersteinModel& model) {
+  switch (appliance.backend) {
+    case config::HalBackend::kSim: {
+      if (appliance.sim_plant == "physics") {
         // Stepped once per scan cycle, so its sample period is the loop's.
-        auto plant = make_physics_plant(config.physics_config,
-                                        {.initial_position_mm = config.sim.initial_position_mm,
-                                         .initial_pressure_bar = config.sim_initial_pressure_bar,
-                                         .noise_std_mm = config.sim.noise_std_mm, .seed = config.sim.seed,
-                                         .sensor_bits = config.sim_sensor_bits, .Ts = config.runtime.period_s});
+        auto plant = make_physics_plant(appliance.physics_config,
+                                        {.initial_position_mm = appliance.sim.initial_position_mm,
+                                         .initial_pressure_bar = appliance.sim_initial_pressure_bar,
+                                         .noise_std_mm = appliance.sim.noise_std_mm, .seed = appliance.sim.seed,
+                                         .sensor_bits = appliance.sim_sensor_bits, .Ts = appliance.runtime.period_s});
         if (!plant) return core::invalid_argument("[hal.sim] " + plant.error().message);
         auto daq = hal::SimDaq::make(std::move(*plant));
         if (!daq) return core::invalid_argument("[hal.sim] " + daq.error().message);
         return std::unique_ptr<hal::Daq>(std::make_unique<hal::SimDaq>(std::move(*daq)));
       }
-      if (!config.sim_effects.empty()) {  // the model with effects hidden in it (test data for epa diagnose)
-        auto effects = plant::parse_effect_specs(config.sim_effects);
+      if (!appliance.sim_effects.empty()) {  // the model with effects hidden in it (test data for epa diagnose)
+        auto effects = plant::parse_effect_specs(appliance.sim_effects);
         if (!effects) return core::invalid_argument("[hal.sim] effects: " + effects.error().message);
-        auto plant = plant::make_augmented_simulator(model, *effects, config.sim);
+        auto plant = plant::make_augmented_simulator(model, *effects, appliance.sim);
         if (!plant) return core::invalid_argument("[hal.sim] " + plant.error().message);
         auto daq = hal::SimDaq::make(std::move(*plant));
         if (!daq) return core::invalid_argument("[hal.sim] " + daq.error().message);
         return std::unique_ptr<hal::Daq>(std::make_unique<hal::SimDaq>(std::move(*daq)));
       }
-      auto daq = hal::SimDaq::make(model, config.sim);
+      auto daq = hal::SimDaq::make(model, appliance.sim);
       if (!daq) return core::invalid_argument("[hal.sim] " + daq.error().message);
       return std::unique_ptr<hal::Daq>(std::make_unique<hal::SimDaq>(std::move(*daq)));
     }
-    case HalBackend::kModbusIo: return std::unique_ptr<hal::Daq>(std::make_unique<hal::ModbusIoDaq>(config.modbus_io));
-    case HalBackend::kComedi: return std::unique_ptr<hal::Daq>(std::make_unique<hal::ComediDaq>(config.comedi));
+    case config::HalBackend::kModbusIo: return std::unique_ptr<hal::Daq>(std::make_unique<hal::ModbusIoDaq>(appliance.modbus_io));
+    case config::HalBackend::kComedi: return std::unique_ptr<hal::Daq>(std::make_unique<hal::ComediDaq>(appliance.comedi));
   }
   return core::invalid_argument("unknown DAQ backend");
 }

@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 
-#include "app/appliance_config.hpp"
+#include "config/appliance_config.hpp"
 #include "core/hammerstein_model.hpp"
 #include "hal/daq.hpp"
 #include "plant/plant_simulator.hpp"
@@ -24,6 +24,6 @@ struct PhysicsPlantOptions {
 // the sim backend and `epa plant-server --plant physics`.
 core::Result<std::unique_ptr<plant::PlantSimulator>> make_physics_plant(const std::string& params_path, const PhysicsPlantOptions& options);
 
-core::Result<std::unique_ptr<hal::Daq>> make_daq(const ApplianceConfig& config, const core::HammersteinModel& model);
+core::Result<std::unique_ptr<hal::Daq>> make_daq(const config::ApplianceConfig& appliance, const core::HammersteinModel& model);
 
 }  // namespace epa::app

@@ -54,11 +54,11 @@ namespace {
 constexpr std::size_t kThreadStackBytes = 512 * 1024;
 
 // Applies the command-line overrides on top of the file, re-validating what they touch.
-core::Status apply_overrides(const ServeOptions& o, ApplianceConfig& c) {
+core::Status apply_overrides(const ServeOptions& o, config::ApplianceConfig& c) {
   if (!o.hal.empty()) {
-    if (o.hal == "sim") c.backend = HalBackend::kSim;
-    else if (o.hal == "modbus-io") c.backend = HalBackend::kModbusIo;
-    else if (o.hal == "comedi") c.backend = HalBackend::kComedi;
+    if (o.hal == "sim") c.backend = config::HalBackend::kSim;
+    else if (o.hal == "modbus-io") c.backend = config::HalBackend::kModbusIo;
+    else if (o.hal == "comedi") c.backend = config::HalBackend::kComedi;
     else return core::invalid_argument("--hal '" + o.hal + "' is not one of sim, modbus-io, comedi");
   }
   if (o.modbus_io_port > 0) c.modbus_io.port = o.modbus_io_port;
@@ -73,7 +73,7 @@ core::Status apply_overrides(const ServeOptions& o, ApplianceConfig& c) {
   if (!o.record_dir.empty()) c.record_directory = o.record_dir;
   if (!o.db_path.empty()) c.store_path = o.db_path;
   if (auto s = runtime::validate(c.runtime); !s) return s;
-  if (c.backend == HalBackend::kModbusIo) return hal::validate(c.modbus_io);
+  if (c.backend == config::HalBackend::kModbusIo) return hal::validate(c.modbus_io);
   return core::ok();
 }
 
@@ -109,7 +109,7 @@ std::set<points::PointId> persisted_points(const std::optional<modbus::RegisterM
 
 // The one set of write limits: the catalog's, narrowed by the configuration and the register map;
 // the start-up setpoint (configuration or --setpoint) must lie within them too.
-core::Result<points::WriteLimits> write_limits(const ApplianceConfig& c, const std::string& config_path,
+core::Result<points::WriteLimits> write_limits(const config::ApplianceConfig& c, const std::string& config_path,
                                                const std::optional<modbus::RegisterMap>& map) {
   auto limits = points::WriteLimits::from_config(c.runtime, config_path);
   if (!limits) return limits.error();
@@ -120,7 +120,7 @@ core::Result<points::WriteLimits> write_limits(const ApplianceConfig& c, const s
   return limits;
 }
 
-core::Result<ControlSetup> prepare_control(ApplianceConfig& c, const std::optional<modbus::RegisterMap>& map, bool setpoint_given) {
+core::Result<ControlSetup> prepare_control(config::ApplianceConfig& c, const std::optional<modbus::RegisterMap>& map, bool setpoint_given) {
   auto plant_model = load_model(c.model_path);
   if (!plant_model) return plant_model.error();
   // The paper does not print its Ts (NOTES.md), so its model takes the loop's period; an
@@ -153,7 +153,7 @@ core::Result<ControlSetup> prepare_control(ApplianceConfig& c, const std::option
   return ControlSetup{std::move(*plant_model), std::move(*store), base, *tuning};
 }
 
-core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const ApplianceConfig& c, const modbus::RegisterMap& map,
+core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const config::ApplianceConfig& c, const modbus::RegisterMap& map,
                                                                  points::WriteGate& gate, runtime::LoopChannels& channels) {
   auto server = modbus::ModbusServer::start(c.modbus, map, gate, channels, [](const std::string& line) { spdlog::info("{}", line); });
   if (!server) return server.error();
@@ -166,7 +166,7 @@ core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const Appliance
   return server;
 }
 
-core::Result<std::unique_ptr<web::WebServer>> start_web(const ApplianceConfig& c, runtime::LoopChannels& channels,
+core::Result<std::unique_ptr<web::WebServer>> start_web(const config::ApplianceConfig& c, runtime::LoopChannels& channels,
                                                         points::WriteGate& gate, web::RecentAudit& audit, const modbus::ModbusServer* mb,
                                                         const store::StoreWriter& store, web::CommissionPort* commission) {
   auto modbus_stats = [mb] {
@@ -177,9 +177,9 @@ core::Result<std::unique_ptr<web::WebServer>> start_web(const ApplianceConfig& c
     const auto health = store.health();
     return web::StoreStats{true, health.ok, counters.accepted, counters.saved, health.last_error, store.running_set().name};
   };
-  web::WebConfig config = c.web;
-  config.log = [](const std::string& line) { spdlog::warn("{}", line); };
-  auto server = web::WebServer::start(config, channels, &gate, &audit, modbus_stats, store_stats, commission);
+  web::WebConfig web_config = c.web;
+  web_config.log = [](const std::string& line) { spdlog::warn("{}", line); };
+  auto server = web::WebServer::start(web_config, channels, &gate, &audit, modbus_stats, store_stats, commission);
   if (!server) return server.error();
   spdlog::info("web: listening on {}:{} (static files {}, commands {})", c.web.address, (*server)->port(), c.web.static_dir,
                c.web.token.empty() ? "disabled: no token configured" : "enabled with the token");
@@ -226,7 +226,7 @@ void take_fault_events(runtime::LoopChannels& channels, store::StoreWriter& stor
 // events and a periodic status, keeps the fault history, has the gate log and audit the commands
 // the loop refused after acceptance, and pings the systemd watchdog only while the loop advances,
 // so a stuck loop gets the unit restarted.
-void supervise(const ApplianceConfig& c, double duration_s, runtime::LoopChannels& channels, points::WriteGate& gate,
+void supervise(const config::ApplianceConfig& c, double duration_s, runtime::LoopChannels& channels, points::WriteGate& gate,
                store::StoreWriter& store_writer, const sigset_t& signals) {
   std::uint64_t watchdog_usec = 0;
   const bool watchdog = sd_watchdog_enabled(0, &watchdog_usec) > 0;
@@ -285,10 +285,10 @@ struct DaqCloser {
 int run_serve(const ServeOptions& o, std::ostream& err) {
   auto fail = [&err](const core::Error& e) { return err << "epa serve: " << e.message << "\n", 1; };
   hal::set_default_thread_stack(kThreadStackBytes);
-  auto config = read_appliance_config(o.config_path);
-  if (!config) return fail(config.error());
-  if (auto s = apply_overrides(o, *config); !s) return fail(s.error());
-  ApplianceConfig& c = *config;
+  auto loaded = config::read_appliance_config(o.config_path);
+  if (!loaded) return fail(loaded.error());
+  if (auto s = apply_overrides(o, *loaded); !s) return fail(s.error());
+  config::ApplianceConfig& c = *loaded;
   std::optional<modbus::RegisterMap> register_map;
   if (c.modbus_enabled) {
     auto map = modbus::RegisterMap::load(c.register_map_path);

@@ -5,9 +5,14 @@
 // run back on the axis: the verdict taken on the split the Hammerstein model fits best (seed 108,
 // 50 % late: pp-traj deployed without its sliding arrival overshot 8 mm), and a retry band of half
 // the e_ss limit (seed 102, 20 % late: the retries ran into the metrics' window, e_ss 1.65 mm).
-// About 12 s, 90 s under ASan, so four runs, not more.
+// About 12 s, 90 s under ASan, so four runs, not more; under the sanitizers two (on time, and the
+// one that takes both the late commands' retries and the Hammerstein split's verdict), which reach
+// the paths the other two repeat (tests/support/sanitizer_run.hpp).
 #include <gtest/gtest.h>
 
+#include <vector>
+
+#include "../support/sanitizer_run.hpp"
 #include "physics_rig_commissioning.hpp"
 
 namespace epa::commission {
@@ -18,7 +23,9 @@ TEST(CommissioningOnThePhysicsRig, DeploysThroughOnTimeAndLateCommands) {
     std::uint64_t seed;
     double late_probability;
   };
-  for (const Case c : {Case{101, 0.0}, Case{102, 0.0}, Case{102, 0.2}, Case{108, 0.5}}) {
+  const std::vector<Case> cases = epa::test::sanitizer_run() ? std::vector<Case>{{101, 0.0}, {108, 0.5}}
+                                                              : std::vector<Case>{{101, 0.0}, {102, 0.0}, {102, 0.2}, {108, 0.5}};
+  for (const Case c : cases) {
     const auto out = testing::commission_physics_rig(c.seed, c.late_probability);
     const std::string which = "seed " + std::to_string(c.seed) + ", " + std::to_string(static_cast<int>(100 * c.late_probability)) + " % late";
     ASSERT_TRUE(out) << which << ": " << out.error().message;

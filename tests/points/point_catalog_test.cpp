@@ -38,7 +38,7 @@ TEST(PointCatalog, OneEntryPerIdInOrderWithUniqueNames) {
 // the point: the configuration's [startup] setpoint_mm and [controller] lc_mm, epa-tuning/1 and
 // epa-model/1 keys, the run files' `controller` metadata, report labels, the recent-moves list.
 const std::map<std::string, std::string> kFormatFiles = {
-    {"app/appliance_config.cpp", "epa-config/1 keys"},
+    {"config/appliance_config.cpp", "epa-config/1 keys"},
     {"store/tuning_file.cpp", "epa-tuning/1 keys"},
     {"core/dead_zone.cpp", "epa-model/1 dead-zone keys"},
     {"core/model_file.cpp", "epa-model/1 keys"},

@@ -1,4 +1,4 @@
-#include "app/appliance_config.hpp"
+#include "config/appliance_config.hpp"
 
 #include "core/format.hpp"
 #include "core/text_file.hpp"
@@ -12,7 +12,7 @@
 #include <set>
 #include <toml++/toml.h>
 
-namespace epa::app {
+namespace epa::config {
 
 namespace {
 
@@ -387,4 +387,4 @@ core::Result<ApplianceConfig> read_appliance_config(const std::string& path) {
   return c;
 }
 
-}  // namespace epa::app
+}  // namespace epa::config

@@ -17,7 +17,7 @@
 #include "runtime/runtime_config.hpp"
 #include "web/web_server.hpp"
 
-namespace epa::app {
+namespace epa::config {
 
 enum class HalBackend { kSim, kModbusIo, kComedi };
 
@@ -58,4 +58,4 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& toml_tex
 core::Result<ApplianceConfig> read_appliance_config(const std::string& path);
 const char* to_string(HalBackend backend);
 
-}  // namespace epa::app
+}  // namespace epa::config

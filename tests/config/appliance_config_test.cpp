@@ -1,11 +1,11 @@
-#include "app/appliance_config.hpp"
+#include "config/appliance_config.hpp"
 
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <regex>
 
-namespace epa::app {
+namespace epa::config {
 namespace {
 
 const std::string kShipped = std::string(EPA_SOURCE_DIR) + "/config/epa.toml";
@@ -184,4 +184,4 @@ TEST(ApplianceConfig, EveryNumericKeyIsBoundedAndARefusalNamesFileLineAndKey) {
 }
 
 }  // namespace
-}  // namespace epa::app
+}  // namespace epa::config
