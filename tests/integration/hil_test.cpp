@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "../support/temp_path.hpp"
 #include "child_process.hpp"
 #include "core/run_file.hpp"
 #include "core/step_metrics.hpp"
@@ -64,8 +65,8 @@ std::optional<fs::path> first_file_in(const fs::path& dir) {
 }
 
 TEST(HardwareInTheLoop, PlantServerAndServeCompleteAFiftyMillimetreMove) {
-  const fs::path dir = fs::temp_directory_path() / ("epa_hil_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const test::TempDir temp("hil");
+  const fs::path& dir = temp.path;
   fs::create_directories(dir / "runs");
   const int port = testing::free_loopback_port();
   const std::string epa = EPA_BINARY;
@@ -117,7 +118,6 @@ TEST(HardwareInTheLoop, PlantServerAndServeCompleteAFiftyMillimetreMove) {
   EXPECT_NE(log.find("modbus-io"), std::string::npos);
   EXPECT_NE(log.find("SIGTERM"), std::string::npos);
   EXPECT_NE(log.find("stopped"), std::string::npos);
-  fs::remove_all(dir);
 }
 
 }  // namespace

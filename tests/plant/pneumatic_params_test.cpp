@@ -8,6 +8,8 @@
 #include <limits>
 #include <string>
 
+#include "../support/temp_path.hpp"
+
 namespace epa::plant {
 namespace {
 
@@ -62,16 +64,15 @@ TEST(PneumaticParams, TomlRoundTripIsExact) {
 }
 
 TEST(PneumaticParams, FileRoundTripThroughTheWriter) {
-  const auto dir = std::filesystem::temp_directory_path() / ("epa-pneumatic-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const std::string path = (dir / "rig.toml").string();
+  const test::TempDir dir("pneumatic");
+  const std::string path = (dir.path / "rig.toml").string();
   PneumaticParams p;
   p.static_friction_n = 55.5;
   ASSERT_TRUE(write_pneumatic_file(path, p).has_value());
   auto back = read_pneumatic_file(path);
   ASSERT_TRUE(back.has_value()) << back.error().message;
   EXPECT_EQ(*back, p);
-  std::filesystem::remove_all(dir);
+  std::filesystem::remove_all(dir.path);
   EXPECT_NE(read_pneumatic_file(path).error().message.find(path), std::string::npos);
 }
 

@@ -9,7 +9,6 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
-#include <unistd.h>
 
 #include "control/paper_controller.hpp"
 #include "core/paper_reference.hpp"
@@ -20,6 +19,7 @@
 #include "plant/plant_adapter.hpp"
 #include "runtime/recorder.hpp"
 #include "runtime/scan_cycle.hpp"
+#include "../support/temp_path.hpp"
 #include "paper_loop.hpp"
 
 namespace epa::runtime {
@@ -28,6 +28,7 @@ namespace {
 using testing::kPeriodNs;
 using testing::kSafeV;
 using testing::paper_tuning;
+using test::TempDir;
 
 constexpr double kTs = 0.005;
 
@@ -49,16 +50,6 @@ class Tracking final : public hal::Daq {
 
  private:
   hal::Daq& inner_;
-};
-
-// A folder of its own for a test's run files, removed afterwards.
-struct TempDir {
-  std::filesystem::path path;
-  explicit TempDir(const std::string& name)
-      : path(std::filesystem::temp_directory_path() / ("epa_excite_" + name + "_" + std::to_string(::getpid()))) {
-    std::filesystem::remove_all(path);
-  }
-  ~TempDir() { std::filesystem::remove_all(path); }
 };
 
 // The paper's plant (Hammerstein, 0.1 mm noise) at rest at `start_mm`.

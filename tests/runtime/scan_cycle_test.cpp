@@ -14,6 +14,7 @@
 #include "plant/plant_adapter.hpp"
 #include "runtime/recorder.hpp"
 #include "sim/closed_loop.hpp"
+#include "../support/temp_path.hpp"
 #include "paper_loop.hpp"
 
 namespace epa::runtime {
@@ -299,8 +300,7 @@ TEST(ScanCycle, RunStopsWhenAskedAndLeavesTheValveSafe) {
 }
 
 TEST(Recorder, WritesEachMoveAsAValidRunFile) {
-  const auto dir = std::filesystem::temp_directory_path() / ("epa_recorder_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
+  const test::TempDir dir("recorder");
   auto daq = *hal::SimDaq::make(core::paper::model(), {});
   VirtualClock clock;
   RuntimeConfig config;
@@ -310,7 +310,7 @@ TEST(Recorder, WritesEachMoveAsAValidRunFile) {
   config.move_window_s = 2.0;
   LoopChannels ch(4000);
   ScanCycle loop(config, paper_tuning(), daq, clock, ch);
-  Recorder recorder({.directory = dir.string(), .per_move = true, .Ts = 0.005, .source = "test"}, ch);
+  Recorder recorder({.directory = dir.path.string(), .per_move = true, .Ts = 0.005, .source = "test"}, ch);
   run_cycles(loop, clock, 450);
   ASSERT_EQ(recorder.process_pending(), 1u);
   auto run = core::read_run_file(recorder.last_file(), 0.005);
@@ -327,7 +327,6 @@ TEST(Recorder, WritesEachMoveAsAValidRunFile) {
   auto requested = core::read_run_file(recorder.last_file(), 0.005);
   ASSERT_TRUE(requested.has_value());
   EXPECT_EQ(requested->size(), 200u);
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -26,6 +26,7 @@
 #include <utility>
 #include <filesystem>
 
+#include "../support/temp_path.hpp"
 #include "web/commission_port.hpp"
 #include "web/recent_audit.hpp"
 
@@ -745,9 +746,8 @@ TEST_F(WebServerTest, WrongTokensFromAnAddressAreRefusedUnseenForABackOff) {
 
 TEST(WebServerStatic, NothingOutsideStaticDirIsServedAndTheFolderMustHoldThePage) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("epa-web-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const epa::test::TempDir temp("web-static");
+  const fs::path& dir = temp.path;
   for (const char* f : {"index.html", "app.js", "style.css"}) fs::copy_file(fs::path(EPA_SOURCE_DIR) / "web" / f, dir / f);
   fs::create_symlink("/etc/passwd", dir / "passwd");  // a link that leaves the folder
   fs::create_directory_symlink("/etc", dir / "etc");
@@ -773,7 +773,6 @@ TEST(WebServerStatic, NothingOutsideStaticDirIsServedAndTheFolderMustHoldThePage
   auto root = epa::web::WebServer::start(config, channels, nullptr, nullptr);
   ASSERT_FALSE(root.has_value());
   EXPECT_NE(root.error().message.find("index.html"), std::string::npos) << root.error().message;
-  fs::remove_all(dir);
 }
 
 TEST_F(WebServerTest, FiftyIdleConnectionsDoNotStopANormalRequest) {
