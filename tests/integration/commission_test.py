@@ -14,8 +14,9 @@ Checks, each printed with its figures:
   * a verification limit the axis cannot meet (e_ss <= 0.02 mm with NG-IDZ), commissioned on a
     second rig and appliance alongside the first: exit 2, verdict "rolled-back" before the axis
     moves with it (the simulation on the identified stick-slip model already ends 0.5-1 mm off)
-    or at the first move, or at identification (which can refuse an experiment); the previous set runs again and is still the stored active set, a switch to the
-    new set and back is in the audit trail, and the valve command never left its +-5 V limits;
+    or at the first move, or at identification (which can refuse an experiment); the previous set
+    runs again and is still the stored active set, a switch to the new set and back is in the
+    audit trail, and the valve command never left its +-5 V limits;
   * a wrong spec is refused before anything moves (HTTP 400, exit 1).
 Under the sanitizers (EPA_SANITIZER_RUN=1, set by the asan test preset) the run ends after the
 deployment's checks: it has reached every part of the appliance the rest does (excitation,
@@ -216,7 +217,7 @@ def run_once(epa, src):
     rigs, roll_back, roll_back_error = [], {}, []
     try:
         rigs.append(start_rig(epa, src, folder, "rig-a"))
-        plant, app = rigs[0]
+        app = rigs[0][1]
         if not SANITIZER_RUN:
             rigs.append(start_rig(epa, src, folder, "rig-b"))
 
