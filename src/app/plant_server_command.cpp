@@ -51,6 +51,9 @@ void add_plant_server_command(CLI::App& app, PlantServerOptions& o) {
                   "SCHED_FIFO priority of the simulator's threads, so it answers in bounded time like a module (0: normal)")
       ->capture_default_str()
       ->check(CLI::Range(0, 99));
+  cmd->add_flag("--sync-to-valve-writes", o.sync_to_valve_writes,
+                "Step the plant half a period after each valve write, as a module with synchronised I/O does (else its "
+                "clock runs free, which adds 0 or 1 sample of delay depending on phase)");
   cmd->add_option("--Ts", o.Ts, "Real-time step period, s (default: the model's, 0.005 for the paper)")
       ->check(CLI::PositiveNumber);
 }
@@ -102,6 +105,7 @@ int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostrea
   config.plant.seed = o.seed;
   config.realtime_priority = o.realtime_priority;
   config.watchdog_ms = o.watchdog_ms;
+  config.sync_to_valve_writes = o.sync_to_valve_writes;
 
   BlockedStopSignals signals;  // before start(): the simulator's threads must not take the signals
   if (!signals.ok()) return err << "epa plant-server: cannot block SIGINT/SIGTERM: " << std::strerror(errno) << "\n", 1;
@@ -133,7 +137,8 @@ int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostrea
                                            (o.effects.empty() ? "" : " with hidden effects");
   out << plant_text << "; initial position "
       << core::format_number(o.initial_position_mm) << " mm; sensor noise " << core::format_number(o.noise_mm)
-      << " mm; stop with SIGINT or SIGTERM" << std::endl;
+      << " mm; " << (o.sync_to_valve_writes ? "steps synchronised to the valve writes" : "free-running clock")
+      << "; stop with SIGINT or SIGTERM" << std::endl;
 
   std::optional<ModuleFaultControl> control;
   if (o.control_stdin) control.emplace(**sim, out);

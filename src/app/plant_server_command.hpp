@@ -28,6 +28,7 @@ struct PlantServerOptions {
   std::uint64_t seed = 1;
   double Ts = 0.0;               // 0: the model's own
   int realtime_priority = 0;     // SCHED_FIFO for the simulator's threads (0: normal priority)
+  bool sync_to_valve_writes = false;  // step half a period after each valve write (remote_io_simulator.hpp)
 };
 
 void add_plant_server_command(CLI::App& app, PlantServerOptions& options);

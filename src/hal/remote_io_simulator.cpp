@@ -81,6 +81,7 @@ struct RemoteIoSimulator::Impl {
   std::atomic<int> clients{0};
   std::atomic<double> last_valve_v{0.0};
   std::atomic<std::int64_t> last_request_ns{0};       // 0: no request yet (the watchdog waits for one)
+  std::atomic<std::int64_t> last_valve_write_ns{0};   // when the last write to the valve arrived; 0: none yet
   std::atomic<bool> watchdog_tripped{false};
   std::atomic<std::int64_t> sensor_fault_step{-1};    // plant step at which a sensor fault was injected
   std::atomic<long> steps_to_safe{-1};
@@ -117,6 +118,7 @@ struct RemoteIoSimulator::Impl {
 
   void serve() noexcept;
   bool serve_request(int fd, std::uint8_t* query) noexcept;
+  bool writes_valve(const std::uint8_t* query, int length) const noexcept;
   void run_plant() noexcept;
 };
 
@@ -170,6 +172,11 @@ bool RemoteIoSimulator::Impl::serve_request(int fd, std::uint8_t* query) noexcep
   const int length = modbus_receive(ctx, query);
   if (length == -1) return false;
   if (length == 0) return true;  // libmodbus ignored it
+  if (config.sync_to_valve_writes && writes_valve(query, length)) {
+    timespec received{};
+    clock_gettime(CLOCK_MONOTONIC, &received);  // the master's phase: when it sent, not when answered
+    last_valve_write_ns.store(to_ns(received));
+  }
   switch (answers.load()) {
     case ModuleFaults::Answers::kNormal: break;
     case ModuleFaults::Answers::kSilent: return true;  // read, never answered: the client times out
@@ -198,6 +205,23 @@ bool RemoteIoSimulator::Impl::serve_request(int fd, std::uint8_t* query) noexcep
   return true;
 }
 
+// Whether the request writes a register of the valve point (FC 6, 16 or 23); the frame was checked
+// by modbus_receive, and each field read here is inside its length.
+bool RemoteIoSimulator::Impl::writes_valve(const std::uint8_t* query, int length) const noexcept {
+  const AnalogPoint& valve = config.layout.valve;
+  if (valve.table != RegisterTable::kHolding) return false;
+  const int h = modbus_get_header_length(ctx);
+  const auto word = [&](int at) { return at + 1 < length ? (query[at] << 8) | query[at + 1] : -1; };
+  int first = -1, count = 0;
+  switch (h < length ? query[h] : 0) {
+    case 0x06: first = word(h + 1), count = 1; break;
+    case 0x10: first = word(h + 1), count = word(h + 3); break;
+    case 0x17: first = word(h + 5), count = word(h + 7); break;  // read/write multiple: the write part
+    default: return false;
+  }
+  return first >= 0 && count > 0 && first <= valve.address && valve.address < first + count;
+}
+
 void RemoteIoSimulator::Impl::run_plant() noexcept {
   const auto period_ns = static_cast<std::int64_t>(std::llround(plant->sample_period_s() * 1e9));
   const AnalogPoint& valve = config.layout.valve;
@@ -205,8 +229,18 @@ void RemoteIoSimulator::Impl::run_plant() noexcept {
   timespec now{};
   clock_gettime(CLOCK_MONOTONIC, &now);
   std::int64_t next_ns = to_ns(now);
+  std::int64_t step_before_ns = next_ns - period_ns;
   while (running.load()) {
+    // next_ns is when the last step was due. Synchronised: the master wrote the valve since the
+    // step before it, so its next write comes a period after that one; step half a period after
+    // it, within half a period of the free schedule. Locked after one write; without writes the
+    // schedule runs free.
+    const std::int64_t write_ns = last_valve_write_ns.load();
+    const std::int64_t last_step_ns = next_ns;
     next_ns += period_ns;
+    if (config.sync_to_valve_writes && write_ns > step_before_ns)
+      next_ns = std::clamp(write_ns + period_ns + period_ns / 2, last_step_ns + period_ns / 2, last_step_ns + period_ns * 3 / 2);
+    step_before_ns = last_step_ns;
     const timespec deadline = from_ns(next_ns);
     while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
     }

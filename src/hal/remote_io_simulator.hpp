@@ -10,6 +10,14 @@
 // 10 periods behind (a suspended process) it starts a fresh schedule instead of catching up in a
 // burst, and counts an overrun.
 //
+// Synchronised (sync_to_valve_writes): each step comes half a period after the master's last valve
+// write (within half a period of the free schedule, so it locks after one write and the plant's
+// rate stays bounded), as a module with synchronised I/O applies outputs and latches inputs at the
+// master's sync point. Why: a plant that is itself a discrete model at the master's period (the
+// paper's) adds, on a free clock, no delay or one whole sample depending on the two clocks' phase
+// (a step between the master's read and its write applies the previous command), and the paper's
+// FF-IDZ loop does not survive one sample (`epa simulate --delay 1`). Without writes it runs free.
+//
 // Server thread: select() over the listening socket and up to kMaxClients clients, waking at
 // least every 50 ms so that stop() returns promptly; libmodbus' modbus_receive/modbus_reply do the
 // protocol (modbus_reply also answers illegal addresses and functions with exceptions). Requests
@@ -40,6 +48,8 @@ struct RemoteIoSimulatorConfig {
   plant::PlantOptions plant;          // model and plant: for start(config) only
   int realtime_priority = 0;          // SCHED_FIFO for both threads, as a module's firmware answers in
                                       // bounded time; 0: normal priority (refusal is not an error)
+  bool sync_to_valve_writes = false;  // step the plant half a period after each valve write, as a module
+                                      // with synchronised I/O does; off: the plant's clock runs free
   int watchdog_ms = 0;                // a module's comms watchdog: no request for this long (after the
                                       // first) centres the valve until requests come back; 0: off
 };

@@ -547,6 +547,38 @@ TEST(RemoteIoSimulator, SurvivesAGarbageClientAndRefusesABusyPort) {
   EXPECT_NE(message.find("in use"), std::string::npos) << message;
 }
 
+// A synchronised module steps half a period after each valve write, whatever the phase of the
+// master's clock: every master cycle sees exactly one step, and it lands between its write and the
+// next read. The master runs at two phases half a period apart, so a free-running module (whose
+// steps keep one phase) fails at least one of them. A 20 ms period leaves 5 ms of slack either side.
+TEST(RemoteIoSimulator, SynchronisedStepsLandHalfAPeriodAfterEachValveWrite) {
+  RemoteIoSimulatorConfig c = sim_config();
+  c.model.Ts = 0.020;
+  c.sync_to_valve_writes = true;
+  auto sim = start_sim(c);
+  ASSERT_NE(sim, nullptr);
+  ModbusIoDaq daq(daq_config(sim->port()));
+  ASSERT_TRUE(daq.open().has_value());
+  constexpr int kCycles = 30, kLockCycles = 3;
+  auto cycle_start = Clock::now() + 7ms;
+  for (const auto phase_shift : {0ms, 10ms}) {
+    cycle_start += phase_shift;
+    int one_step_between = 0;
+    for (int k = 0; k < kCycles; ++k, cycle_start += 20ms) {
+      std::this_thread::sleep_until(cycle_start);
+      ASSERT_EQ(daq.write_valve(0.0), IoStatus::kOk);
+      const auto at_write = sim->steps();
+      std::this_thread::sleep_until(cycle_start + 5ms);
+      const auto quarter = sim->steps();
+      std::this_thread::sleep_until(cycle_start + 15ms);
+      const auto three_quarters = sim->steps();
+      if (k >= kLockCycles && quarter == at_write && three_quarters == at_write + 1) ++one_step_between;
+    }
+    // A scheduling hiccup of the test's own thread may spoil a cycle or two on a loaded machine.
+    EXPECT_GE(one_step_between, kCycles - kLockCycles - 2) << "phase shift " << phase_shift.count() << " ms";
+  }
+}
+
 TEST(RemoteIoSimulator, StepsInRealTimeAndStopsPromptly) {
   auto sim = start_sim(sim_config());
   ASSERT_NE(sim, nullptr);
