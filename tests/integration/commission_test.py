@@ -167,13 +167,18 @@ def start_rig(epa, src, folder, name):
     return plant, app
 
 
+def stored_active_sets(epa, app):
+    """The lines of `epa tuning list` that mark the stored active set (they start with `*`)."""
+    listing = subprocess.run([epa, "tuning", "--db", app.db, "list"], capture_output=True, text=True).stdout
+    return [line for line in listing.splitlines() if line.startswith("*")], listing
+
+
 def roll_back_run(epa, app, spec, folder):
     """A verification limit no axis meets, commissioned on its own rig: what the checks read after it."""
     out = {"before": http(app, "GET", "/api/status")[1]["store"]["tuning_set"]}
     out["r"], out["outcome"], _, out["took"] = commission(epa, app, spec, folder, "rolled-back")
     out["running"] = http(app, "GET", "/api/status")[1]["store"]["tuning_set"]
-    listing = subprocess.run([epa, "tuning", "--db", app.db, "list"], capture_output=True, text=True).stdout
-    out["active"] = [line for line in listing.splitlines() if line.startswith("*")]
+    out["active"], _ = stored_active_sets(epa, app)
     out["audit"] = json.dumps(http(app, "GET", "/api/audit")[1])
     out["valves"] = http(app, "GET", "/api/trend")[1].get("valve_v", [])
     return out
@@ -253,8 +258,7 @@ def run_once(epa, src):
         check(os.path.getsize(report) > 2000 if os.path.exists(report) else False, "the report was written")
         status = http(app, "GET", "/api/status")[1]
         check(status["store"]["tuning_set"] == "rig-1", f"the new set runs (running set {status['store']['tuning_set']})")
-        listing = subprocess.run([epa, "tuning", "--db", app.db, "list"], capture_output=True, text=True).stdout
-        active = [line for line in listing.splitlines() if line.startswith("*")]
+        active, listing = stored_active_sets(epa, app)
         check(any("rig-1" in line for line in active), f"the new set is the stored active set: {active or listing}")
         if SANITIZER_RUN:
             print("      under the sanitizers: the HMI moves and the roll-back are left to the release run")
