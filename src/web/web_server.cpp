@@ -360,8 +360,12 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
   // Debian's libcpp-httplib is built with a listen queue of 5; the hook that sets the listening
   // socket's options is where its descriptor can be seen, to listen again with the larger queue.
   auto listening_socket = std::make_shared<socket_t>(INVALID_SOCKET);
+  // Not httplib's default options: they set SO_REUSEPORT, with which a second appliance binds the
+  // same port without an error and the kernel shares the connections between the two, so an
+  // operator's page shows either axis. SO_REUSEADDR alone lets a restart bind past TIME_WAIT.
   s.set_socket_options([listening_socket](socket_t sock) {
-    httplib::default_socket_options(sock);
+    const int yes = 1;
+    ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
     *listening_socket = sock;
   });
   impl->routes();

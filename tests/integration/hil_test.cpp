@@ -25,13 +25,11 @@ constexpr double kPaperRiseS = 0.30, kRiseMarginS = 0.10;
 constexpr double kPaperEssMm = 1.04, kEssMarginMm = 1.0;
 
 // Under a sanitizer both processes run several times slower, and the simulated module is no
-// longer a module's firmware answering within the shipped 2 ms; FF-IDZ's final position on this
-// plant also moves with every sample of timing (0.97 mm when clean, as in simulation; with one
-// sample of delay the simulation diverges). On this VM on 2026-11-26, of 20 ASan runs with the
-// shipped config, some faulted with io-errors and some ended 2.3 mm off. So a sanitized build
-// gives the module 20 ms, still checks that the move runs its whole window, is recorded and shuts
-// down cleanly, and prints the control figures without judging them; the release build judges
-// them on the shipped configuration.
+// longer a module's firmware answering within the shipped 2 ms (on this VM on 2026-11-26, of 20
+// ASan runs with the shipped config, some faulted with io-errors), so a sanitized build gives the
+// module 20 ms. The control figures are judged in both: since the module steps in phase with the
+// valve writes, 10 of 10 ASan runs ended 0.94-0.97 mm off (2026-11-29), as in simulation; before,
+// some ended 2.3 mm off, the free clock's phase at work.
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 constexpr bool kSanitized = true;
 #else
@@ -107,14 +105,11 @@ TEST(HardwareInTheLoop, PlantServerAndServeCompleteAFiftyMillimetreMove) {
   EXPECT_EQ(run->size(), 1000u) << serve.log();  // 5 s at 5 ms: the move ran its whole window
   const auto m = core::step_metrics(run->y_mm, 50.0, {.Ts = 0.005});
   ASSERT_TRUE(m.rise_s.has_value()) << serve.log();
-  std::printf("HIL 50 mm move: rise %.3f s, settling %s s, e_ss %.2f mm, overshoot %.1f %%%s\n", *m.rise_s,
-              m.settling_s ? std::to_string(*m.settling_s).c_str() : "never", m.ess_mm, m.overshoot_pct.value_or(0.0),
-              kSanitized ? " (a sanitized build: not judged)" : "");
-  if (!kSanitized) {
-    EXPECT_LE(*m.rise_s, kPaperRiseS + kRiseMarginS);
-    EXPECT_LE(m.ess_mm, kPaperEssMm + kEssMarginMm);
-    EXPECT_NEAR(m.final_mm, 50.0, kPaperEssMm + kEssMarginMm) << "serve log:\n" << serve.log() << "\nplant log:\n" << plant.log();
-  }
+  std::printf("HIL 50 mm move: rise %.3f s, settling %s s, e_ss %.2f mm, overshoot %.1f %%\n", *m.rise_s,
+              m.settling_s ? std::to_string(*m.settling_s).c_str() : "never", m.ess_mm, m.overshoot_pct.value_or(0.0));
+  EXPECT_LE(*m.rise_s, kPaperRiseS + kRiseMarginS);
+  EXPECT_LE(m.ess_mm, kPaperEssMm + kEssMarginMm);
+  EXPECT_NEAR(m.final_mm, 50.0, kPaperEssMm + kEssMarginMm) << "serve log:\n" << serve.log() << "\nplant log:\n" << plant.log();
 
   // The appliance logged its start, the move and a clean shutdown with the valve safe.
   const std::string log = serve.log();

@@ -714,6 +714,22 @@ std::pair<std::string, std::chrono::milliseconds> raw_exchange(int port, const s
   return {answer.substr(0, answer.find("\r\n")), took};
 }
 
+// A second appliance on the same web port is refused with the port named, not let in beside the
+// first (SO_REUSEPORT would share the connections between the two pages).
+TEST_F(WebServerTest, ASecondServerOnTheSamePortIsRefused) {
+  start();
+  epa::web::WebConfig config;
+  config.address = "127.0.0.1";
+  config.port = server_->port();
+  config.static_dir = std::string(EPA_SOURCE_DIR) + "/web";
+  auto second = epa::web::WebServer::start(config, channels_, gate_.get(), &audit_,
+                                           [] { return epa::web::ModbusStats{true, 2, 77, 1}; }, {}, nullptr);
+  ASSERT_FALSE(second.has_value()) << "a second server bound 127.0.0.1:" << server_->port();
+  EXPECT_NE(second.error().message.find(":" + std::to_string(server_->port())), std::string::npos) << second.error().message;
+  EXPECT_NE(second.error().message.find("in use"), std::string::npos) << second.error().message;
+  EXPECT_EQ(get_json("/api/status")["setpoint_mm"], 120.0);  // the first still answers
+}
+
 TEST_F(WebServerTest, OversizedHeadsAndDeclaredBodiesAreRefusedAtOnce) {
   start("a-token-of-sixteen-chars");
   std::string many = "GET /api/status HTTP/1.1\r\nHost: x\r\n";
