@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "app/appliance_http.hpp"
+#include "app/cli_checks.hpp"
 #include "app/output_file.hpp"
 #include "core/text_file.hpp"
 
@@ -26,7 +27,7 @@ void add_commission_command(CLI::App& app, CommissionOptions& o) {
   cmd->add_option("--report", o.report_path, "Write the report here (HTML)");
   cmd->add_option("--poll", o.poll_s, "Seconds between progress polls")->capture_default_str()->check(CLI::Range(0.05, 60.0));
   cmd->add_option("--timeout", o.timeout_s, "Give up waiting (and abort) after this many seconds")->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(cli::kPositive);
 }
 
 namespace {

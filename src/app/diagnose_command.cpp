@@ -3,6 +3,7 @@
 #include <chrono>
 #include <optional>
 
+#include "app/cli_checks.hpp"
 #include "app/diagnose_report.hpp"
 #include "app/output_file.hpp"
 #include "core/format.hpp"
@@ -28,7 +29,7 @@ void add_diagnose_command(CLI::App& app, DiagnoseOptions& o) {
   cmd->add_option("--json", o.json_path, "Write the epa-gap-report/1 JSON here ('-': standard output)");
   cmd->add_option("--report", o.report_path, "Write the HTML report here");
   cmd->add_option("--effects", o.effects, "Candidate effects (default: all eight)")->delimiter(',');
-  cmd->add_option("--stroke", o.stroke_mm, "Stroke, mm (end stops)")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--stroke", o.stroke_mm, "Stroke, mm (end stops)")->capture_default_str()->check(cli::kPositive);
 }
 
 namespace {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "app/cli_checks.hpp"
 #include "app/output_file.hpp"
 #include "app/svg_chart.hpp"
 #include "app/tuning_source.hpp"
@@ -27,9 +28,9 @@ void add_excite_command(CLI::App& app, ExciteOptions& o) {
                   "Physics plant parameters (epa-pneumatic/1 TOML) for --plant physics; default: built in")
       ->check(CLI::ExistingFile);
   cmd->add_option("--plot", o.plot_path, "Draw the run (position and valve command) as an SVG picture");
-  cmd->add_option("--duration", o.duration_s, "Length of the run, s")->capture_default_str()->check(CLI::PositiveNumber);
-  cmd->add_option("--seed", o.seed, "Seed of the pulse sequence and of the sensor noise")->capture_default_str();
-  cmd->add_option("--noise", o.noise_mm, "Sensor noise standard deviation, mm")->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--duration", o.duration_s, "Length of the run, s")->capture_default_str()->check(cli::kPositive);
+  cmd->add_option("--seed", o.seed, "Seed of the pulse sequence and of the sensor noise")->capture_default_str()->check(cli::kSeed);
+  cmd->add_option("--noise", o.noise_mm, "Sensor noise standard deviation, mm")->capture_default_str()->check(cli::kNonNegative);
   cmd->add_option("--amplitude-max", o.amplitude_max_v, "Largest |valve command|, V (beyond both break points)")
       ->capture_default_str();
   cmd->add_option("--amplitude-min", o.amplitude_min_v, "Smallest pulse level, V (inside the dead band)")->capture_default_str();

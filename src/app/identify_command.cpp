@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "app/cli_checks.hpp"
 #include "app/identify_report.hpp"
 #include "app/output_file.hpp"
 #include "app/store_save.hpp"
@@ -34,28 +35,28 @@ void add_identify_command(CLI::App& app, IdentifyOptions& o) {
   cmd->add_option("--save", o.save_name, "Save the model under this name into the tuning store, with its fit figures");
   cmd->add_option("--db", o.db_path, "The tuning store for --save")->capture_default_str();
   cmd->add_option("--plot", o.plot_path, "Draw measured vs model output of the validation runs as an SVG picture");
-  cmd->add_option("--seed", o.seed, "Seed of the particle swarm (same seed, same data: same model)")->capture_default_str();
+  cmd->add_option("--seed", o.seed, "Seed of the particle swarm (same seed, same data: same model)")->capture_default_str()->check(cli::kSeed);
   cmd->add_option("--particles", o.particles, "Particles in the swarm")->capture_default_str()->check(CLI::Range(2u, 10000u));
   cmd->add_option("--generations", o.generations, "Swarm generations")->capture_default_str()->check(CLI::Range(1u, 100000u));
   cmd->add_option("--m-l", o.m_l, "Normalisation: the left slope m_l the model is scaled to (the data fix only m B)")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(cli::kPositive);
   cmd->add_option("--tolerance", o.tolerance_pct, "Order rule: fits within this many points of the best count as equal")
-      ->capture_default_str()->check(CLI::NonNegativeNumber);
-  cmd->add_option("--mm-per-volt", o.mm_per_volt, "Sensor scale of the model's output y")->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(cli::kNonNegative);
+  cmd->add_option("--mm-per-volt", o.mm_per_volt, "Sensor scale of the model's output y")->capture_default_str()->check(cli::kPositive);
   cmd->add_option("--criterion", o.criterion,
                   "simulation: refine A, B and the dead zone on the free-run simulation error, break points within "
                   "the ramps' dead band; one-step: the swarm's least-squares (one-step prediction) fit alone")
       ->capture_default_str()->check(CLI::IsMember({"simulation", "one-step"}));
   cmd->add_option("--window", o.window_s, "Simulation criterion: restart the simulation from the measured position every "
                                           "this many seconds (0: whole runs)")
-      ->capture_default_str()->check(CLI::NonNegativeNumber);
+      ->capture_default_str()->check(cli::kNonNegative);
   cmd->add_option("--break-points", o.break_points,
                   "Simulation criterion: ramps: keep each break point between where the ramps start the piston from "
                   "rest and where it stops on the way back; free: wherever the simulation error puts it")
       ->capture_default_str()->check(CLI::IsMember({"ramps", "free"}));
   cmd->add_flag("!--no-stick-slip", o.stick_slip,
                "Skip the stick-slip model (the model for simulating a pneumatic axis, fitted after the Hammerstein one)");
-  cmd->add_option("--stroke", o.stroke_mm, "Stroke, mm (samples at an end stop are left out)")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--stroke", o.stroke_mm, "Stroke, mm (samples at an end stop are left out)")->capture_default_str()->check(cli::kPositive);
 }
 
 namespace {

@@ -47,6 +47,17 @@ int main(int argc, char** argv) {
   CLI::App* records_command = epa::app::add_records_command(app, records);
   epa::app::DiagnoseOptions diagnose;
   epa::app::add_diagnose_command(app, diagnose);
+  // CLI11 answers a mistyped command with "A subcommand is required"; name it and the commands.
+  std::string commands;
+  bool known = false;
+  for (CLI::App* command : app.get_subcommands({})) {
+    commands += (commands.empty() ? "" : ", ") + command->get_name();
+    known = known || (argc > 1 && command->check_name(argv[1]));
+  }
+  if (argc > 1 && argv[1][0] != '-' && !known) {
+    std::cerr << "epa: '" << argv[1] << "' is not a command; the commands: " << commands << " (epa --help)\n";
+    return 109;  // CLI11's exit code for a missing or unknown subcommand
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -9,6 +9,7 @@
 #include <optional>
 #include <ostream>
 
+#include "app/cli_checks.hpp"
 #include "app/daq_factory.hpp"
 #include "app/module_fault_control.hpp"
 #include "app/tuning_source.hpp"
@@ -43,10 +44,10 @@ void add_plant_server_command(CLI::App& app, PlantServerOptions& o) {
   cmd->add_option("--effect", o.effects, "Hammerstein plant: hide an effect in it, e.g. valve_lag=0.02 or static_friction=0.6,0.3 "
                                          "(repeatable; names and parameters as epa diagnose reports them)");
   cmd->add_option("--initial-position", o.initial_position_mm, "Piston position at start, mm")
-      ->capture_default_str()->check(CLI::NonNegativeNumber);
+      ->capture_default_str()->check(cli::kNonNegative);
   cmd->add_option("--noise", o.noise_mm, "Sensor noise standard deviation, mm")
-      ->capture_default_str()->check(CLI::NonNegativeNumber);
-  cmd->add_option("--seed", o.seed, "Seed of the sensor noise")->capture_default_str();
+      ->capture_default_str()->check(cli::kNonNegative);
+  cmd->add_option("--seed", o.seed, "Seed of the sensor noise")->capture_default_str()->check(cli::kSeed);
   cmd->add_option("--realtime-priority", o.realtime_priority,
                   "SCHED_FIFO priority of the simulator's threads, so it answers in bounded time like a module (0: normal)")
       ->capture_default_str()
@@ -55,7 +56,7 @@ void add_plant_server_command(CLI::App& app, PlantServerOptions& o) {
                 "Step the plant half a period after each valve write, as a module with synchronised I/O does (else its "
                 "clock runs free, which adds 0 or 1 sample of delay depending on phase)");
   cmd->add_option("--Ts", o.Ts, "Real-time step period, s (default: the model's, 0.005 for the paper)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::kPositive);
 }
 
 namespace {

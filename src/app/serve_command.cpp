@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/cli_checks.hpp"
 #include "app/daq_factory.hpp"
 #include "app/appliance_axis.hpp"
 #include "app/commission_identify.hpp"
@@ -36,14 +37,16 @@ void add_serve_command(CLI::App& app, ServeOptions& o) {
   auto* cmd = app.add_subcommand("serve", "Run the appliance: scan cycle, DAQ backend, run recorder");
   cmd->add_option("--config", o.config_path, "Configuration file (epa-config/1 TOML)")->capture_default_str();
   cmd->add_option("--hal", o.hal, "DAQ backend, overriding the configuration: sim, modbus-io, comedi");
-  cmd->add_option("--modbus-io-port", o.modbus_io_port, "TCP port of the remote I/O module (modbus-io)");
-  cmd->add_option("--modbus-port", o.modbus_port, "TCP port of the Modbus server, overriding [modbus] port");
-  cmd->add_option("--web-port", o.web_port, "TCP port of the status page's HTTP server, overriding [web] port");
+  cmd->add_option("--modbus-io-port", o.modbus_io_port, "TCP port of the remote I/O module (modbus-io)")->check(CLI::Range(1, 65535));
+  cmd->add_option("--modbus-port", o.modbus_port, "TCP port of the Modbus server, overriding [modbus] port (0: any free port)")
+      ->check(CLI::Range(0, 65535));
+  cmd->add_option("--web-port", o.web_port, "TCP port of the status page's HTTP server, overriding [web] port (0: any free port)")
+      ->check(CLI::Range(0, 65535));
   cmd->add_option("--mode", o.mode, "Mode at start-up: stop or run");
-  cmd->add_option("--setpoint", o.setpoint_mm, "Setpoint at start-up, mm");
+  cmd->add_option("--setpoint", o.setpoint_mm, "Setpoint at start-up, mm; in RUN the axis moves there (within the setpoint range)");
   cmd->add_option("--record-dir", o.record_dir, "Directory for recorded run files");
   cmd->add_option("--db", o.db_path, "The tuning store's database file, overriding [store] path");
-  cmd->add_option("--duration", o.duration_s, "Stop by itself after this many seconds (0: run until SIGTERM)");
+  cmd->add_option("--duration", o.duration_s, "Stop by itself after this many seconds (0: run until SIGTERM)")->check(cli::kNonNegative);
 }
 
 namespace {
@@ -61,15 +64,15 @@ core::Status apply_overrides(const ServeOptions& o, config::ApplianceConfig& c) 
     else if (o.hal == "comedi") c.backend = config::HalBackend::kComedi;
     else return core::invalid_argument("--hal '" + o.hal + "' is not one of sim, modbus-io, comedi");
   }
-  if (o.modbus_io_port > 0) c.modbus_io.port = o.modbus_io_port;
-  if (o.modbus_port >= 0) c.modbus.port = o.modbus_port;
-  if (o.web_port >= 0) c.web.port = o.web_port;
+  if (o.modbus_io_port) c.modbus_io.port = *o.modbus_io_port;
+  if (o.modbus_port) c.modbus.port = *o.modbus_port;
+  if (o.web_port) c.web.port = *o.web_port;
   if (!o.mode.empty()) {
     auto m = runtime::parse_mode(o.mode);
-    if (!m) return core::invalid_argument("--mode: " + m.error().message);
+    if (!m) return core::invalid_argument("--mode '" + o.mode + "' is not a mode; at start-up: stop or run");  // the rest: validate()
     c.runtime.start_mode = *m;
   }
-  if (o.setpoint_mm >= 0.0) c.runtime.start_setpoint_mm = o.setpoint_mm, c.runtime.start_moves_to_setpoint = true;
+  if (o.setpoint_mm) c.runtime.start_setpoint_mm = *o.setpoint_mm, c.runtime.start_moves_to_setpoint = true;
   if (!o.record_dir.empty()) c.record_directory = o.record_dir;
   if (!o.db_path.empty()) c.store_path = o.db_path;
   if (auto s = runtime::validate(c.runtime); !s) return s;
@@ -297,7 +300,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   }
   auto limits = write_limits(c, o.config_path, register_map);
   if (!limits) return fail(limits.error());
-  auto control = prepare_control(c, register_map, o.setpoint_mm >= 0.0);
+  auto control = prepare_control(c, register_map, o.setpoint_mm.has_value());
   if (!control) return fail(control.error());
   for (const auto& line : control->store.notes) spdlog::info("{}", line);
   for (const auto& line : control->store.warnings) spdlog::warn("{}", line);
@@ -310,10 +313,14 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
     return 1;
   }
   const DaqCloser closer{**daq};
-  spdlog::info("controller {} (tuning set '{}': {}), model '{}', Ts {} s, start mode {}, setpoint {} mm",
+  // In RUN without --setpoint the axis holds where it stands (enable_holds_position): the retained
+  // or configured setpoint is not a move, and the log must not read as one.
+  const bool holds = c.runtime.start_mode == runtime::Mode::kRun && c.runtime.enable_holds_position && !c.runtime.start_moves_to_setpoint;
+  spdlog::info("controller {} (tuning set '{}': {}), model '{}', Ts {} s, start mode {}, {}",
                control::to_string(c.runtime.controller), control->store.set.name, control->store.set.source,
                control->store.model.name, control->store.model.model.Ts, runtime::to_string(c.runtime.start_mode),
-               c.runtime.start_setpoint_mm);
+               holds ? "holding the piston where it stands until a move is started"
+                     : "setpoint " + core::format_number(c.runtime.start_setpoint_mm) + " mm");
 
   // SIGTERM/SIGINT are taken synchronously by this thread; the threads below inherit the mask.
   sigset_t signals;

@@ -5,6 +5,7 @@
 // talks to systemd (Type=notify: READY, WATCHDOG while the loop advances, STOPPING).
 #include <CLI/CLI.hpp>
 #include <ostream>
+#include <optional>
 #include <string>
 
 namespace epa::app {
@@ -12,11 +13,11 @@ namespace epa::app {
 struct ServeOptions {
   std::string config_path = "config/epa.toml";
   std::string hal;            // overrides [hal] backend
-  int modbus_io_port = 0;     // overrides [hal.modbus_io] port
-  int modbus_port = -1;       // overrides [modbus] port (0: any free port, logged)
-  int web_port = -1;          // overrides [web] port (0: any free port, logged)
-  std::string mode;           // overrides [startup] mode
-  double setpoint_mm = -1.0;  // overrides [startup] setpoint_mm (< 0: not given)
+  std::optional<int> modbus_io_port;  // overrides [hal.modbus_io] port
+  std::optional<int> modbus_port;     // overrides [modbus] port (0: any free port, logged)
+  std::optional<int> web_port;        // overrides [web] port (0: any free port, logged)
+  std::string mode;                   // overrides [startup] mode
+  std::optional<double> setpoint_mm;  // overrides [startup] setpoint_mm; RUN at start-up then moves there
   std::string record_dir;     // overrides [recorder] directory
   std::string db_path;        // overrides [store] path
   double duration_s = 0.0;    // > 0: stop by itself after this long (tests, demos)

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "app/cli_checks.hpp"
 #include "app/output_file.hpp"
 #include "app/response_plot.hpp"
 #include "app/simulation_case.hpp"
@@ -35,23 +36,23 @@ void add_simulate_command(CLI::App& app, SimulateOptions& o) {
   cmd->add_option("--physics-config", o.physics_config, "Physics plant parameters (epa-pneumatic/1 TOML); default: built in")
       ->check(CLI::ExistingFile);
   cmd->add_option("--gain-factor", o.gain_factor, "Robustness: the plant's gain (B) is this times the model's")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(cli::kPositive);
   cmd->add_option("--break-point-error", o.break_point_error_v,
                   "Robustness: the plant's dead band is wider by this on each side, V (negative: narrower)")->capture_default_str();
   cmd->add_option("--delay", o.delay_samples, "Robustness: samples of transport delay before the valve")
       ->capture_default_str()->check(CLI::Range(std::size_t{0}, sim::kMaxDelaySamples));
-  cmd->add_option("--valve-lag", o.valve_lag_s, "Robustness: first-order lag of the valve, s")->capture_default_str()->check(CLI::NonNegativeNumber);
-  cmd->add_option("--duration", o.duration_s, "Length of each run, s")->capture_default_str()->check(CLI::PositiveNumber);
-  cmd->add_option("--Ts", o.Ts, "Sample time, s (default: the model's, 0.005 for the paper)")->check(CLI::PositiveNumber);
-  cmd->add_option("--lc", o.lc_mm, "FF-IDZ switch-off band l_c, mm")->capture_default_str()->check(CLI::NonNegativeNumber);
-  cmd->add_option("--noise", o.noise_mm, "Sensor noise standard deviation, mm")->capture_default_str()->check(CLI::NonNegativeNumber);
-  cmd->add_option("--seed", o.seed, "Seed of the sensor noise")->capture_default_str();
+  cmd->add_option("--valve-lag", o.valve_lag_s, "Robustness: first-order lag of the valve, s")->capture_default_str()->check(cli::kNonNegative);
+  cmd->add_option("--duration", o.duration_s, "Length of each run, s")->capture_default_str()->check(cli::kPositive);
+  cmd->add_option("--Ts", o.Ts, "Sample time, s (default: the model's, 0.005 for the paper)")->check(cli::kPositive);
+  cmd->add_option("--lc", o.lc_mm, "FF-IDZ switch-off band l_c, mm")->capture_default_str()->check(cli::kNonNegative);
+  cmd->add_option("--noise", o.noise_mm, "Sensor noise standard deviation, mm")->capture_default_str()->check(cli::kNonNegative);
+  cmd->add_option("--seed", o.seed, "Seed of the sensor noise")->capture_default_str()->check(cli::kSeed);
   cmd->add_option("--model", o.model_path, "Model file (epa-model/1 TOML); default: the paper's eq 9-10")->check(CLI::ExistingFile);
   cmd->add_option("--design", o.design_path, "Controller from an epa-design/1 JSON file; default: the paper's eq 12-13")->check(CLI::ExistingFile);
   cmd->add_option("--out-dir", o.out_dir, "Write each run as an epa-run/1 CSV file here");
   cmd->add_option("--json", o.json_path, "Write the metrics as epa-sim/1 JSON");
   cmd->add_option("--plot", o.plot_path, "Draw the responses as an SVG picture");
-  cmd->add_option("--plot-window", o.plot_window_s, "Seconds of each run to draw")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--plot-window", o.plot_window_s, "Seconds of each run to draw")->capture_default_str()->check(cli::kPositive);
 }
 
 namespace {

@@ -55,7 +55,8 @@ core::Status validate(const RuntimeConfig& c) {
   if (c.start_mode != Mode::kStop && c.start_mode != Mode::kRun)
     return core::invalid_argument("start mode must be stop or run (manual and excite are entered by command)");
   if (c.start_setpoint_mm < c.setpoint_min_mm || c.start_setpoint_mm > c.setpoint_max_mm)
-    return core::invalid_argument("start setpoint " + core::format_number(c.start_setpoint_mm) + " mm lies outside the setpoint range");
+    return core::invalid_argument("start setpoint " + core::format_number(c.start_setpoint_mm) + " mm lies outside the setpoint range [" +
+                                  core::format_number(c.setpoint_min_mm) + ", " + core::format_number(c.setpoint_max_mm) + "] mm");
   if (c.move_window_s > c.record_buffer_s) return core::invalid_argument("move_window_s must not exceed record_buffer_s");
   if (const char* problem = excitation_problem(c.excitation, c)) {
     const auto& e = c.excitation;

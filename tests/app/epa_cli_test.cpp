@@ -58,6 +58,36 @@ TEST_F(EpaCli, UnknownControllerIsRefusedWithTheChoices) {
   EXPECT_NE(o.output.find("unknown controller 'pid'"), std::string::npos) << o.output;
 }
 
+// What a new user mistypes (an outside walk-through, 2026-11-29): each refused, naming the option
+// and the rule, before anything runs; none taken as something else (a wrapped port, a negative
+// seed taken as 2^64 - 3, a negative setpoint taken as "not given").
+TEST_F(EpaCli, MistypedCommandsAndNumbersAreRefusedNamingWhatWasWrong) {
+  const std::string config = "serve --config " + std::string(EPA_SOURCE_DIR) + "/config/epa.toml --db " + path("epa.db") +
+                             " --modbus-port 0 --web-port 0 --duration 0.1";
+  const struct {
+    std::string args, says;
+  } cases[] = {
+      {"simulat", "'simulat' is not a command; the commands: serve,"},
+      {"simulate --lc abc", "--lc: 'abc' is not a number (expected a number >= 0)"},
+      {"simulate --noise -1", "--noise: -1 is not a number >= 0"},
+      {"simulate --seed -3", "--seed: '-3' is not a seed (expected a whole number >= 0)"},
+      {"plant-server --Ts 0", "--Ts: 0 is not a number > 0"},
+      {"serve --modbus-port 70000", "--modbus-port: Value 70000 not in range 0 to 65535"},
+      {"serve --web-port -1", "--web-port: Value -1 not in range 0 to 65535"},
+      {"serve --duration -1", "--duration: -1 is not a number >= 0"},
+      {config + " --mode runn", "--mode 'runn' is not a mode; at start-up: stop or run"},
+      {config + " --mode manual", "start mode must be stop or run"},
+      {config + " --setpoint -5", "start setpoint -5 mm lies outside the setpoint range [0, 500] mm"},
+      {config + " --setpoint 700", "start setpoint 700 mm lies outside the setpoint range [0, 500] mm"},
+  };
+  for (const auto& c : cases) {
+    const auto o = run_epa(c.args);
+    EXPECT_NE(o.exit_code, 0) << c.args << "\n" << o.output;
+    EXPECT_NE(o.output.find(c.says), std::string::npos) << c.args << "\n" << o.output;
+    EXPECT_EQ(o.output.find("1797693134862315"), std::string::npos) << c.args << "\n" << o.output;  // DBL_MAX in full
+  }
+}
+
 TEST_F(EpaCli, BadModelFileIsNamedInTheError) {
   std::ofstream(path("bad.toml")) << "schema = \"epa-model/1\"\nTs = 0.005\n[arx]\nA = [1.0, -0.5]\n";
   const auto o = run_epa("simulate --model " + path("bad.toml"));
