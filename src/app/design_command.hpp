@@ -23,6 +23,8 @@ struct DesignOptions {
 };
 
 void add_design_command(CLI::App& app, DesignOptions& options);
+// Exit status: 0; 1 on bad input; 3 when a branch's closed loop is unstable (said last on `err`;
+// the JSON is written all the same, for analysis, and --save stores nothing).
 int run_design(const DesignOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace epa::app

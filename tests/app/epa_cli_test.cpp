@@ -117,12 +117,29 @@ TEST_F(EpaCli, ResolvingThePaperEquationReportsIllConditioning) {
   EXPECT_NE(o.output.find("marginal"), std::string::npos) << o.output;  // root at z = 1
 }
 
+// A spec whose loop is stable on every branch (the README's example).
 TEST_F(EpaCli, DesignFromSpecFeedsSimulate) {
-  ASSERT_EQ(run_epa("design --overshoot 5 --settling 0.5 --observer-pole 0.5 --json " + path("d.json")).exit_code, 0);
+  ASSERT_EQ(run_epa("design --overshoot 0 --settling 0.8 --observer-pole 0.2 --json " + path("d.json")).exit_code, 0);
   const auto o = run_epa("simulate --controller pp-ngidz --steps 50 --design " + path("d.json") + " --json " + path("s.json"));
   ASSERT_EQ(o.exit_code, 0) << o.output;
   const auto j = read_json(path("s.json"));
   EXPECT_NEAR(j["results"][0]["ess_mm"].get<double>(), 0.0, 1.0);  // the designed loop reaches 50 mm
+}
+
+// A spec that is unstable where the dead zone's slopes apply (5 % in 0.5 s, observer pole 0.5:
+// left max |root| 1.07, right 1.32): exit 3, said last, the JSON written for analysis, and --save
+// stores nothing.
+TEST_F(EpaCli, AnUnstableDesignExitsThreeAndIsNeverSaved) {
+  const auto o = run_epa("design --overshoot 5 --settling 0.5 --observer-pole 0.5 --json " + path("d.json"));
+  EXPECT_EQ(o.exit_code, 3) << o.output;
+  EXPECT_NE(o.output.find("UNSTABLE: the closed loop is unstable on left (max |root| 1.06"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("right (max |root| 1.31"), std::string::npos) << o.output;
+  EXPECT_FALSE(read_json(path("d.json"))["closed_loop"][1]["jury_stable"].get<bool>());
+  const auto saved = run_epa("design --overshoot 5 --settling 0.5 --observer-pole 0.5 --save fast --db " + path("epa.db"));
+  EXPECT_EQ(saved.exit_code, 3) << saved.output;
+  EXPECT_NE(saved.output.find("--save: not stored"), std::string::npos) << saved.output;
+  const auto listed = run_epa("tuning --db " + path("epa.db") + " list");
+  EXPECT_EQ(listed.output.find("fast"), std::string::npos) << listed.output;
 }
 
 TEST_F(EpaCli, SpecAndTTogetherAreRefused) {
