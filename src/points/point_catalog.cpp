@@ -211,7 +211,7 @@ std::vector<PointDef> build() {
       {P::kMoveEss, "move_ess_mm", "mm", "last move: steady-state error", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.ess_mm; }},
       {P::kMoveOvershoot, "move_overshoot_pct", "%", "last move: overshoot", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.overshoot_pct; }},
       {P::kMoveEnd, "move_end", "", "last move: how it ended: 0 complete (its whole window), 1 cut short by a new target, 2 halted, "
-                                    "3 stopped (mode change), 4 fault; its metrics are over the samples it had",
+                                    "3 stopped (mode change), 4 fault, 5 controller switched; its metrics are over the samples it had",
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.last_move.end); }},
       // loop statistics and counters
       {P::kLoopWakeP50, "loop_wake_p50_us", "us", "scan cycle wake-up latency, median", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.loop.wake_p50_us; }},

@@ -17,6 +17,7 @@ enum class MoveEnd : std::uint8_t {
   kHalted = 2,    // a halt
   kStopped = 3,   // the mode changed (STOP, MANUAL) or the appliance shut down
   kFault = 4,     // a fault
+  kControllerSwitched = 5,  // another controller took over: the move is its first controller's alone
 };
 
 struct MoveResult {

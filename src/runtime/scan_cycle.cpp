@@ -108,6 +108,9 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
         if ((c.controller == control::ControllerKind::kPpTraj) != (law() == control::ControllerKind::kPpTraj))
           start_law_at_the_piston(tuning_.for_kind(c.controller));
         if (c.controller != law()) transfer_pending_ = mode_ == Mode::kRun;
+        // A move's record, metrics and run file belong to the controller that made it: a switch
+        // ends it here (the piston goes on to its target under the new law, not as a move).
+        if (c.controller != controller_ && moves_.active()) finish_move(MoveEnd::kControllerSwitched);
         controller_ = c.controller;
         profile_law_ = false;  // the law asked for runs from now on, a halt's hold included
         break;

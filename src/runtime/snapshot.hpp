@@ -19,7 +19,7 @@ struct MoveMetricsView {
   std::uint32_t number = 0;  // 0: no move finished yet
   double from_mm = 0, to_mm = 0;
   double rise_s = 0, settling_s = 0, ess_mm = 0, overshoot_pct = 0;  // NaN: never reached / never moved
-  std::uint8_t end = 0;      // MoveEnd: 0 complete, 1 cut short, 2 halted, 3 stopped, 4 fault
+  std::uint8_t end = 0;      // MoveEnd: 0 complete, 1 cut short, 2 halted, 3 stopped, 4 fault, 5 controller switched
 };
 
 struct TuningView {

@@ -275,6 +275,33 @@ TEST(Positioning, AMoveCutShortIsReportedAsCutShortWithItsOwnMetrics) {
   EXPECT_TRUE(std::isfinite(m.settling_s)) << "it settled before it was cut";
 }
 
+// A switch of controller mid-move ends the move there, filed under the controller that made it
+// (an outside walk-through found FF-IDZ's figures filed as PP's after a switch 2.5 s into a move).
+TEST(Positioning, ASwitchOfControllerEndsTheMoveUnderTheControllerThatMadeIt) {
+  Axis axis(100.0, ControllerKind::kPpFfidz);
+  axis.push(mode_command(Mode::kRun));
+  axis.push(setpoint_command(150.0));
+  axis.cycles(kCyclesPerSecond);
+  axis.push(controller_command(ControllerKind::kPp));
+  axis.cycles(1);
+  const auto& m = axis.snap().last_move;
+  EXPECT_EQ(m.number, 1u);
+  EXPECT_EQ(m.end, static_cast<std::uint8_t>(MoveEnd::kControllerSwitched));
+  RecordRequest r;
+  ASSERT_TRUE(axis.ch.record_requests.try_pop(r)) << "the move's run file was asked for";
+  EXPECT_EQ(r.controller, ControllerKind::kPpFfidz);
+  EXPECT_EQ(r.move.end, MoveEnd::kControllerSwitched);
+  EXPECT_NEAR(static_cast<double>(r.end - r.first), kCyclesPerSecond, 2.0) << "its samples are FF-IDZ's second";
+  axis.cycles(2 * kCyclesPerSecond);
+  EXPECT_EQ(axis.snap().moves, 1u) << "the rest under PP is not a move";
+  // A switch to the controller already running ends nothing.
+  axis.push(setpoint_command(200.0));
+  axis.cycles(10);
+  axis.push(controller_command(ControllerKind::kPp));
+  axis.cycles(1);
+  EXPECT_EQ(axis.snap().last_move.number, 1u);
+}
+
 TEST(Positioning, AResetBitClearsALatchedFault) {
   RuntimeConfig c;
   c.heartbeat_timeout_s = 0.05;  // nobody counts: RUN faults after 50 ms
