@@ -181,7 +181,7 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
   std::vector<const core::Run*> all_runs = train;
   all_runs.insert(all_runs.end(), heldout.begin(), heldout.end());
   d.noise_std_mm = estimate_noise_std_mm(all_runs, nominal.model.dead_zone);
-  d.noise_floor_mm = noise_floor_mm(nominal.model, d.noise_std_mm, o.horizon);
+  d.noise_floor_mm = std::max(o.min_floor_mm, noise_floor_mm(nominal.model, d.noise_std_mm, o.horizon));
 
   // 2. Forward selection over the structural effects, each fitted together with the nominal
   // parameters; its first round scores every candidate. An effect is accepted only while the gap
@@ -413,15 +413,17 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
   }
   d.unexplained = unexplained(d, o);
   // 8. The sensor's resolution: readings on a grid whose rounding error (step / sqrt(12)) is at
-  // least half the noise are a coarse sensor. A replay cannot predict the rounding, so this raises the
+  // least half the noise are a coarse sensor (a grid finer than min_floor_mm is the file's digits).
+  // A replay cannot predict the rounding, so this raises the
   // floor the gap can reach rather than shrinking the gap; the verdict uses that floor.
   const bool quantization_candidate =
       std::find(o.candidates.begin(), o.candidates.end(), EffectKind::kSensorQuantization) != o.candidates.end();
   // The noise estimate holds the rounding too, so a grid whose rounding is half of it is already
   // most of it.
   if (const auto step = reading_resolution_mm(all_runs);
-      step && quantization_candidate && *step / std::sqrt(12.0) >= 0.5 * d.noise_std_mm) {
-    d.noise_floor_mm = noise_floor_mm(nominal.model, std::hypot(d.noise_std_mm, *step / std::sqrt(12.0)), o.horizon);
+      step && quantization_candidate && *step >= o.min_floor_mm && *step / std::sqrt(12.0) >= 0.5 * d.noise_std_mm) {
+    d.noise_floor_mm =
+        std::max(o.min_floor_mm, noise_floor_mm(nominal.model, std::hypot(d.noise_std_mm, *step / std::sqrt(12.0)), o.horizon));
     std::snprintf(buf, sizeof buf, "readings lie on a %.4g mm grid, coarser than the noise: with its rounding the floor is %.3f mm",
                   *step, d.noise_floor_mm);
     say(buf);

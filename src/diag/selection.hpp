@@ -25,7 +25,8 @@
 //     and holding them nominal costs more than their chance threshold of the baseline gap (a
 //     parameter that only absorbs the residue of an effect's imperfect form is not a finding).
 //  8. Unexplained: a held-out gap left above unexplained_factor times the noise floor (the gap
-//     that sensor noise alone gives a perfect model, estimated from the runs at rest) and, when
+//     that sensor noise alone gives a perfect model, estimated from the runs at rest, and never
+//     below min_floor_mm) and, when
 //     effects are named, above unexplained_share of the baseline gap: a rig's effect never has
 //     the library's exact form, and the residue of the named effects' forms is theirs. Also when
 //     the readings move while the valve rests inside the dead band (rest_drift.hpp): no effect
@@ -51,6 +52,10 @@ struct DiagnosisOptions {
   double threshold_scale = 1.0;    // multiplies every chance threshold
   double confusable_ratio = 0.85;
   double unexplained_factor = 1.6;
+  // The noise floor is never below this: under 10 um a gap is finer than any position sensor of a
+  // pneumatic axis (the shipped ADC's count is 15 um), and the run files' own digits (0.1 um, 10 uV
+  // of valve command) leave a few um on noise-free recordings, which no effect is to be named for.
+  double min_floor_mm = 0.01;
   double unexplained_share = 1.0 / 3.0;  // with effects named: a gap left above this share of the baseline
   std::size_t pair_pool = 4;             // the best first-round candidates tried in pairs
   double refit_threshold_pct = 5.0;  // the re-fit must beat this reduction for gain/break points to be named

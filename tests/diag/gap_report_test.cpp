@@ -134,6 +134,23 @@ TEST_F(DiagnoseCli, ReadingsThatDriftWhileTheValveRestsLeaveTheGapUnexplainedAnd
   EXPECT_NE(j.at("verdict").at("text").get<std::string>().find("while the valve rests"), std::string::npos);
 }
 
+// Noise-free runs of the paper's own model, through run files: what is left is the files' digits
+// (0.1 um, 10 uV), which is neither a coarse sensor nor a significant gap (an outside walk-through
+// found `sensor_quantization` at 0.0001 mm and "a significant gap remains" at 0.004 mm).
+TEST_F(DiagnoseCli, NoiseFreeRunsOfItsOwnModelNameNothing) {
+  std::vector<std::string> files;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed)
+    files.push_back(write(epa::testing::make_run(epa::core::paper::model(), {}, {.closed_loop = seed != 2, .noise_std_mm = 0.0, .seed = seed}),
+                          "run" + std::to_string(seed) + ".csv"));
+  const auto o = epa::testing::run_epa("diagnose " + files[0] + " " + files[1] + " --holdout " + files[2] + " --json " + path("clean.json"));
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  std::ifstream in(path("clean.json"));
+  const json j = json::parse(in);
+  EXPECT_EQ(j.at("verdict").at("effects"), json::array()) << j.dump(1);
+  EXPECT_EQ(j.at("verdict").at("unexplained"), false) << j.dump(1);
+  EXPECT_GE(j.at("verdict").at("noise_floor_mm").get<double>(), 0.01) << j.dump(1);
+}
+
 TEST_F(DiagnoseCli, WithoutHeldOutRunsItCrossValidatesByRun) {
   const auto& d = fixture().data;
   const auto o = epa::testing::run_epa("diagnose " + write(d.train[0], "a.csv") + " " + write(d.train[1], "b.csv") + " " +
