@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "hal/daq.hpp"
 #include "runtime/mode.hpp"
 
 namespace epa::runtime {
@@ -19,6 +20,11 @@ struct FaultEvent {
   double position_mm = 0, setpoint_mm = 0;
   double valve_v = 0;        // the command applied when it happened (written in the cycle before)
   double sensor_v = 0;       // the reading that cycle (NaN: none yet)
+  // I/O in a row up to it: failed reads and writes, and how the last of each went (io-errors'
+  // cause: a module that does not answer times out; a link that is down or a module that answers
+  // with an error reports one).
+  int failed_reads = 0, failed_writes = 0;
+  hal::IoStatus last_read = hal::IoStatus::kOk, last_write = hal::IoStatus::kOk;
 };
 static_assert(std::is_trivially_copyable_v<FaultEvent>);
 

@@ -5,9 +5,26 @@
 
 namespace epa::runtime {
 
+namespace {
+
+// "3 reads in a row timed out" / "the last of 3 writes in a row reported an error".
+std::string failed_io(int count, const char* what, hal::IoStatus last) {
+  const std::string how = last == hal::IoStatus::kTimeout ? "timed out (no answer in time)" : "reported an error (a link down, a refused connection, an exception answer or an undecodable value)";
+  return std::to_string(count) + " " + what + " in a row failed, the last " + how;
+}
+
+}  // namespace
+
 FaultRecord fault_record(const FaultEvent& e, std::int64_t time_ms) {
-  return {time_ms, e.code, e.mode, e.position_mm, e.setpoint_mm, e.valve_v, e.sensor_v, std::string(to_string(e.code)),
-          std::string(describe(e.code))};
+  std::string text(describe(e.code));
+  if (e.code == FaultCode::kIoErrors) {  // which exchange failed, and how: what the engineer checks first
+    std::string cause;
+    if (e.failed_reads > 0) cause = failed_io(e.failed_reads, e.failed_reads == 1 ? "read" : "reads", e.last_read);
+    if (e.failed_writes > 0)
+      cause += (cause.empty() ? "" : "; ") + failed_io(e.failed_writes, e.failed_writes == 1 ? "write" : "writes", e.last_write);
+    if (!cause.empty()) text += ": " + cause;
+  }
+  return {time_ms, e.code, e.mode, e.position_mm, e.setpoint_mm, e.valve_v, e.sensor_v, std::string(to_string(e.code)), std::move(text)};
 }
 
 std::int64_t fault_time_ms(const FaultEvent& e, double loop_now_s, std::int64_t now_ms) {

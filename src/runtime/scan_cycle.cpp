@@ -332,7 +332,8 @@ void ScanCycle::enter_fault(FaultCode code) noexcept {
   // The cause, as it is before anything below changes it: a reset in the next cycle clears the
   // snapshot's fault, never this. A full ring drops it, counted.
   if (!ch_.fault_events.try_push({cycle_, static_cast<double>(cycle_) * config_.period_s, code, mode_, position_mm_,
-                                  setpoint_mm_, valve_v_, sensor_v_}))
+                                  setpoint_mm_, valve_v_, sensor_v_, consecutive_read_errors_, consecutive_write_errors_,
+                                  last_read_status_, last_write_status_}))
     ++snap_.fault_events_dropped;
   if (moves_.active()) finish_move(MoveEnd::kFault);
   jog_law_ = profile_law_ = false;
@@ -347,6 +348,7 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
   apply_commands(now_ns);
 
   const hal::SensorReading reading = daq_.read_sensor();
+  last_read_status_ = reading.status;
   const bool read_ok = reading.status == hal::IoStatus::kOk;
   if (read_ok) {
     previous_sensor_v_ = sensor_v_;
@@ -417,7 +419,8 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
     case Mode::kFault: valve_v_ = config_.safe_valve_v; controller_v_ = 0.0; break;
   }
 
-  const bool write_ok = daq_.write_valve(valve_v_) == hal::IoStatus::kOk;
+  last_write_status_ = daq_.write_valve(valve_v_);
+  const bool write_ok = last_write_status_ == hal::IoStatus::kOk;
   io_ok_ = read_ok && write_ok;
   if (write_ok) {
     consecutive_write_errors_ = 0;

@@ -122,6 +122,7 @@ class ScanCycle {
   double sensor_v_ = 0.0, position_mm_ = 0.0, valve_v_ = 0.0, controller_v_ = 0.0;
   bool saturated_ = false, io_ok_ = true;
   int consecutive_read_errors_ = 0, consecutive_write_errors_ = 0, consecutive_overruns_ = 0;
+  hal::IoStatus last_read_status_ = hal::IoStatus::kOk, last_write_status_ = hal::IoStatus::kOk;  // for a fault's cause
   std::int64_t following_error_since_ns_ = -1;
   std::int64_t frozen_since_ns_ = -1;
   // RUN or MANUAL entered with the piston outside the soft limits (after a soft-limit fault and its

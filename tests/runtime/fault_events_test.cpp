@@ -88,6 +88,36 @@ TEST_F(FaultEvents, AFaultResetInTheNextCycleIsInTheRingWithItsCause) {
   EXPECT_EQ(snap().fault_events_dropped, 0u);
 }
 
+// io-errors says which exchange failed and how (an outside walk-through had only "the DAQ failed
+// to read or write several cycles in a row" when the module's process was killed).
+TEST_F(FaultEvents, AnIoFaultSaysWhichExchangesFailedAndHow) {
+  start();
+  ASSERT_TRUE(drain().empty());
+  daq_.read_status = hal::IoStatus::kTimeout;  // the module stops answering
+  cycles(3);                                   // the shipped 3 in a row
+  ASSERT_EQ(snap().mode, Mode::kFault);
+  auto events = drain();
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].failed_reads, 3);
+  EXPECT_EQ(events[0].last_read, hal::IoStatus::kTimeout);
+  const FaultRecord timed_out = fault_record(events[0], 5000);
+  EXPECT_EQ(timed_out.text, std::string(describe(FaultCode::kIoErrors)) + ": 3 reads in a row failed, the last timed out (no answer in time)");
+
+  daq_.read_status = hal::IoStatus::kOk;
+  ASSERT_TRUE(ch_.commands.try_push(reset_command()));
+  cycles(1);
+  ASSERT_TRUE(ch_.commands.try_push(mode_command(Mode::kRun)));
+  daq_.write_status = hal::IoStatus::kError;  // the link is down for writes
+  cycles(5);
+  ASSERT_EQ(snap().mode, Mode::kFault);
+  events = drain();
+  ASSERT_EQ(events.size(), 1u);
+  const FaultRecord refused = fault_record(events[0], 5000);
+  EXPECT_EQ(refused.code, FaultCode::kIoErrors);
+  EXPECT_NE(refused.text.find("writes in a row failed, the last reported an error"), std::string::npos) << refused.text;
+  EXPECT_EQ(refused.text.find("reads"), std::string::npos) << refused.text;
+}
+
 TEST_F(FaultEvents, ThreeQuickFaultsInARowGiveThreeEventsInOrder) {
   start();
   const double run_valve_v = daq_.last_written_v;
