@@ -133,14 +133,10 @@ core::Result<ControlSetup> prepare_control(config::ApplianceConfig& c, const std
   if (!polynomials) return polynomials.error();
   const bool paper = c.model_path.empty() && c.design_path.empty();
   const auto seed = make_seed(paper ? "paper" : "initial", *plant_model, *polynomials, c.runtime.controller, c.lc_mm, c.valve_limit_v);
-  auto store = open_tuning_store(c.store_path, seed, persisted_points(map));
+  auto store = open_tuning_store(c.store_path, seed, persisted_points(map), c.runtime.period_s);
   if (!store) return store.error();
 
-  const core::HammersteinModel& model = store->model.model;
-  if (std::abs(model.Ts - c.runtime.period_s) > 1e-12)
-    return core::invalid_argument("loop.period_s " + core::format_number(c.runtime.period_s) + " s differs from Ts " +
-                                  core::format_number(model.Ts) + " s of model '" + store->model.name + "' of tuning set '" +
-                                  store->set.name + "' in " + c.store_path);
+  const core::HammersteinModel& model = store->model.model;  // its Ts is the loop's (load_active_tuning)
   c.runtime.mm_per_volt = model.mm_per_volt;
   c.runtime.controller = store->set.controller;
   c.runtime.start_fault = store->start_fault;

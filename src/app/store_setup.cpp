@@ -30,7 +30,7 @@ store::StoreSeed make_seed(const std::string& name, const core::ModelFile& model
 }
 
 core::Result<StoreStartup> open_tuning_store(const std::string& path, const store::StoreSeed& seed,
-                                             std::set<points::PointId> persisted_points) {
+                                             std::set<points::PointId> persisted_points, double loop_period_s) {
   auto opened = store::open_store(path, seed, core::unix_time_ms());
   if (!opened) return core::Error{opened.error().code, "store: " + opened.error().message};
   StoreStartup out;
@@ -44,7 +44,7 @@ core::Result<StoreStartup> open_tuning_store(const std::string& path, const stor
     out.notes.push_back("store: migrated " + path + " from schema version " + std::to_string(opened->migrated_from) +
                            " to " + std::to_string(store::kSchemaVersion));
   }
-  auto loaded = store::load_active_tuning(opened->db);
+  auto loaded = store::load_active_tuning(opened->db, loop_period_s);
   if (!loaded) return core::Error{loaded.error().code, "store: " + loaded.error().message};
   for (const auto& refusal : loaded->refused) out.warnings.push_back("store: refused " + refusal + "; using the next good set");
   auto retained = store::RetainedPoints(opened->db).all();

@@ -42,6 +42,6 @@ store::StoreSeed make_seed(const std::string& name, const core::ModelFile& model
 
 // Errors: a database from a newer epa, a file that cannot be created, no valid tuning set.
 core::Result<StoreStartup> open_tuning_store(const std::string& path, const store::StoreSeed& seed,
-                                             std::set<points::PointId> persisted_points);
+                                             std::set<points::PointId> persisted_points, double loop_period_s);
 
 }  // namespace epa::app

@@ -9,6 +9,7 @@
 #include "core/atomic_file.hpp"
 #include "core/format.hpp"
 #include "core/text_file.hpp"
+#include "core/toml_keys.hpp"
 #include "core/toml_number.hpp"
 
 namespace epa::core {
@@ -48,6 +49,11 @@ Result<Polynomial> array_at(const toml::table& t, const char* key, const std::st
 
 // The [stick_slip] table: every field, by its name (a reader that knows the table wants it whole).
 Result<StickSlipParams> stick_slip_at(const toml::table& t, const std::string& src) {
+  if (auto s = only_keys(t, {"break_right_v", "break_left_v", "speed_right_mm_s_per_v", "speed_left_mm_s_per_v", "spring_rad_s",
+                             "damping_ratio", "coulomb_mm", "static_mm", "spool_lag_s", "delay_samples"},
+                         src + ": [stick_slip]");
+      !s)
+    return s.error();
   StickSlipParams p;
   struct Field {
     const char* key;
@@ -93,6 +99,8 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
   if (!schema) return parse_error(src + ": schema is missing (expected \"" + kSchema + "\")");
   if (*schema != kSchema) return parse_error(src + ": schema \"" + *schema + "\" is not supported (expected \"" + kSchema + "\")");
 
+  if (auto s = only_keys(root, {"schema", "Ts", "mm_per_volt", "source", "axis_model", "arx", "dead_zone", "stick_slip"}, src); !s)
+    return s.error();
   ModelFile f;
   auto Ts = number_at(root, "", "Ts", src);
   if (!Ts) return Ts.error();
@@ -106,6 +114,7 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
 
   const auto* arx = root["arx"].as_table();
   if (!arx) return parse_error(src + ": table [arx] is missing");
+  if (auto s = only_keys(*arx, {"A", "B"}, src + ": [arx]"); !s) return s.error();
   auto A = array_at(*arx, "A", src);
   if (!A) return A.error();
   auto B = array_at(*arx, "B", src);
@@ -115,6 +124,7 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
 
   const auto* dz = root["dead_zone"].as_table();
   if (!dz) return parse_error(src + ": table [dead_zone] is missing");
+  if (auto s = only_keys(*dz, {"m_r", "m_l", "b_r", "b_l"}, src + ": [dead_zone]"); !s) return s.error();
   double* fields[] = {&f.model.dead_zone.m_r, &f.model.dead_zone.m_l, &f.model.dead_zone.b_r, &f.model.dead_zone.b_l};
   const char* names[] = {"m_r", "m_l", "b_r", "b_l"};
   for (int i = 0; i < 4; ++i) {

@@ -1,13 +1,16 @@
 #include "store/active_tuning.hpp"
 
 #include <algorithm>
+#include <cmath>
+
+#include "core/format.hpp"
 
 #include "store/model_table.hpp"
 #include "store/tuning_set_table.hpp"
 
 namespace epa::store {
 
-core::Result<LoadedTuning> load_active_tuning(Database& db) {
+core::Result<LoadedTuning> load_active_tuning(Database& db, std::optional<double> loop_period_s) {
   TuningSetTable sets(db);
   ModelTable models(db);
   auto active = sets.active_id();
@@ -40,6 +43,12 @@ core::Result<LoadedTuning> load_active_tuning(Database& db) {
     }
     if (auto s = validate(*set, model->model); !s) {
       out.refused.push_back(s.error().message);
+      continue;
+    }
+    if (loop_period_s && std::abs(model->model.Ts - *loop_period_s) > 1e-12) {
+      out.refused.push_back("tuning set '" + set->name + "': its model '" + model->name + "' has Ts " +
+                            core::format_number(model->model.Ts) + " s, and the loop runs every " +
+                            core::format_number(*loop_period_s) + " s (loop.period_s)");
       continue;
     }
     if (!*last_good || **last_good != id)

@@ -1,12 +1,12 @@
 #include "store/tuning_file.hpp"
 
 #include <cmath>
-#include <set>
 #include <sstream>
 #include <toml++/toml.h>
 
 #include "core/format.hpp"
 #include "core/model_file.hpp"
+#include "core/toml_keys.hpp"
 #include "core/toml_number.hpp"
 
 namespace epa::store {
@@ -22,13 +22,6 @@ std::string quoted(const std::string& s) {
   std::ostringstream out;
   out << toml::value<std::string>(s);  // TOML string escaping by the library
   return out.str();
-}
-
-core::Status only_keys(const toml::table& t, const std::set<std::string>& allowed, const std::string& where) {
-  for (const auto& [key, node] : t)
-    if (!allowed.contains(std::string(key.str())))
-      return core::parse_error(where + ": unknown key '" + std::string(key.str()) + "'");
-  return core::ok();
 }
 
 core::Result<double> number(const toml::table& t, const char* key, const std::string& where) {
@@ -94,7 +87,7 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
   const auto schema = root["schema"].value<std::string>();
   if (!schema) return core::parse_error(src + ": schema is missing (expected \"" + kSchema + "\")");
   if (*schema != kSchema) return core::parse_error(src + ": schema \"" + *schema + "\" is not supported (expected \"" + kSchema + "\")");
-  if (auto s = only_keys(root, {"schema", "name", "source", "controller", "lc_mm", "valve_limit_v", "design", "rst", "dead_zone", "trajectory", "model"}, src); !s)
+  if (auto s = core::only_keys(root, {"schema", "name", "source", "controller", "lc_mm", "valve_limit_v", "design", "rst", "dead_zone", "trajectory", "model"}, src); !s)
     return s.error();
 
   TuningFile f;
@@ -115,7 +108,7 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
 
   const auto* rst = root["rst"].as_table();
   if (!rst) return core::parse_error(src + ": table [rst] is missing");
-  if (auto s = only_keys(*rst, {"F", "G", "H"}, src + ": [rst]"); !s) return s.error();
+  if (auto s = core::only_keys(*rst, {"F", "G", "H"}, src + ": [rst]"); !s) return s.error();
   core::Polynomial* polys[] = {&t.F, &t.G, &t.H};
   const char* names[] = {"F", "G", "H"};
   for (int i = 0; i < 3; ++i) {
@@ -125,7 +118,7 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
   }
   const auto* dz = root["dead_zone"].as_table();
   if (!dz) return core::parse_error(src + ": table [dead_zone] is missing");
-  if (auto s = only_keys(*dz, {"m_r", "m_l", "b_r", "b_l"}, src + ": [dead_zone]"); !s) return s.error();
+  if (auto s = core::only_keys(*dz, {"m_r", "m_l", "b_r", "b_l"}, src + ": [dead_zone]"); !s) return s.error();
   double* fields[] = {&t.dead_zone.m_r, &t.dead_zone.m_l, &t.dead_zone.b_r, &t.dead_zone.b_l};
   const char* dz_names[] = {"m_r", "m_l", "b_r", "b_l"};
   for (int i = 0; i < 4; ++i) {
@@ -146,7 +139,7 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
 
   const auto* model = root["model"].as_table();
   if (!model) return core::parse_error(src + ": table [model] is missing");
-  if (auto s = only_keys(*model, {"name", "fit", "source", "Ts", "mm_per_volt", "arx", "dead_zone"}, src + ": [model]"); !s)
+  if (auto s = core::only_keys(*model, {"name", "fit", "source", "Ts", "mm_per_volt", "arx", "dead_zone"}, src + ": [model]"); !s)
     return s.error();
   f.model.name = (*model)["name"].value_or(std::string());
   if (f.model.name.empty()) return core::parse_error(src + ": [model] name is missing");

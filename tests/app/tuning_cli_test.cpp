@@ -93,6 +93,28 @@ TEST_F(TuningCli, AnInvalidActiveSetIsRefusedAndTheLastGoodOneRuns) {
   EXPECT_NE(s.output.find("tuning set 'paper'"), std::string::npos) << s.output;
 }
 
+// A set whose model was identified at another sample period is refused at start like any invalid
+// set, and the last good one runs (an outside walk-through's import at Ts 0.01 s had stopped the
+// appliance from starting at all).
+TEST_F(TuningCli, AnActiveSetAtAnotherSamplePeriodIsRefusedAndTheLastGoodOneRuns) {
+  ASSERT_EQ(serve().exit_code, 0);
+  ASSERT_EQ(tuning("export paper --out " + path("p.toml")).exit_code, 0);
+  std::ifstream in(path("p.toml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string toml = text.str();
+  const auto at = toml.find("Ts = 0.005");
+  ASSERT_NE(at, std::string::npos) << toml;
+  toml.replace(at, 10, "Ts = 0.01");
+  std::ofstream(path("slow.toml")) << toml;
+  ASSERT_EQ(tuning("import " + path("slow.toml") + " --name slow --activate").exit_code, 0);
+  const auto s = serve();
+  ASSERT_EQ(s.exit_code, 0) << s.output;
+  EXPECT_NE(s.output.find("refused tuning set 'slow': its model"), std::string::npos) << s.output;
+  EXPECT_NE(s.output.find("has Ts 0.01 s, and the loop runs every 0.005 s"), std::string::npos) << s.output;
+  EXPECT_NE(s.output.find("tuning set 'paper'"), std::string::npos) << s.output;
+}
+
 TEST_F(TuningCli, ADamagedDatabaseIsMovedAsideAndTheApplianceStartsInFault) {
   std::ofstream(path("epa.db"), std::ios::binary) << std::string(4096, 'x');
   const auto s = serve();

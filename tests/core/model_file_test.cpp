@@ -98,6 +98,25 @@ TEST(ModelFile, NumbersOutsideAnyPhysicalRangeAreRefusedNamingKeyAndLine) {
   }
 }
 
+// A misspelt key is refused naming it and its line, in every table: an outside walk-through's
+// `mm_per_vlot = 25` had run on the default 50 mm/V, and `b_rx` in [dead_zone] had been ignored.
+TEST(ModelFile, AMisspeltKeyIsRefusedNamingItAndItsLine) {
+  const std::string text(kValidText);
+  for (const auto& [from, to, expected] :
+       {std::tuple{"Ts = 0.005", "Ts = 0.005\nmm_per_vlot = 25.0", "m.toml: unknown key 'mm_per_vlot' (line 3;"},
+        std::tuple{"Ts = 0.005", "Ts = 0.005\naxis_modle = \"stick-slip\"", "m.toml: unknown key 'axis_modle'"},
+        std::tuple{"[dead_zone]", "[dead_zone]\nb_rx = 9.0", "m.toml: [dead_zone]: unknown key 'b_rx'"},
+        std::tuple{"[arx]", "[arx]\nC = [1.0]", "m.toml: [arx]: unknown key 'C'"}}) {
+    std::string bad = text;
+    const auto at = bad.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    bad.replace(at, std::string(from).size(), to);
+    const auto r = parse_model_toml(bad, "m.toml");
+    ASSERT_FALSE(r.has_value()) << to;
+    EXPECT_NE(r.error().message.find(expected), std::string::npos) << r.error().message;
+  }
+}
+
 TEST(ModelFile, IntegerValuesAreAcceptedAsNumbers) {
   // A hand-written file may well say "mm_per_volt = 50" or "b_r = 1".
   std::string text = replaced(kValidText, "mm_per_volt = 50.0", "mm_per_volt = 50");
