@@ -1,6 +1,8 @@
 #include "app/diagnose_command.hpp"
 
 #include <chrono>
+#include <filesystem>
+#include <map>
 #include <optional>
 
 #include "app/cli_checks.hpp"
@@ -63,6 +65,17 @@ int run_diagnose(const DiagnoseOptions& o, std::ostream& out, std::ostream& err)
   }
   if (o.holdout.empty() && o.runs.size() < 2)
     return fail("without --holdout the runs are cross-validated one against the others: give at least 2 runs, or --holdout FILE");
+  // A run given twice would be fitted twice, or scored on the very data it was fitted on.
+  std::map<std::filesystem::path, std::string> seen;
+  for (const auto* files : {&o.runs, &o.holdout})
+    for (const auto& file : *files) {
+      std::error_code ec;
+      const auto [at, fresh] = seen.emplace(std::filesystem::weakly_canonical(file, ec), file);
+      if (!fresh) return fail("the run " + file + " is given twice (also as " + at->second + "): each run is fitted or scored once");
+    }
+  if (o.runs.size() < 4)  // the chance thresholds and tolerances come from 4 training runs and 2 held out
+    err << "epa diagnose: note: " << o.runs.size() << " training run(s); the chance thresholds are calibrated on 4, so with "
+        << "fewer an effect can be named by chance (record more runs to be sure)\n";
   diag::DiagnosisOptions options;
   options.horizon = o.horizon;
   if (!o.effects.empty()) {

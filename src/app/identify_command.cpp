@@ -17,6 +17,7 @@
 #include "ident/order_selection.hpp"
 #include "ident/ramp_reading.hpp"
 #include "ident/stick_slip_fit.hpp"
+#include "store/store_file.hpp"
 
 namespace epa::app {
 
@@ -148,6 +149,9 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   const ident::OrderSearch search{.na = *na, .nb = *nb, .nk = *nk, .tolerance_pct = o.tolerance_pct};
   const auto nesting = nesting_orders(search);
   if (!nesting) return fail(nesting.error().message);
+  // A store that --save cannot use is said before the fit, not after it with the model file written.
+  if (!o.save_name.empty())
+    if (auto db = store::open_existing_store(o.db_path); !db) return fail("--save: " + db.error().message);
 
   std::optional<double> Ts;
   out << "Runs:\n";

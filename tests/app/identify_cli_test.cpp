@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -284,6 +285,18 @@ TEST_F(IdentifyCli, TheSameSeedGivesTheSameModelFile) {
   sa << a.rdbuf();
   sb << b.rdbuf();
   EXPECT_EQ(sa.str(), sb.str());
+}
+
+// --save into a store that is not there is refused before the fit, and no model file is left
+// (an outside walk-through met the refusal after a whole fit, with the model file written).
+TEST_F(IdentifyCli, SaveIntoAMissingStoreIsRefusedBeforeTheFit) {
+  const auto est = excite("est.csv", 4, 30);
+  const auto o = run_epa("identify " + est + " --na 3 --nb 3 --nk 1 --out " + path("m.toml") + " --save rig --db " +
+                         path("missing.db") + kSmallBudget);
+  EXPECT_EQ(o.exit_code, 1) << o.output;
+  EXPECT_NE(o.output.find("--save: no database at " + path("missing.db")), std::string::npos) << o.output;
+  EXPECT_EQ(o.output.find("Identified model"), std::string::npos) << "the fit ran first:\n" << o.output;
+  EXPECT_FALSE(std::filesystem::exists(path("m.toml")));
 }
 
 TEST_F(IdentifyCli, BadRunsGetAnErrorThatSaysWhatToDo) {

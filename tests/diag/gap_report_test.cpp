@@ -151,6 +151,19 @@ TEST_F(DiagnoseCli, NoiseFreeRunsOfItsOwnModelNameNothing) {
   EXPECT_GE(j.at("verdict").at("noise_floor_mm").get<double>(), 0.01) << j.dump(1);
 }
 
+// A run given twice is refused naming it; fewer than 4 training runs get a note that an effect
+// may then be named by chance (an outside walk-through's two runs had named a spurious ceiling).
+TEST_F(DiagnoseCli, ARunGivenTwiceIsRefusedAndFewRunsGetANote) {
+  const auto& d = fixture().data;
+  const std::string a = write(d.train[0], "a.csv"), b = write(d.train[1], "b.csv");
+  const auto twice = epa::testing::run_epa("diagnose " + a + " " + b + " --holdout " + path("./a.csv"));
+  EXPECT_EQ(twice.exit_code, 1) << twice.output;
+  EXPECT_NE(twice.output.find("the run " + path("./a.csv") + " is given twice (also as " + a + ")"), std::string::npos) << twice.output;
+  const auto few = epa::testing::run_epa("diagnose " + a + " " + b + " --holdout " + write(d.heldout[0], "c.csv"));
+  EXPECT_EQ(few.exit_code, 0) << few.output;
+  EXPECT_NE(few.output.find("note: 2 training run(s); the chance thresholds are calibrated on 4"), std::string::npos) << few.output;
+}
+
 TEST_F(DiagnoseCli, WithoutHeldOutRunsItCrossValidatesByRun) {
   const auto& d = fixture().data;
   const auto o = epa::testing::run_epa("diagnose " + write(d.train[0], "a.csv") + " " + write(d.train[1], "b.csv") + " " +
@@ -193,7 +206,7 @@ TEST_F(DiagnoseCli, BadInputIsNamed) {
   auto o = epa::testing::run_epa("diagnose " + a + " --json -");
   EXPECT_EQ(o.exit_code, 1);
   EXPECT_NE(o.output.find("give at least 2 runs, or --holdout"), std::string::npos) << o.output;
-  o = epa::testing::run_epa("diagnose " + a + " --holdout " + a + " --effects valve_lag,wind --json -");
+  o = epa::testing::run_epa("diagnose " + a + " --holdout " + write(d.train[1], "b.csv") + " --effects valve_lag,wind --json -");
   EXPECT_EQ(o.exit_code, 1);
   EXPECT_NE(o.output.find("wind"), std::string::npos) << o.output;
   epa::core::Run other = d.train[1];
