@@ -11,6 +11,7 @@
 #include "app/appliance_http.hpp"
 #include "app/cli_checks.hpp"
 #include "app/output_file.hpp"
+#include "commission/commission_spec.hpp"
 #include "core/text_file.hpp"
 
 namespace epa::app {
@@ -48,6 +49,9 @@ int run_commission(const CommissionOptions& o, std::ostream& out, std::ostream& 
   if (!o.spec_path.empty()) {
     auto text = core::read_text_file(o.spec_path, "commission spec");
     if (!text) return fail(text.error().message);
+    // Read here first, so that a file that is no spec is named as the file; the appliance checks
+    // the values against its own limits.
+    if (auto parsed = commission::parse_commission_spec(*text); !parsed) return fail(o.spec_path + ": " + parsed.error().message);
     spec = *text;
   }
   auto made = appliance_client(o.url);
@@ -56,7 +60,7 @@ int run_commission(const CommissionOptions& o, std::ostream& out, std::ostream& 
   const httplib::Headers auth = bearer(o.token);
 
   auto started = client.Post("/api/commission", auth, spec, "application/json");
-  if (!started || started->status != 202) return fail("the appliance refused to start: " + http_failure(started, o.url));
+  if (!started || started->status != 202) return fail("the appliance did not start the commissioning: " + http_failure(started, o.url));
   out << "commissioning started on " << o.url << (o.spec_path.empty() ? " with the default spec" : " with " + o.spec_path) << "\n";
 
   auto* previous = std::signal(SIGINT, on_interrupt);

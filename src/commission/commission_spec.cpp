@@ -77,8 +77,15 @@ core::Status CommissionSpec::validate(double lo_mm, double hi_mm) const {
 }
 
 core::Result<CommissionSpec> parse_commission_spec(const std::string& text) {
-  const auto j = nlohmann::json::parse(text, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) return core::parse_error("commission spec: not a JSON object");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {  // its what() says where: "... at line 1, column 22: ..."
+    const std::string what = e.what();
+    const auto at = what.find("parse error");
+    return core::parse_error("commission spec: not valid JSON: " + (at == std::string::npos ? what : what.substr(at)));
+  }
+  if (!j.is_object()) return core::parse_error("commission spec: a JSON object is expected, not " + std::string(j.type_name()));
   static const std::set<std::string> known = {"excitation_runs", "excitation_s", "seed", "amplitude_max_v", "controller",
                                               "overshoot_pct", "settling_s", "observer_pole", "moves_mm", "move_hold_s",
                                               "limits", "robust_gain", "robust_breakpoint_v", "robust_limits", "name"};

@@ -227,6 +227,16 @@ TEST(CommissionSequence, AFailedIdentificationLeavesEverythingAsItWas) {
   EXPECT_TRUE(out.new_set.empty());
 }
 
+// Text that is no JSON says where it breaks; JSON that is no object says what it is (both were
+// "not a JSON object", for a truncated spec and for a TOML file alike).
+TEST(CommissionSpec, TextThatIsNoSpecSaysWhatItIs) {
+  const std::string truncated = parse_commission_spec(R"({"excitation_runs": 2,)").error().message;
+  EXPECT_NE(truncated.find("commission spec: not valid JSON: parse error at line 1, column"), std::string::npos) << truncated;
+  const std::string toml = parse_commission_spec("excitation_runs = 2\n").error().message;
+  EXPECT_NE(toml.find("not valid JSON"), std::string::npos) << toml;
+  EXPECT_EQ(parse_commission_spec("[1, 2]").error().message, "commission spec: a JSON object is expected, not array");
+}
+
 TEST(CommissionSpec, UnknownKeysAndOutOfRangeValuesAreNamed) {
   EXPECT_NE(parse_commission_spec(R"({"excitation_s": 1})").error().message.find("excitation_s"), std::string::npos);
   EXPECT_NE(parse_commission_spec(R"({"colour": 1})").error().message.find("colour"), std::string::npos);
