@@ -132,14 +132,18 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
     }
   }
 
-  char summary[256];
-  std::snprintf(summary, sizeof summary, "Step responses: model %s, controller %s, Ts = %g s, %g s per run, l_c = %g mm, sensor noise %g mm\n",
-                model_file->source.c_str(), polynomials->source.c_str(), model.Ts, o.duration_s, o.lc_mm, o.noise_mm);
-  out << summary;
-  std::snprintf(summary, sizeof summary, "Plant: %s, from rest at %g mm; gain x%g, dead band %+g V each side, delay %zu samples, valve lag %g s\n\n",
-                physics ? ("physics (" + (o.physics_config.empty() ? std::string("built-in parameters") : o.physics_config) + ")").c_str()
-                        : stick_slip ? "the model's stick-slip table" : "the model", o.start_mm, o.gain_factor, o.break_point_error_v, o.delay_samples, o.valve_lag_s);
-  out << summary;
+  // Streamed, not through a fixed buffer: the model's and the design's sources are free text (a
+  // 256-byte buffer cut the line and its newline: "20 s per run,Plant: ...").
+  using core::format_number;
+  out << "Step responses: model " << model_file->source << ", controller " << polynomials->source << ", Ts = " << format_number(model.Ts)
+      << " s, " << format_number(o.duration_s) << " s per run, l_c = " << format_number(o.lc_mm) << " mm, sensor noise "
+      << format_number(o.noise_mm) << " mm\n";
+  out << "Plant: "
+      << (physics ? "physics (" + (o.physics_config.empty() ? std::string("built-in parameters") : o.physics_config) + ")"
+                  : std::string(stick_slip ? "the model's stick-slip table" : "the model"))
+      << ", from rest at " << format_number(o.start_mm) << " mm; gain x" << format_number(o.gain_factor) << ", dead band "
+      << (o.break_point_error_v >= 0 ? "+" : "") << format_number(o.break_point_error_v) << " V each side, delay " << o.delay_samples
+      << " samples, valve lag " << format_number(o.valve_lag_s) << " s\n\n";
   print_table1_comparison(out, cases);
 
   if (!o.out_dir.empty()) {
