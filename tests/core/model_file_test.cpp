@@ -81,39 +81,32 @@ TEST(ModelFile, ValidTextParsesToTheDocumentedFields) {
   EXPECT_EQ(file->source, "hand-written test model");
 }
 
+// The valid text with `from` replaced by `to` is refused, the message holding `expected`.
+void expect_refused(const std::string& from, const std::string& to, const std::string& expected) {
+  const auto r = parse_model_toml(replaced(kValidText, from, to), "m.toml");
+  ASSERT_FALSE(r.has_value()) << to;
+  EXPECT_NE(r.error().message.find(expected), std::string::npos) << r.error().message;
+}
+
 // Every number is bounded: 1e300, NaN and infinities are refused naming the key and its line.
 TEST(ModelFile, NumbersOutsideAnyPhysicalRangeAreRefusedNamingKeyAndLine) {
-  const std::string text(kValidText);
   for (const auto& [from, to, expected] :
        {std::tuple{"Ts = 0.005", "Ts = 1e300", "Ts 1e+300 is outside [-1e6, 1e6] (line "},
         std::tuple{"Ts = 0.005", "Ts = nan", "Ts nan is outside"},
         std::tuple{"-0.9094", "-inf", "A[1] -inf is outside"}}) {
-    std::string bad = text;
-    const auto at = bad.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    bad.replace(at, std::string(from).size(), to);
-    const auto r = parse_model_toml(bad, "m.toml");
-    ASSERT_FALSE(r.has_value()) << to;
-    EXPECT_NE(r.error().message.find(expected), std::string::npos) << r.error().message;
+    expect_refused(from, to, expected);
   }
 }
 
 // A misspelt key is refused naming it and its line, in every table: an outside walk-through's
 // `mm_per_vlot = 25` had run on the default 50 mm/V, and `b_rx` in [dead_zone] had been ignored.
 TEST(ModelFile, AMisspeltKeyIsRefusedNamingItAndItsLine) {
-  const std::string text(kValidText);
   for (const auto& [from, to, expected] :
        {std::tuple{"Ts = 0.005", "Ts = 0.005\nmm_per_vlot = 25.0", "m.toml: unknown key 'mm_per_vlot' (line 3;"},
         std::tuple{"Ts = 0.005", "Ts = 0.005\naxis_modle = \"stick-slip\"", "m.toml: unknown key 'axis_modle'"},
         std::tuple{"[dead_zone]", "[dead_zone]\nb_rx = 9.0", "m.toml: [dead_zone]: unknown key 'b_rx'"},
         std::tuple{"[arx]", "[arx]\nC = [1.0]", "m.toml: [arx]: unknown key 'C'"}}) {
-    std::string bad = text;
-    const auto at = bad.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    bad.replace(at, std::string(from).size(), to);
-    const auto r = parse_model_toml(bad, "m.toml");
-    ASSERT_FALSE(r.has_value()) << to;
-    EXPECT_NE(r.error().message.find(expected), std::string::npos) << r.error().message;
+    expect_refused(from, to, expected);
   }
 }
 
