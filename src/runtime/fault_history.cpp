@@ -7,9 +7,11 @@ namespace epa::runtime {
 
 namespace {
 
-// "3 reads in a row timed out" / "the last of 3 writes in a row reported an error".
+// "3 reads in a row failed, the last timed out (no answer in time)".
 std::string failed_io(int count, const char* what, hal::IoStatus last) {
-  const std::string how = last == hal::IoStatus::kTimeout ? "timed out (no answer in time)" : "reported an error (a link down, a refused connection, an exception answer or an undecodable value)";
+  const std::string how = last == hal::IoStatus::kTimeout
+                              ? "timed out (no answer in time)"
+                              : "reported an error (a link down, a refused connection, an exception answer or an undecodable value)";
   return std::to_string(count) + " " + what + " in a row failed, the last " + how;
 }
 

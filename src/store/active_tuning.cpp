@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "core/format.hpp"
-
 #include "store/model_table.hpp"
 #include "store/tuning_set_table.hpp"
 
