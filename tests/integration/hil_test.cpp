@@ -71,8 +71,8 @@ TEST(HardwareInTheLoop, PlantServerAndServeCompleteAFiftyMillimetreMove) {
   // The simulated module answers at real-time priority, as a module's firmware does in bounded time,
   // and steps its plant (the paper's model, discrete at the loop's period) in phase with the
   // appliance's valve writes: on a free clock the phase alone decides between no extra delay and one
-  // sample, which FF-IDZ does not survive (2 of 15 free-running runs here went to 106 mm, as
-  // `epa simulate --delay 1` does).
+  // sample, which FF-IDZ does not survive (3 of 30 free-running runs here failed, e_ss up to 65 mm;
+  // a fresh root's went to 106 mm, as `epa simulate --delay 1` does).
   testing::ChildProcess plant({epa, "plant-server", "--address", "127.0.0.1", "--port", std::to_string(port),
                                "--realtime-priority", "70", "--sync-to-valve-writes"},
                               (dir / "plant.log").string());
