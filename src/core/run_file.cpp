@@ -205,8 +205,9 @@ Result<Run> parse_run_impl(std::istream& in, const std::string& src, std::option
   std::string origin;
   if (file_Ts) {
     if (expected_Ts && std::abs(*file_Ts - *expected_Ts) > kTsRelTolerance * std::max(*file_Ts, *expected_Ts))
-      return error_at(src, ts_line, "Ts=" + shortest(*file_Ts) + " s in the file, but the model's Ts is " +
-                                        shortest(*expected_Ts) + " s");
+      // The reader does not know whose Ts it was given: a model's, or the first run's (identify).
+      return error_at(src, ts_line, "Ts=" + shortest(*file_Ts) + " s in the file, but " + shortest(*expected_Ts) +
+                                        " s is expected (the model's Ts, or the other runs')");
     run.Ts = *file_Ts;
   } else if (expected_Ts) {
     run.Ts = *expected_Ts;

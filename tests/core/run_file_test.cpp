@@ -262,7 +262,7 @@ TEST(RunFile, TsMismatchWithExpectedNamesBothValues) {
   const std::string message = parse_error_of("# epa-run/1\n# Ts=0.01\nt_s,y_mm,u_V\n0,0,0\n0.01,0,0\n", 0.005);
   EXPECT_TRUE(contains(message, "runs/a.csv:2:"));
   EXPECT_TRUE(contains(message, "Ts=0.01"));
-  EXPECT_TRUE(contains(message, "model's Ts is 0.005"));
+  EXPECT_TRUE(contains(message, "but 0.005 s is expected (the model's Ts, or the other runs')")) << message;
 }
 
 TEST(RunFile, TsEqualToExpectedWithinRelativeTolerance) {
