@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <cmath>
 #include <sstream>
+#include <string_view>
+#include <vector>
 #include <toml++/toml.h>
 
 #include "core/atomic_file.hpp"
@@ -49,11 +51,6 @@ Result<Polynomial> array_at(const toml::table& t, const char* key, const std::st
 
 // The [stick_slip] table: every field, by its name (a reader that knows the table wants it whole).
 Result<StickSlipParams> stick_slip_at(const toml::table& t, const std::string& src) {
-  if (auto s = only_keys(t, {"break_right_v", "break_left_v", "speed_right_mm_s_per_v", "speed_left_mm_s_per_v", "spring_rad_s",
-                             "damping_ratio", "coulomb_mm", "static_mm", "spool_lag_s", "delay_samples"},
-                         src + ": [stick_slip]");
-      !s)
-    return s.error();
   StickSlipParams p;
   struct Field {
     const char* key;
@@ -68,6 +65,9 @@ Result<StickSlipParams> stick_slip_at(const toml::table& t, const std::string& s
                           {"coulomb_mm", &p.coulomb_mm},
                           {"static_mm", &p.static_mm},
                           {"spool_lag_s", &p.spool_lag_s}};
+  std::vector<std::string_view> keys{"delay_samples"};  // the table's keys: the fields and the delay
+  for (const auto& f : fields) keys.push_back(f.key);
+  if (auto s = only_keys(t, keys, src + ": [stick_slip]"); !s) return s.error();
   for (const auto& f : fields) {
     auto v = number_at(t, "stick_slip", f.key, src);
     if (!v) return v.error();

@@ -3,6 +3,7 @@
 // and line, never left out in silence (a model file's `mm_per_vlot = 25` ran on the default
 // 50 mm/V until 2026-11-29). Shared by the files' readers (model, tuning).
 #include <initializer_list>
+#include <span>
 #include <string>
 #include <string_view>
 #include <toml++/toml.h>
@@ -11,7 +12,7 @@
 
 namespace epa::core {
 
-inline Status only_keys(const toml::table& table, std::initializer_list<std::string_view> allowed, const std::string& where) {
+inline Status only_keys(const toml::table& table, std::span<const std::string_view> allowed, const std::string& where) {
   for (const auto& [key, node] : table) {
     bool known = false;
     for (const std::string_view a : allowed) known = known || key.str() == a;
@@ -23,6 +24,10 @@ inline Status only_keys(const toml::table& table, std::initializer_list<std::str
                        (line > 0 ? "line " + std::to_string(line) + "; " : std::string()) + "expected one of: " + names + ")");
   }
   return ok();
+}
+
+inline Status only_keys(const toml::table& table, std::initializer_list<std::string_view> allowed, const std::string& where) {
+  return only_keys(table, std::span<const std::string_view>(allowed.begin(), allowed.size()), where);
 }
 
 }  // namespace epa::core
