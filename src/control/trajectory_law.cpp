@@ -229,6 +229,12 @@ TrajectoryOutput trajectory_step(const TrajectoryParams& p, TrajectoryState& s, 
   bool arrived = motion_profile_arrived(p.limits, s.profile, r_v);
   for (std::size_t i = 0; arrived && i <= std::max(p.nA, p.nB); ++i) arrived = s.w[i] == r_v;
   const double ef = s.filtered_error_v;
+  // Leaving the target: the integral goes. It was wound up against the creeping inverse, which
+  // stops creep_margin_v short of the break points, and NG-IDZ while moving has no such margin:
+  // carried into the move it drove the piston ahead of its path (1.7 mm at 15 mm/s on the printed
+  // model, and a halt that braked from the piston then ran 3 mm past its stop).
+  if (s.arrived && !arrived) s.integral = 0.0;
+  s.arrived = arrived;
   if (!arrived) {
     s.holding = false;
   } else if (s.holding) {

@@ -100,6 +100,7 @@ struct TrajectoryState {
   double integral = 0.0;
   double creep_margin_v = 0.0;  // the creeping inverse's margin now: 0 while moving, growing after arrival
   bool holding = false;
+  bool arrived = false;  // the profile stood at the target in the last sample
   ApproachState approach;
   // The sliding arrival follows a reference that moves sample after sample with the law above.
   double last_r_v = NAN;

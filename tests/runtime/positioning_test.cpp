@@ -316,5 +316,50 @@ TEST(Positioning, AResetBitClearsALatchedFault) {
   EXPECT_EQ(axis.snap().fault, FaultCode::kNone);
 }
 
+TEST(Positioning, AHaltDuringASlowMoveAfterAHoldStopsWhereItIsHaltedAndStays) {
+  // The browser test's sequence (CI, 2026-11-29): FF-IDZ to 50 mm, a record start under pp-traj to
+  // 200 mm and a hold there, a record at 15 mm/s towards 420 mm, halted at ten phases. pp-traj's
+  // integral from the hold had driven the whole slow move 1.7 mm ahead of its path, the halt
+  // (braking from the piston) then asked the law for a jump, the piston ran 2.9 mm past the
+  // halt, came back and crept on 0.5 mm three seconds later.
+  for (int phase = 0; phase < 40; phase += 4) {
+    Axis axis(0.0, ControllerKind::kPpFfidz);
+    axis.push(mode_command(Mode::kRun));
+    axis.push(setpoint_command(50.0));
+    axis.cycles(5 * kCyclesPerSecond);
+    Command record3 = control_command(kControlStart);
+    record3.value = 200.0;
+    record3.start_controller = true;
+    record3.controller = ControllerKind::kPpTraj;
+    axis.push(record3);
+    axis.cycles(2);
+    axis.control(0);
+    axis.cycles(3 * kCyclesPerSecond);
+    ASSERT_NEAR(axis.daq.plant().position_mm(), 200.0, 1.0);
+    Command record4 = control_command(kControlStart);
+    record4.value = 420.0;
+    record4.speed_limit_mm_s = 15.0;
+    axis.push(record4);
+    axis.cycles(2);
+    axis.control(0);
+    axis.cycles(4 * kCyclesPerSecond + phase);
+    axis.control(kControlHalt);
+    const double halted_at = axis.daq.plant().position_mm();
+    double furthest = halted_at, moved_after_one_second = 0.0, at_one_second = 0.0;
+    for (int k = 1; k <= 5 * kCyclesPerSecond; ++k) {
+      axis.cycles(1);
+      const double y = axis.daq.plant().position_mm();
+      furthest = std::max(furthest, y);
+      if (k == kCyclesPerSecond) at_one_second = y;
+      if (k > kCyclesPerSecond) moved_after_one_second = std::max(moved_after_one_second, std::abs(y - at_one_second));
+    }
+    EXPECT_LT(furthest - halted_at, 1.5) << "phase " << phase << ": halted at " << halted_at << " mm, ran on to " << furthest;
+    EXPECT_LT(moved_after_one_second, 0.1) << "phase " << phase << ": still moving 1-5 s after the halt";
+    EXPECT_NEAR(axis.daq.plant().position_mm(), axis.snap().setpoint_mm, axis.config.in_position_window_mm)
+        << "phase " << phase << ": rests away from the halt's stop";
+    EXPECT_TRUE(axis.snap().axis.halted);
+  }
+}
+
 }  // namespace
 }  // namespace epa::runtime
