@@ -15,7 +15,9 @@
 //                              near-unit-circle zeros (16.7 rad/s)
 //   u_i    integrator on the filtered tracking error, only after the profile has arrived (and y_d
 //          with it) and only outside integrator_band_v: it removes what the model does not know
-//          (a wrong gain, a wrong break point, a load) without winding up during the move
+//          (a wrong gain, a wrong break point, a load) without winding up during the move; it
+//          starts from zero when the profile leaves the target (wound up against the creeping
+//          inverse, it is no bias NG-IDZ needs while moving)
 //   valve  while moving: u_d through the inverse dead zone (idz_ramp 0: NG-IDZ, exact on the
 //          model); once arrived: creeping_idz_command, which cannot bang-bang between the break
 //          points when they lie nearer than the model's. Its margin grows from 0 (where it equals
