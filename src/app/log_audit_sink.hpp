@@ -1,6 +1,6 @@
 #pragma once
 // The audit trail in the log as well (journald keeps it with the rest): one line per accepted
-// change, with who, what, from and to; then on to the next sink (the store).
+// change, with who, what, from and to (or an interface's event); then on to the next sink (the store).
 #include <spdlog/spdlog.h>
 
 #include "core/audit.hpp"
@@ -11,7 +11,7 @@ class LogAuditSink final : public core::AuditSink {
  public:
   explicit LogAuditSink(core::AuditSink* next = nullptr) : next_(next) {}
   void record(const std::vector<core::AuditEntry>& change) override {
-    for (const auto& e : change) spdlog::info("audit: {} set {} from {} to {}", e.source, e.point, e.old_value, e.new_value);
+    for (const auto& e : change) spdlog::info("audit: {} {}", e.source, core::audit_text(e));
     if (next_) next_->record(change);
   }
   core::ChangeCounters counters() const override { return next_ ? next_->counters() : core::ChangeCounters{}; }

@@ -225,8 +225,9 @@ void take_fault_events(runtime::LoopChannels& channels, store::StoreWriter& stor
 // events and a periodic status, keeps the fault history, has the gate log and audit the commands
 // the loop refused after acceptance, and pings the systemd watchdog only while the loop advances,
 // so a stuck loop gets the unit restarted.
-void supervise(const config::ApplianceConfig& c, double duration_s, runtime::LoopChannels& channels, points::WriteGate& gate,
-               store::StoreWriter& store_writer, const sigset_t& signals) {
+enum class StopCause { kSignal, kDuration };
+StopCause supervise(const config::ApplianceConfig& c, double duration_s, runtime::LoopChannels& channels, points::WriteGate& gate,
+                    store::StoreWriter& store_writer, const sigset_t& signals) {
   std::uint64_t watchdog_usec = 0;
   const bool watchdog = sd_watchdog_enabled(0, &watchdog_usec) > 0;
   const auto started = std::chrono::steady_clock::now();
@@ -238,7 +239,7 @@ void supervise(const config::ApplianceConfig& c, double duration_s, runtime::Loo
     const int sig = sigtimedwait(&signals, nullptr, &tick);
     if (sig == SIGTERM || sig == SIGINT) {
       spdlog::info("signal {}: shutting down", sig == SIGTERM ? "SIGTERM" : "SIGINT");
-      return;
+      return StopCause::kSignal;
     }
     const auto now = std::chrono::steady_clock::now();
     const runtime::Snapshot s = channels.snapshot.read();
@@ -257,7 +258,7 @@ void supervise(const config::ApplianceConfig& c, double duration_s, runtime::Loo
     }
     if (duration_s > 0 && now - started >= std::chrono::duration<double>(duration_s)) {
       spdlog::info("duration of {} s reached: shutting down", duration_s);
-      return;
+      return StopCause::kDuration;
     }
   }
 }
@@ -376,7 +377,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
 
   sd_notify(0, "READY=1");
   spdlog::info("running");
-  supervise(c, o.duration_s, channels, gate, store_writer, signals);
+  const StopCause cause = supervise(c, o.duration_s, channels, gate, store_writer, signals);
 
   sd_notify(0, "STOPPING=1");
   if (web_server) web_server->stop();        // no more commands from either interface;
@@ -388,7 +389,14 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   recorder.stop();     // writes what is pending; the DAQ closes on the way out
   store_writer.stop(); // every accepted change and run on disk (or logged as not saved)
   const auto saved = store_writer.counters();
-  spdlog::info("stopped: {}; {} of {} changes saved", describe_snapshot(channels.snapshot.read()), saved.saved, saved.accepted);
+  const runtime::Snapshot last = channels.snapshot.read();
+  spdlog::info("stopped: {}; {} of {} changes saved", describe_snapshot(last), saved.saved, saved.accepted);
+  // A timed run (a script, a test) learns from the exit code that the axis ended it in FAULT. A
+  // signal's stop exits 0 whatever the mode: systemd's stop is no failure of the unit.
+  if (cause == StopCause::kDuration && last.mode == runtime::Mode::kFault) {
+    spdlog::error("the run ended with the axis in FAULT ({}): exit {}", runtime::to_string(last.fault), kExitEndedInFault);
+    return kExitEndedInFault;
+  }
   return 0;
 }
 

@@ -20,8 +20,12 @@ struct ServeOptions {
   std::optional<double> setpoint_mm;  // overrides [startup] setpoint_mm; RUN at start-up then moves there
   std::string record_dir;     // overrides [recorder] directory
   std::string db_path;        // overrides [store] path
-  double duration_s = 0.0;    // > 0: stop by itself after this long (tests, demos)
+  double duration_s = 0.0;    // > 0: stop by itself after this long (tests, demos); exit 4 in FAULT
 };
+
+// `serve --duration` whose axis is in FAULT when the time is up exits with this (a signal's stop
+// exits 0 whatever the mode).
+inline constexpr int kExitEndedInFault = 4;
 
 void add_serve_command(CLI::App& app, ServeOptions& options);
 int run_serve(const ServeOptions& options, std::ostream& err);

@@ -227,8 +227,10 @@ int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::os
                      .dump()
               << "\n";
         } else {
-          out << iso_time(e.unix_time_ms) << "  " << e.source << "  " << e.point << "  " << core::format_number(e.old_value)
-              << " -> " << core::format_number(e.new_value) << "\n";
+          out << iso_time(e.unix_time_ms) << "  " << e.source << "  " << e.point << "  "
+              << (core::is_audit_event(e) ? "nothing changed"
+                                          : core::audit_value_text(e.old_value) + " -> " + core::audit_value_text(e.new_value))
+              << "\n";
         }
       }
       if (!o.json && rows->empty()) out << "no audit entries match\n";

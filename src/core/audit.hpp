@@ -4,9 +4,12 @@
 // (SQLite) keeps them append-only and applies the persisted ones; its counters tell clients
 // how many accepted changes are on disk.
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
+
+#include "core/format.hpp"
 
 namespace epa::core {
 
@@ -22,6 +25,21 @@ struct AuditEntry {
   double old_value = 0.0;
   double new_value = 0.0;
 };
+
+// An entry with no value on either side (NaN, NULL in the store) is an event an interface
+// recorded, not a change: a refused unlock key names the point it was written to, nothing changed.
+inline bool is_audit_event(const AuditEntry& e) { return std::isnan(e.old_value) && std::isnan(e.new_value); }
+
+// A value of an entry as people read it: "none" for one there was not (no running tuning set
+// before the first).
+inline std::string audit_value_text(double v) { return std::isnan(v) ? std::string("none") : format_number(v); }
+
+// How an entry reads in the log, after its source: "set mode from 1 to 0", or for an event
+// "(unlock: nothing changed)".
+inline std::string audit_text(const AuditEntry& e) {
+  if (is_audit_event(e)) return "(" + e.point + ": nothing changed)";
+  return "set " + e.point + " from " + audit_value_text(e.old_value) + " to " + audit_value_text(e.new_value);
+}
 
 // Accepted changes since start, and how many of them are durable (on disk). A client that
 // reads saved >= the accepted count it saw after its write knows its write survives a crash.

@@ -190,7 +190,7 @@ std::uint8_t RequestHandler::take_key(const Write& key, const Session& session, 
   if (a.lockout_started)
     what += "; unlock writes from " + session.address + " refused for " + std::to_string(a.backoff_ns / 1'000'000'000) + " s";
   if (log_) log_("modbus: " + session.peer + ": " + what + " (" + std::to_string(unlock_.failures()) + " refused attempts since start)");
-  gate_.record_event({{core::unix_time_ms(), "modbus " + session.peer + ": " + what, std::string(key.entry->point->name), 0, 0}});
+  gate_.record_event({{core::unix_time_ms(), "modbus " + session.peer + ": " + what, std::string(key.entry->point->name), NAN, NAN}});
   return kIllegalValue;
 }
 

@@ -88,6 +88,36 @@ TEST_F(EpaCli, MistypedCommandsAndNumbersAreRefusedNamingWhatWasWrong) {
   }
 }
 
+// `serve --duration` is how a script runs the appliance for a while: the exit code says whether
+// the axis ended the run in FAULT (it exited 0 either way; an outside walk-through, 2026-11-29).
+// Plain PP stands still in the dead band 25 mm short (the paper's point), so a following error of
+// 10 mm for 0.5 s faults it.
+TEST_F(EpaCli, ATimedServeThatEndsInFaultExitsFourAndSaysWhy) {
+  std::ifstream shipped(std::string(EPA_SOURCE_DIR) + "/config/epa.toml");
+  std::stringstream text;
+  text << shipped.rdbuf();
+  std::string config = text.str();
+  const auto set = [&config](const std::string& line, const std::string& replacement) {
+    const auto at = config.find(line);
+    ASSERT_NE(at, std::string::npos) << line;
+    config.replace(at, line.size(), replacement);
+  };
+  set("kind = \"pp-ffidz\"", "kind = \"pp\"");
+  set("following_error_mm = 50.0", "following_error_mm = 10.0");
+  set("following_error_time_s = 2.0", "following_error_time_s = 0.5");
+  set("register_map = \"../registers/epa.csv\"", "register_map = \"" + std::string(EPA_SOURCE_DIR) + "/registers/epa.csv\"");
+  set("static_dir = \"../web\"", "static_dir = \"" + std::string(EPA_SOURCE_DIR) + "/web\"");
+  std::ofstream(path("epa.toml")) << config;
+  const std::string serve = "serve --config " + path("epa.toml") + " --db " + path("epa.db") + " --record-dir " + path("runs") +
+                            " --modbus-port 0 --web-port 0 --mode run --duration 1.5 --setpoint ";
+  const auto faulted = run_epa(serve + "25");
+  EXPECT_EQ(faulted.exit_code, 4) << faulted.output;
+  EXPECT_NE(faulted.output.find("the run ended with the axis in FAULT (following-error): exit 4"), std::string::npos)
+      << faulted.output;
+  const auto held = run_epa(serve + "0");  // nothing to follow: the run ends in RUN
+  EXPECT_EQ(held.exit_code, 0) << held.output;
+}
+
 TEST_F(EpaCli, BadModelFileIsNamedInTheError) {
   std::ofstream(path("bad.toml")) << "schema = \"epa-model/1\"\nTs = 0.005\n[arx]\nA = [1.0, -0.5]\n";
   const auto o = run_epa("simulate --model " + path("bad.toml"));
