@@ -72,10 +72,17 @@ std::string poly_text(const core::Polynomial& p) {
   return s + "]";
 }
 
+// Where a set came from, and whether its values were edited since (Modbus or HTTP writes: the
+// store moves its modified time, and the audit trail has each edit from its creation on).
+std::string source_text(const store::TuningSet& t) {
+  if (t.modified_ms <= t.created_ms) return t.source;
+  return t.source + "; edited since (the edits: epa tuning audit --since " + std::to_string(t.created_ms) + ")";
+}
+
 // Field name and value, in the order `show` prints and `diff` compares them.
 std::vector<std::pair<std::string, std::string>> fields(const store::TuningSet& t, const store::ModelRecord& m) {
   std::vector<std::pair<std::string, std::string>> out = {{"name", t.name},
-          {"source", t.source},
+          {"source", source_text(t)},
           {"created", iso_time(t.created_ms)},
           {"modified", iso_time(t.modified_ms)},
           {"controller", std::string(control::to_string(t.controller))},
@@ -115,7 +122,7 @@ int list(store::Database& db, std::ostream& out) {
     char line[512];
     std::snprintf(line, sizeof line, "%s %3lld  %-20s  %-10s  %-25s  %s\n", *active && **active == t.id ? "*" : " ",
                   static_cast<long long>(t.id), t.name.c_str(), std::string(control::to_string(t.controller)).c_str(),
-                  iso_time(t.modified_ms).c_str(), t.source.c_str());
+                  iso_time(t.modified_ms).c_str(), source_text(t).c_str());
     out << line;
   }
   return 0;

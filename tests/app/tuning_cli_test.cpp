@@ -115,6 +115,20 @@ TEST_F(TuningCli, AnActiveSetAtAnotherSamplePeriodIsRefusedAndTheLastGoodOneRuns
   EXPECT_NE(s.output.find("tuning set 'paper'"), std::string::npos) << s.output;
 }
 
+// A set edited over Modbus or HTTP keeps where it came from, and says it was edited since (it
+// read "seeded from the configuration" after any edit; an outside walk-through, 2026-11-29).
+TEST_F(TuningCli, AnEditedSetSaysSoBesideWhereItCameFrom) {
+  ASSERT_EQ(serve().exit_code, 0);
+  EXPECT_EQ(tuning("show paper").output.find("edited since"), std::string::npos) << "not edited yet";
+  // What the store writer does with an accepted lc_mm write: the value and the modified time.
+  sql("UPDATE tuning_sets SET lc_mm = 3, modified_ms = created_ms + 60000 WHERE name = 'paper'");
+  const auto show = tuning("show paper");
+  ASSERT_EQ(show.exit_code, 0) << show.output;
+  EXPECT_TRUE(std::regex_search(show.output, std::regex(R"(source: seeded from the configuration[^\n]*; edited since \(the edits: epa tuning audit --since \d+\))")))
+      << show.output;
+  EXPECT_NE(tuning("list").output.find("; edited since"), std::string::npos);
+}
+
 TEST_F(TuningCli, ADamagedDatabaseIsMovedAsideAndTheApplianceStartsInFault) {
   std::ofstream(path("epa.db"), std::ios::binary) << std::string(4096, 'x');
   const auto s = serve();
