@@ -124,11 +124,10 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
 
   const auto* dz = root["dead_zone"].as_table();
   if (!dz) return parse_error(src + ": table [dead_zone] is missing");
-  if (auto s = only_keys(*dz, {"m_r", "m_l", "b_r", "b_l"}, src + ": [dead_zone]"); !s) return s.error();
+  if (auto s = only_keys(*dz, kDeadZoneKeys, src + ": [dead_zone]"); !s) return s.error();
   double* fields[] = {&f.model.dead_zone.m_r, &f.model.dead_zone.m_l, &f.model.dead_zone.b_r, &f.model.dead_zone.b_l};
-  const char* names[] = {"m_r", "m_l", "b_r", "b_l"};
   for (int i = 0; i < 4; ++i) {
-    auto v = number_at(*dz, "dead_zone", names[i], src);
+    auto v = number_at(*dz, "dead_zone", kDeadZoneKeys[i].data(), src);  // literals: terminated
     if (!v) return v.error();
     *fields[i] = *v;
   }

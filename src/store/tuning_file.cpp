@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <string_view>
 #include <toml++/toml.h>
 
 #include "core/format.hpp"
@@ -108,21 +109,20 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
 
   const auto* rst = root["rst"].as_table();
   if (!rst) return core::parse_error(src + ": table [rst] is missing");
-  if (auto s = core::only_keys(*rst, {"F", "G", "H"}, src + ": [rst]"); !s) return s.error();
+  constexpr std::string_view rst_keys[] = {"F", "G", "H"};
+  if (auto s = core::only_keys(*rst, rst_keys, src + ": [rst]"); !s) return s.error();
   core::Polynomial* polys[] = {&t.F, &t.G, &t.H};
-  const char* names[] = {"F", "G", "H"};
   for (int i = 0; i < 3; ++i) {
-    auto p = polynomial(*rst, names[i], src + ": [rst]");
+    auto p = polynomial(*rst, rst_keys[i].data(), src + ": [rst]");  // literals: terminated
     if (!p) return p.error();
     *polys[i] = *p;
   }
   const auto* dz = root["dead_zone"].as_table();
   if (!dz) return core::parse_error(src + ": table [dead_zone] is missing");
-  if (auto s = core::only_keys(*dz, {"m_r", "m_l", "b_r", "b_l"}, src + ": [dead_zone]"); !s) return s.error();
+  if (auto s = core::only_keys(*dz, core::kDeadZoneKeys, src + ": [dead_zone]"); !s) return s.error();
   double* fields[] = {&t.dead_zone.m_r, &t.dead_zone.m_l, &t.dead_zone.b_r, &t.dead_zone.b_l};
-  const char* dz_names[] = {"m_r", "m_l", "b_r", "b_l"};
   for (int i = 0; i < 4; ++i) {
-    auto v = number(*dz, dz_names[i], src + ": [dead_zone]");
+    auto v = number(*dz, core::kDeadZoneKeys[i].data(), src + ": [dead_zone]");  // literals: terminated
     if (!v) return v.error();
     *fields[i] = *v;
   }
