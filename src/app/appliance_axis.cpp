@@ -6,6 +6,7 @@
 
 #include "app/store_save.hpp"
 #include "core/format.hpp"
+#include "core/units.hpp"
 #include "runtime/excitation_settings.hpp"
 #include "store/set_activation.hpp"
 #include "store/store_file.hpp"
@@ -110,7 +111,7 @@ core::Status ApplianceAxis::use_set(std::int64_t set_id, bool persist, const std
   auto loaded = store::find_set_with_model(*db, std::to_string(set_id));
   if (!loaded) return loaded.error();
   const auto& model = loaded->model.model;
-  if (std::abs(model.Ts - rules_.period_s) > 1e-12 || std::abs(model.mm_per_volt - rules_.mm_per_volt) > 1e-9)
+  if (!core::same_sample_time(model.Ts, rules_.period_s) || std::abs(model.mm_per_volt - rules_.mm_per_volt) > 1e-9)
     return core::invalid_argument("tuning set '" + loaded->set.name + "': its model's Ts " + core::format_number(model.Ts) +
                                   " s and sensor scale " + core::format_number(model.mm_per_volt) + " mm/V differ from the loop's");
   const auto old = store_.running_set();

@@ -5,6 +5,7 @@
 
 #include "app/identify_command.hpp"
 #include "app/identify_report.hpp"
+#include "core/units.hpp"
 #include "ident/arx_estimator.hpp"
 #include "ident/arx_metrics.hpp"
 #include "ident/hammerstein_identification.hpp"
@@ -51,7 +52,7 @@ commission::Identify identify_for_commissioning(double mm_per_volt) {
     const double Ts = estimation.front().Ts;
     std::vector<ident::Segment> est, val;
     for (std::size_t i = 0; i < estimation.size(); ++i) {
-      if (std::abs(estimation[i].Ts - Ts) > 1e-12) return core::invalid_argument("the excitation runs differ in Ts");
+      if (!core::same_sample_time(estimation[i].Ts, Ts)) return core::invalid_argument("the excitation runs differ in Ts");
       auto s = segments_of(estimation[i], "excitation run " + std::to_string(i + 1), mm_per_volt, true);
       if (!s) return s.error();
       est.insert(est.end(), s->begin(), s->end());

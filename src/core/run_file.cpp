@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/atomic_file.hpp"
+#include "core/units.hpp"
 
 namespace epa::core {
 namespace {
@@ -24,7 +25,6 @@ constexpr std::string_view kVersionTag = "epa-run/1";
 constexpr std::string_view kVersionPrefix = "epa-run/";
 constexpr std::string_view kBom = "\xEF\xBB\xBF";
 constexpr std::array<std::string_view, 5> kControllers = {"pp", "pp-ngidz", "pp-ffidz", "pp-traj", "open-loop"};
-constexpr double kTsRelTolerance = 1e-9;
 
 struct ColumnSpec {
   std::string_view name;
@@ -204,7 +204,7 @@ Result<Run> parse_run_impl(std::istream& in, const std::string& src, std::option
   const auto& t = run.t_s;  // Ts: the file's, else the model's, else inferred
   std::string origin;
   if (file_Ts) {
-    if (expected_Ts && std::abs(*file_Ts - *expected_Ts) > kTsRelTolerance * std::max(*file_Ts, *expected_Ts))
+    if (expected_Ts && !same_sample_time(*file_Ts, *expected_Ts))
       // The reader does not know whose Ts it was given: a model's, or the first run's (identify).
       return error_at(src, ts_line, "Ts=" + shortest(*file_Ts) + " s in the file, but " + shortest(*expected_Ts) +
                                         " s is expected (the model's Ts, or the other runs')");

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/format.hpp"
+#include "core/units.hpp"
 #include "store/model_table.hpp"
 #include "store/tuning_set_table.hpp"
 
@@ -44,7 +45,7 @@ core::Result<LoadedTuning> load_active_tuning(Database& db, std::optional<double
       out.refused.push_back(s.error().message);
       continue;
     }
-    if (loop_period_s && std::abs(model->model.Ts - *loop_period_s) > 1e-12) {
+    if (loop_period_s && !core::same_sample_time(model->model.Ts, *loop_period_s)) {
       out.refused.push_back("tuning set '" + set->name + "': its model '" + model->name + "' has Ts " +
                             core::format_number(model->model.Ts) + " s, and the loop runs every " +
                             core::format_number(*loop_period_s) + " s (loop.period_s)");
