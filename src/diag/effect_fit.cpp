@@ -201,6 +201,7 @@ EffectFit fit_effects(const ReplayModel& base, std::span<const EffectKind> kinds
     const auto specs = plant::param_specs(kind);
     for (std::size_t i = 0; i < specs.size(); ++i) {
       const Slot s{kind, i, specs[i], fresh};
+      if (specs[i].fitted_last && !o.fit_last && obj.model.effects.params(kind)[i] == specs[i].neutral) continue;
       if (specs[i].grid_after_the_rest) {
         if (fresh) grid_after.push_back(s);  // an accepted effect keeps its shape
         continue;

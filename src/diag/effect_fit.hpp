@@ -16,6 +16,9 @@ namespace epa::diag {
 struct FitOptions {
   std::size_t horizon = 10;
   unsigned max_evaluations_per_start = 150;
+  // Also fit the members fitted last (ParamSpec::fitted_last: gain_change's drift), which
+  // otherwise stay where they stand while neutral.
+  bool fit_last = false;
 };
 
 struct EffectFit {

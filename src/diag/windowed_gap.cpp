@@ -54,7 +54,7 @@ WindowCount replay(const ReplayModel& m, const core::Run& run, std::size_t horiz
   // piston (friction on the model's mechanical speed, which the command history gives).
   plant::ValveEffects valve(m.effects, model.Ts);
   const auto path = plant::force_path(model);
-  plant::DriveEffects drive(m.effects, model.dead_zone, path.speed_mm_s_per_V, path.pole);
+  plant::DriveEffects drive(m.effects, model.dead_zone, model.Ts, path.speed_mm_s_per_V, path.pole);
   thread_local std::vector<double> pre, force;
   pre.resize(n), force.resize(n);
   for (std::size_t k = 0; k < n; ++k) pre[k] = drive.drive_before_position(valve.apply(run.u_V[k])), force[k] = drive.force();

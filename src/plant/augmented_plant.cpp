@@ -23,7 +23,7 @@ core::Result<AugmentedPlant> AugmentedPlant::make(const core::HammersteinModel& 
   AugmentedPlant p(std::move(*arx));
   p.valve_ = ValveEffects(effects, model.Ts);
   const auto& path = p.arx_.mechanical_path();
-  p.drive_ = DriveEffects(effects, model.dead_zone, path.speed_mm_s_per_V, path.pole);
+  p.drive_ = DriveEffects(effects, model.dead_zone, model.Ts, path.speed_mm_s_per_V, path.pole);
   p.mm_per_volt_ = model.mm_per_volt;
   p.noise_std_v_ = options.noise_std_mm / model.mm_per_volt;
   p.step_mm_ = effects.on(EffectKind::kSensorQuantization) ? effects.param(EffectKind::kSensorQuantization, 0) : 0.0;

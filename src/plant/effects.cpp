@@ -22,9 +22,21 @@ constexpr std::array<std::string_view, kEffectCount> kNames = {
 // +-20 % (0.007 +- 0.0015), while they fix its swing closely; a rig within those digits moves
 // steadily faster or slower than B says without a gain change. Re-fitted with the nominal
 // parameters; it would otherwise pass for friction (a steady speed lost) on effect-free rigs.
+// drift_per_s: a family of two members, a gain that holds and one that drifts during each run (a
+// receiver that cannot keep up sags its supply pressure while the axis moves, and refills between
+// runs): from the run's start at drift_per_s, settling exponentially with drift_settles_s toward
+// where the compressor catches up (drift x settles: 1 - exp(-t / settles) of it; linear while t is
+// short of it), the gain never below kMinGainFactor. Fitted last, after the selection
+// (ParamSpec::fitted_last says why).
 constexpr ParamSpec kGain[] = {
     {"gain_ratio", 0.3, 3.0, 1.0, false, "drive (piston speed per volt beyond the break point) over the nominal"},
-    {"steady_ratio", 0.7, 1.3, 1.0, false, "steady piston speed over what B gives (B's sum is printed to +-20 %)", true}};
+    {"steady_ratio", 0.7, 1.3, 1.0, false, "steady piston speed over what B gives (B's sum is printed to +-20 %)", true},
+    {.name = "drift_per_s", .lo = -0.1, .hi = 0.1, .neutral = 0.0,
+     .meaning = "relative change of the gain per second at the run's start (a supply that sags or recovers during a run)",
+     .optional = true, .fitted_last = true},
+    {.name = "drift_settles_s", .lo = 1.0, .hi = 1000.0, .neutral = 1000.0,
+     .meaning = "time constant with which the drift settles (a compressor that catches up); 1000: it does not, linear",
+     .optional = true, .log_scale = true, .fitted_last = true}};
 constexpr ParamSpec kShift[] = {{"shift_r_V", -1.0, 1.0, 0.0, false, "right break point b_r moved by"},
                                 {"shift_l_V", -1.0, 1.0, 0.0, false, "left break point b_l moved by"}};
 constexpr ParamSpec kDelay[] = {{"delay_samples", 0.0, 40.0, 0.0, true, "transport delay of the valve command, samples of Ts"}};
@@ -65,6 +77,7 @@ constexpr ParamSpec kQuantization[] = {{"step_mm", 0.0, 10.0, 0.0, false, "posit
 
 constexpr double kMidStrokeMm = 250.0;
 constexpr double kMinPositionFactor = 0.05;  // the drive never reverses along the stroke
+constexpr double kMinGainFactor = 0.05;      // nor as the gain drifts
 // How sharply the spool's speed meets its limit (the flow ceiling's knee, soft_ceiling): 16 rounds
 // only the last few per cent, as a solenoid's force runs out. Fitted, it went to its sharpest
 // end on every speed-limited rig, so it is not a parameter.
@@ -180,9 +193,9 @@ double ValveEffects::apply(double valve_v) noexcept {
   return second_alpha_ >= 1.0 ? first : state_.second_v;
 }
 
-DriveEffects::DriveEffects(const EffectSet& e, const core::DeadZone& nominal, double speed_mm_s_per_V,
+DriveEffects::DriveEffects(const EffectSet& e, const core::DeadZone& nominal, double Ts, double speed_mm_s_per_V,
                            double mechanical_pole)
-    : dead_zone_(nominal), speed_mm_s_per_V_(speed_mm_s_per_V), pole_(mechanical_pole) {
+    : dead_zone_(nominal), Ts_(Ts), speed_mm_s_per_V_(speed_mm_s_per_V), pole_(mechanical_pole) {
   if (e.on(EffectKind::kDeadzoneShift)) {
     dead_zone_.b_r += e.param(EffectKind::kDeadzoneShift, 0);
     dead_zone_.b_l += e.param(EffectKind::kDeadzoneShift, 1);
@@ -196,6 +209,8 @@ DriveEffects::DriveEffects(const EffectSet& e, const core::DeadZone& nominal, do
   if (e.on(EffectKind::kGainChange)) {
     gain_ = e.param(EffectKind::kGainChange, 0);
     steady_extra_ = e.param(EffectKind::kGainChange, 1) - 1.0;
+    drift_per_s_ = e.param(EffectKind::kGainChange, 2);
+    drift_settles_s_ = e.param(EffectKind::kGainChange, 3);
   }
   if (e.on(EffectKind::kPositionDependentGain)) {
     slope_per_mm_ = e.param(EffectKind::kPositionDependentGain, 0) / 100.0;
@@ -220,8 +235,16 @@ double DriveEffects::friction_V(double v, double d) const noexcept {
   return std::clamp(d, -breakaway_, breakaway_);
 }
 
+double DriveEffects::gain_at(double run_time_s) const noexcept {
+  if (drift_per_s_ == 0.0) return gain_;
+  const double drifted = drift_settles_s_ > 0.0 ? drift_per_s_ * drift_settles_s_ * -std::expm1(-run_time_s / drift_settles_s_)
+                                                : drift_per_s_ * run_time_s;
+  return gain_ * std::max(kMinGainFactor, 1.0 + drifted);
+}
+
 double DriveEffects::drive_before_position(double spool_v) noexcept {
-  const double d = dead_zone_.apply(spool_v) * gain_;
+  const double d = dead_zone_.apply(spool_v) * (drift_per_s_ != 0.0 ? gain_at(state_.run_time_s) : gain_);
+  state_.run_time_s += Ts_;
   double force = steady_extra_ * d;
   if (friction_) {
     auto& v = state_.mechanical_speed_mm_s;

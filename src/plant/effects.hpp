@@ -26,7 +26,8 @@
 namespace epa::plant {
 
 enum class EffectKind {
-  kGainChange,             // gain_ratio: the drive u_d scaled (supply pressure, valve gain); steady_ratio
+  kGainChange,             // gain_ratio: the drive u_d scaled (supply pressure, valve gain); steady_ratio;
+                           // drift_per_s, drift_settles_s: the gain drifting during each run (a sagging supply)
   kDeadzoneShift,          // shift_r_V, shift_l_V: break points moved
   kInputDelay,             // delay_samples: transport delay of the valve command
   kValveLag,               // tau_s, second_tau_s, rate_V_per_s: spool dynamics, one lag or two in series, a speed limit
@@ -63,6 +64,10 @@ struct ParamSpec {
   // fits it apart, the rest of its effect neutral, and keeps the better member; later fits leave
   // it out while it stays neutral (diag/effect_fit.cpp).
   bool starts_alone = false;
+  // A member fitted only after the selection (diag::FitOptions::fit_last), and in later fits once
+  // it is away from its neutral value: free in every fit, it lets the nominal re-fit absorb other
+  // effects further (a gain drifting to nothing over a run soaked up a 5.5-sample delay).
+  bool fitted_last = false;
 };
 std::span<const ParamSpec> param_specs(EffectKind kind);
 
@@ -150,9 +155,12 @@ class DriveEffects {
   struct State {
     double mechanical_speed_mm_s = 0.0;  // v: what friction opposes
     double force_V = 0.0;                // the last sample's force on the piston, volts of drive
+    double run_time_s = 0.0;             // since the run started, for gain_change's drift
   };
   DriveEffects() = default;
-  DriveEffects(const EffectSet& effects, const core::DeadZone& nominal, double speed_mm_s_per_V,
+  // Ts: the sample time, by which each drive_before_position() advances the run's time (0: the
+  // time stands still at the run's start, for a shape drawn against something else).
+  DriveEffects(const EffectSet& effects, const core::DeadZone& nominal, double Ts, double speed_mm_s_per_V,
                double mechanical_pole = 0.0);
   // The drive before the position-dependent factor and the ceiling (history-dependent part); also
   // advances the force (force()).
@@ -162,6 +170,8 @@ class DriveEffects {
   double force() const { return state_.force_V; }
   // The friction force (volts of drive) at mechanical speed v with drive d: the form's shape.
   double friction_V(double mechanical_speed_mm_s, double drive_V) const noexcept;
+  // gain_change's gain (over the nominal) at a time since the run started: its drift's shape.
+  double gain_at(double run_time_s) const noexcept;
   // The position-dependent factor and the ceiling (memoryless part).
   double finish(double drive, double position_mm) const noexcept;
   // Whether finish() reads the position (position_dependent_gain is on and not neutral).
@@ -174,10 +184,12 @@ class DriveEffects {
 
  private:
   core::DeadZone dead_zone_;
+  double Ts_ = 0.0;
   bool friction_ = false;
   double breakaway_ = 0, coulomb_ = 0;
   double speed_mm_s_per_V_ = 0.0, pole_ = 0.0;
   double gain_ = 1.0, steady_extra_ = 0.0, max_drive_ = 0.0;  // max_drive_ 0: no ceiling
+  double drift_per_s_ = 0.0, drift_settles_s_ = 0.0;          // gain_change's drift (settles 0: linear)
   double retract_ratio_ = 1.0, knee_ = 64.0;                   // flow_saturation's family
   double slope_per_mm_ = 0.0, chamber_per_mm_ = 0.0, curvature_ = 0.0;  // position_dependent_gain
   std::size_t where_samples_ = kDefaultWherePositions;

@@ -59,4 +59,15 @@ TEST(EffectShapes, ALagIsTheSpoolsStepAndQuantisationHasNoPanel) {
   EXPECT_TRUE(epa::app::effect_shape_panels(diagnosis_naming(EffectKind::kSensorQuantization, {1.0, 0.0, 0.0})).empty());
 }
 
+TEST(EffectShapes, AGainThatDriftsIsDrawnAgainstTheRunsTimeBesideTheSpeedMap) {
+  const auto holds = epa::app::effect_shape_panels(diagnosis_naming(EffectKind::kGainChange, {0.8, 1.0, 0.0}));
+  ASSERT_EQ(holds.size(), 1u);  // the speed map alone
+  const auto panels = epa::app::effect_shape_panels(diagnosis_naming(EffectKind::kGainChange, {0.8, 1.0, -0.01, 1000.0}));
+  ASSERT_EQ(panels.size(), 2u);
+  EXPECT_EQ(panels[1].x_label, "time since the run started (s)");
+  const auto& gain = panels[1].series[1];
+  EXPECT_NEAR(at(gain, 0.0), 0.8, 1e-12);
+  EXPECT_NEAR(at(gain, 10.0), 0.8 * (1.0 - 0.01 * 1000.0 * -std::expm1(-10.0 / 1000.0)), 1e-12);  // 0.7204: settling in 1000 s
+}
+
 }  // namespace

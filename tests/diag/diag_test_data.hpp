@@ -26,12 +26,23 @@ namespace epa::testing {
 // the two whole delays around it (the library's delay is whole samples).
 // `slew_V_per_s` > 0 moves the spool toward the command by at most that much, a hard clip (the
 // library's speed limit has a rounded knee).
+// `sagging_supply_bar` > 0: the supply falls from 6 bar toward that pressure with a 6-s time
+// constant from each run's start (a receiver the compressor refills only between runs), and the
+// valve's flow goes with the square root of supply less 1 bar of exhaust (the library's drifting
+// gain is linear in time and knows no pressure); applied to the command beyond the break points.
 struct Hidden {
   plant::EffectSet effects;
   double periodic_mm = 0.0;
   double fractional_delay_samples = 0.0;
   double slew_V_per_s = 0.0;
+  double sagging_supply_bar = 0.0;
 };
+
+// The flow's share at time t of a supply sagging toward `to_bar` (Hidden::sagging_supply_bar).
+inline double sagging_supply_flow_ratio(double to_bar, double t_s) {
+  const double supply_bar = to_bar + (6.0 - to_bar) * std::exp(-t_s / 6.0);
+  return std::sqrt((supply_bar - 1.0) / (6.0 - 1.0));
+}
 
 // The paper's model as a rig might differ from it within what identification gives back: B
 // scaled by up to +-3 % (the steady gain), break points moved by up to +-0.02 V. The diagnosis
@@ -98,6 +109,11 @@ inline core::Run make_run(const core::HammersteinModel& truth, const Hidden& hid
         return i <= k ? run.u_V[k - i] : 0.0;
       };
       u = (1.0 - (d - whole)) * past(whole) + (d - whole) * past(whole + 1.0);
+    }
+    if (hidden.sagging_supply_bar > 0.0) {  // the drive beyond each break point scaled with the flow
+      const double ratio = sagging_supply_flow_ratio(hidden.sagging_supply_bar, t);
+      if (u > truth.dead_zone.b_r) u = truth.dead_zone.b_r + ratio * (u - truth.dead_zone.b_r);
+      if (u < truth.dead_zone.b_l) u = truth.dead_zone.b_l + ratio * (u - truth.dead_zone.b_l);
     }
     if (hidden.slew_V_per_s > 0.0) {
       const double most_V = hidden.slew_V_per_s * truth.Ts;

@@ -112,6 +112,38 @@ TEST(Effects, TheFlowCeilingIsPerDirectionAndItsKneeHardOrSoft) {
   EXPECT_NEAR(steady_speed_mm_s(soft, 1.232 + 3.0), 60.0, 3.0);  // far beyond: near the ceiling
 }
 
+// gain_change's drifting member: the gain moves with the run's time (a sagging supply), whatever
+// the command, at drift_per_s from the start and settling with drift_settles_s; with Ts 0 the time
+// stands still (a shape drawn against the command).
+TEST(Effects, AGainThatDriftsMovesWithTheRunsTimeNotWithTheCommand) {
+  EffectSet e;
+  e.set(EffectKind::kGainChange, {0.9, 1.0, -0.01});  // drift_settles_s left out: 1000 s, all but linear
+  const epa::core::DeadZone unit{.m_r = 1.0, .m_l = 1.0, .b_r = 0.0, .b_l = 0.0};
+  epa::plant::DriveEffects drive(e, unit, 0.005, 0.0);
+  EXPECT_DOUBLE_EQ(drive.drive_before_position(1.0), 0.9);
+  for (int k = 1; k < 2000; ++k) drive.drive_before_position(k % 2 ? 1.0 : -1.0);
+  const double at_10_s = 0.9 * (1.0 - 0.01 * 1000.0 * (1.0 - std::exp(-10.0 / 1000.0)));
+  EXPECT_NEAR(at_10_s, 0.81, 0.001);
+  EXPECT_NEAR(drive.drive_before_position(2.0), 2.0 * at_10_s, 1e-12);
+  EXPECT_NEAR(drive.gain_at(10.0), at_10_s, 1e-12);
+  EXPECT_NEAR(drive.gain_at(1000.0), 0.9 * 0.05, 1e-12);  // never below 5 % of the start: the drive never reverses
+  epa::plant::DriveEffects still(e, unit, 0.0, 0.0);
+  for (int k = 0; k < 2000; ++k) still.drive_before_position(1.0);
+  EXPECT_DOUBLE_EQ(still.drive_before_position(1.0), 0.9);
+  EffectSet settles;
+  settles.set(EffectKind::kGainChange, {1.0, 1.0, -0.05, 2.0});  // 5 %/s at first, settling within seconds
+  const epa::plant::DriveEffects settling(settles, unit, 0.005, 0.0);
+  EXPECT_NEAR(settling.gain_at(0.1), 1.0 - 0.05 * 0.1, 2e-4);
+  EXPECT_NEAR(settling.gain_at(20.0), 1.0 - 0.05 * 2.0, 1e-5);  // where the compressor catches up: 10 % down
+  // In the plant: the same command moves the piston as far early in the run, 9-10 % less 4.5-5 s in.
+  EffectSet sags;
+  sags.set(EffectKind::kGainChange, {1.0, 1.0, -0.02});
+  const double beyond_v = 1.232 + 0.1, start_mm = 20.0;
+  auto late_mm = [&](const EffectSet& set) { return travel_mm(set, beyond_v, 1000, start_mm) - travel_mm(set, beyond_v, 900, start_mm); };
+  ASSERT_LT(travel_mm(EffectSet{}, beyond_v, 1000, start_mm), 470.0);  // short of the end stop
+  EXPECT_NEAR(travel_mm(sags, beyond_v, 100, start_mm) / travel_mm(EffectSet{}, beyond_v, 100, start_mm), 0.995, 0.006);
+  EXPECT_NEAR(late_mm(sags) / late_mm(EffectSet{}), 0.905, 0.01);
+}
 
 // The spool family against the continuous-time step responses it stands for: one lag,
 // 1 - exp(-t/tau); two in series, 1 - (t1 exp(-t/t1) - t2 exp(-t/t2)) / (t1 - t2), which starts

@@ -116,6 +116,8 @@ def main():
     ap.add_argument("epa")
     ap.add_argument("--fast", action="store_true", help="the CI subset (one case per phenomenon, one seed)")
     ap.add_argument("--seeds", type=int, default=1, help="seeds per case (the whole set: 38 cases each)")
+    ap.add_argument("--first-seed", type=int, default=1,
+                    help="start at this seed (seeds 3 and 4, never used to change the diagnosis: --first-seed 3 --seeds 4)")
     ap.add_argument("--keep", help="leave each case's runs and report here")
     ap.add_argument("--matrix", help="write the confusion matrix (Markdown) here")
     ap.add_argument("--check", action="store_true", help="exit 1 unless the issue's thresholds hold")
@@ -125,7 +127,7 @@ def main():
     cases = [c for c in CASES if (not args.fast or c[0] in FAST) and (not args.only or re.search(args.only, c[0]))]
     results = []
     with tempfile.TemporaryDirectory(prefix="epa-blind-") as tmp:
-        for seed in range(1, args.seeds + 1):
+        for seed in range(args.first_seed, args.seeds + 1):
             for name, category, factory, expected, allowed in cases:
                 folder = os.path.join(args.keep or tmp, f"{name}-s{seed}")
                 os.makedirs(folder, exist_ok=True)
