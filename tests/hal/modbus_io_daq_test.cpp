@@ -551,6 +551,9 @@ TEST(RemoteIoSimulator, SurvivesAGarbageClientAndRefusesABusyPort) {
 // master's clock: every master cycle sees exactly one step, and it lands between its write and the
 // next read. The master runs at two phases half a period apart, so a free-running module (whose
 // steps keep one phase) fails at least one of them. A 20 ms period leaves 5 ms of slack either side.
+// A cycle is judged only when the test's own thread woke on time for its write and both looks
+// (within kObserverLate): a late observer says nothing about the module (on CI, with the
+// diagnosis's self-check on both cores, one look woke late in one cycle too many: 24 of 27).
 TEST(RemoteIoSimulator, SynchronisedStepsLandHalfAPeriodAfterEachValveWrite) {
   RemoteIoSimulatorConfig c = sim_config();
   c.model.Ts = 0.020;
@@ -560,22 +563,30 @@ TEST(RemoteIoSimulator, SynchronisedStepsLandHalfAPeriodAfterEachValveWrite) {
   ModbusIoDaq daq(daq_config(sim->port()));
   ASSERT_TRUE(daq.open().has_value());
   constexpr int kCycles = 30, kLockCycles = 3;
+  constexpr auto kObserverLate = 2ms;
+  auto woke_late = [&](Clock::time_point due) { return Clock::now() - due > kObserverLate; };
   auto cycle_start = Clock::now() + 7ms;
   for (const auto phase_shift : {0ms, 10ms}) {
     cycle_start += phase_shift;
-    int one_step_between = 0;
+    int judged = 0, one_step_between = 0;
     for (int k = 0; k < kCycles; ++k, cycle_start += 20ms) {
       std::this_thread::sleep_until(cycle_start);
       ASSERT_EQ(daq.write_valve(0.0), IoStatus::kOk);
       const auto at_write = sim->steps();
+      bool late = woke_late(cycle_start);
       std::this_thread::sleep_until(cycle_start + 5ms);
       const auto quarter = sim->steps();
+      late = woke_late(cycle_start + 5ms) || late;
       std::this_thread::sleep_until(cycle_start + 15ms);
       const auto three_quarters = sim->steps();
-      if (k >= kLockCycles && quarter == at_write && three_quarters == at_write + 1) ++one_step_between;
+      late = woke_late(cycle_start + 15ms) || late;
+      if (k < kLockCycles || late) continue;
+      ++judged;
+      if (quarter == at_write && three_quarters == at_write + 1) ++one_step_between;
     }
-    // A scheduling hiccup of the test's own thread may spoil a cycle or two on a loaded machine.
-    EXPECT_GE(one_step_between, kCycles - kLockCycles - 2) << "phase shift " << phase_shift.count() << " ms";
+    // The module's own thread may still be held up once on a loaded machine.
+    EXPECT_GE(judged, (kCycles - kLockCycles) / 2) << "phase shift " << phase_shift.count() << " ms: the test's thread woke late too often to judge";
+    EXPECT_GE(one_step_between, judged - 1) << "phase shift " << phase_shift.count() << " ms: " << one_step_between << " of " << judged;
   }
 }
 
