@@ -360,8 +360,12 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
       ++i;
       continue;
     }
-    std::snprintf(buf, sizeof buf, "%s fitted to %s does nothing: not named", std::string(plant::to_string(d.effects[i])).c_str(),
-                  neutral ? "its neutral values" : "where switching it off moves the held-out gap by less than 0.5 %");
+    if (neutral)
+      std::snprintf(buf, sizeof buf, "%s fitted to its neutral values does nothing: not named",
+                    std::string(plant::to_string(d.effects[i])).c_str());
+    else
+      std::snprintf(buf, sizeof buf, "%s switched off moves the held-out gap by %.2f %%, less than %.1f %%: it does nothing, not named",
+                    std::string(plant::to_string(d.effects[i])).c_str(), change_pct, kDoesNothingPct);
     say(buf);
     current = without(current, d.effects[i]);
     d.effects.erase(d.effects.begin() + static_cast<std::ptrdiff_t>(i));

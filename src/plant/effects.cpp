@@ -243,7 +243,7 @@ double DriveEffects::gain_at(double run_time_s) const noexcept {
 }
 
 double DriveEffects::drive_before_position(double spool_v) noexcept {
-  const double d = dead_zone_.apply(spool_v) * (drift_per_s_ != 0.0 ? gain_at(state_.run_time_s) : gain_);
+  const double d = dead_zone_.apply(spool_v) * gain_at(state_.run_time_s);
   state_.run_time_s += Ts_;
   double force = steady_extra_ * d;
   if (friction_) {
