@@ -115,7 +115,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("epa")
     ap.add_argument("--fast", action="store_true", help="the CI subset (one case per phenomenon, one seed)")
-    ap.add_argument("--seeds", type=int, default=1, help="seeds per case (the whole set: 38 cases each)")
+    ap.add_argument("--seeds", type=int, default=1, help="the last seed: seeds --first-seed..SEEDS run (the whole set: 38 cases each)")
     ap.add_argument("--first-seed", type=int, default=1,
                     help="start at this seed (seeds 3 and 4, never used to change the diagnosis: --first-seed 3 --seeds 4)")
     ap.add_argument("--keep", help="leave each case's runs and report here")
