@@ -3,7 +3,7 @@
 training and 3 held-out runs per case (closed-loop FF-IDZ and NG-IDZ step sequences, open-loop
 ramps and pulse trains), the diagnosis run on each as a user would, and a score.
 
-    blind_diagnosis.py EPA_BINARY [--fast] [--seeds N] [--keep DIR] [--matrix FILE] [--check] [--only REGEX]
+    blind_diagnosis.py EPA_BINARY [--fast] [--seeds N] [--first-seed K] [--keep DIR] [--matrix FILE] [--check] [--only REGEX]
 
 A case is correct when: its effects are all named, nothing outside them and their allowed
 companions is named, and `unexplained` is false (a named effect with `unexplained: true` cannot
