@@ -112,7 +112,7 @@ std::string commission_report_html(const commission::CommissionOutcome& o) {
       p.series.push_back({"measured", "#1f77b4", times(r.y_mm.size(), r.Ts), r.y_mm, false});
       if (sim && i < sim->positions_mm.size())
         p.series.push_back({"simulated (identified model)", "#ff7f0e", times(sim->positions_mm[i].size(), r.Ts), sim->positions_mm[i], true});
-      p.series.push_back({"target", "#2ca02c", {0.0, static_cast<double>(r.y_mm.size()) * r.Ts}, {m.to_mm, m.to_mm}, true});
+      p.series.push_back({"target", "#2ca02c", {0.0, r.duration_s()}, {m.to_mm, m.to_mm}, true});
       panels.push_back(std::move(p));
     }
     h += render_svg("", panels, 2, 560, 260);

@@ -83,7 +83,7 @@ core::Result<std::vector<IdentifiedRun>> load_runs(const std::vector<std::string
     if (auto s = ident::check_excitation(r.segments, path, check, o.mm_per_volt); !s) return s.error();
     char buf[320];
     std::snprintf(buf, sizeof buf, "  %-11s %s: %zu samples (%g s), %zu segment(s)", estimation ? "estimation" : "validation",
-                  path.c_str(), r.run.size(), static_cast<double>(r.run.size()) * r.run.Ts, r.segments.size());
+                  path.c_str(), r.run.size(), r.run.duration_s(), r.segments.size());
     out << buf;
     if (report.samples_at_stops + report.samples_in_short > 0)
       out << "; " << report.samples_at_stops + report.samples_in_short

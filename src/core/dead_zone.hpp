@@ -1,9 +1,15 @@
 #pragma once
 // The valve's asymmetric dead zone (paper eq 2) and its inverse (eq 5). Shared by the plant
 // (which applies it) and the controllers (which invert it), hence in core.
+#include <string_view>
+
 #include "core/result.hpp"
 
 namespace epa::core {
+
+// Its fields' names, in field order: the keys of the [dead_zone] table in the model file and the
+// tuning file alike (FORMATS.md), and the names validate() gives.
+inline constexpr std::string_view kDeadZoneKeys[] = {"m_r", "m_l", "b_r", "b_l"};
 
 struct DeadZone {
   double m_r = 1.0;  // right slope (valve volts in -> effective volts out), > 0

@@ -33,10 +33,6 @@ namespace epa::core {
 // Which model describes the axis: epa identify's verdict, the one that follows held-out runs better.
 enum class AxisModel { kHammerstein, kStickSlip };
 
-// The keys of the [dead_zone] table, in the model file and in the tuning file alike (FORMATS.md),
-// in the order of core::DeadZone's fields m_r, m_l, b_r, b_l.
-inline constexpr std::string_view kDeadZoneKeys[] = {"m_r", "m_l", "b_r", "b_l"};
-
 struct ModelFile {
   HammersteinModel model;
   std::string source;  // provenance text

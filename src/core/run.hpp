@@ -20,6 +20,8 @@ struct Run {
   std::vector<double> uc_V;  // controller output before dead-zone compensation (optional)
 
   std::size_t size() const { return t_s.size(); }
+  // How long it lasts: each sample is held for Ts.
+  double duration_s() const { return static_cast<double>(size()) * Ts; }
 
   // Value of a metadata key, or "" when absent.
   std::string meta(const std::string& key) const {

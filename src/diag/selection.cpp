@@ -87,7 +87,7 @@ bool unexplained(const Diagnosis& d, const DiagnosisOptions& o) {
 
 double longest_run_s(const std::vector<const core::Run*>& runs) {
   double s = 0.0;
-  for (const auto* r : runs) s = std::max(s, static_cast<double>(r->size()) * r->Ts);
+  for (const auto* r : runs) s = std::max(s, r->duration_s());
   return s;
 }
 

@@ -40,9 +40,8 @@ TEST(PointCatalog, OneEntryPerIdInOrderWithUniqueNames) {
 const std::map<std::string, std::string> kFormatFiles = {
     {"config/appliance_config.cpp", "epa-config/1 keys"},
     {"store/tuning_file.cpp", "epa-tuning/1 keys"},
-    {"core/dead_zone.cpp", "epa-model/1 dead-zone keys"},
+    {"core/dead_zone.hpp", "epa-model/1 and epa-tuning/1 dead-zone keys"},
     {"core/model_file.cpp", "epa-model/1 keys"},
-    {"core/model_file.hpp", "epa-model/1 and epa-tuning/1 dead-zone keys"},
     {"core/run_file.cpp", "epa-run/1 metadata"},
     {"runtime/recorder.cpp", "epa-run/1 metadata"},
     {"app/run_history.cpp", "epa-run/1 metadata"},
