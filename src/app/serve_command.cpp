@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 #include <systemd/sd-daemon.h>
 
+#include <atomic>
 #include <csignal>
 #include <ctime>
 #include <mutex>
@@ -152,9 +153,12 @@ core::Result<ControlSetup> prepare_control(config::ApplianceConfig& c, const std
   return ControlSetup{std::move(*plant_model), std::move(*store), base, *tuning};
 }
 
+// `web_port`: where the status page listens (its VendorUrl), 0 with none.
 core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const config::ApplianceConfig& c, const modbus::RegisterMap& map,
-                                                                 points::WriteGate& gate, runtime::LoopChannels& channels) {
-  auto server = modbus::ModbusServer::start(c.modbus, map, gate, channels, [](const std::string& line) { spdlog::info("{}", line); });
+                                                                 points::WriteGate& gate, runtime::LoopChannels& channels, int web_port) {
+  modbus::ServerConfig mc = c.modbus;
+  mc.status_page_url = web_port > 0 ? modbus::status_page_url(web_port) : "";
+  auto server = modbus::ModbusServer::start(mc, map, gate, channels, [](const std::string& line) { spdlog::info("{}", line); });
   if (!server) return server.error();
   const auto& p = c.modbus.policy;
   std::string aliases;
@@ -165,10 +169,14 @@ core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const config::A
   return server;
 }
 
+// `modbus`: the Modbus server once it has started (after the web server: its identity names the
+// status page's port), null while it has not or without one.
 core::Result<std::unique_ptr<web::WebServer>> start_web(const config::ApplianceConfig& c, runtime::LoopChannels& channels,
-                                                        points::WriteGate& gate, web::RecentAudit& audit, const modbus::ModbusServer* mb,
+                                                        points::WriteGate& gate, web::RecentAudit& audit,
+                                                        const std::atomic<const modbus::ModbusServer*>& modbus,
                                                         const store::StoreWriter& store, web::CommissionPort* commission) {
-  auto modbus_stats = [mb] {
+  auto modbus_stats = [&modbus] {
+    const modbus::ModbusServer* mb = modbus.load();
     return mb ? web::ModbusStats{true, mb->clients(), mb->requests(), mb->exceptions()} : web::ModbusStats{};
   };
   auto store_stats = [&store] {
@@ -354,17 +362,22 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   auto commissioning = std::make_unique<CommissionService>(make_axis, identify_for_commissioning(c.runtime.mm_per_volt),
                                                            [](const std::string& line) { spdlog::info("{}", line); });
   gate.attach_commission(commissioning.get());
+  // The web server starts first, so the Modbus identity names the port it bound (VendorUrl; with
+  // `port = 0` only the bind knows it), and stops first (declared after the Modbus server): its
+  // status reads the Modbus server's counters through `modbus_for_web`, set once that runs.
+  std::atomic<const modbus::ModbusServer*> modbus_for_web{nullptr};
   std::unique_ptr<modbus::ModbusServer> modbus_server;
-  if (register_map) {
-    auto server = start_modbus(c, *register_map, gate, channels);
-    if (!server) return spdlog::error("{}", server.error().message), 1;
-    modbus_server = std::move(*server);
-  }
   std::unique_ptr<web::WebServer> web_server;
   if (c.web_enabled) {
-    auto server = start_web(c, channels, gate, audit, modbus_server.get(), store_writer, commissioning.get());
+    auto server = start_web(c, channels, gate, audit, modbus_for_web, store_writer, commissioning.get());
     if (!server) return spdlog::error("{}", server.error().message), 1;
     web_server = std::move(*server);
+  }
+  if (register_map) {
+    auto server = start_modbus(c, *register_map, gate, channels, web_server ? web_server->port() : 0);
+    if (!server) return spdlog::error("{}", server.error().message), 1;
+    modbus_server = std::move(*server);
+    modbus_for_web = modbus_server.get();
   }
   runtime::Recorder recorder({.directory = c.record_directory, .per_move = c.record_per_move, .Ts = c.runtime.period_s,
                               .source = std::string("appliance/") + to_string(c.backend)},

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <string>
 
 #include "core/version.hpp"
 #include "modbus/exception_codes.hpp"
@@ -28,11 +29,13 @@ void append_object(std::vector<std::uint8_t>& pdu, int id, std::string_view valu
 
 }  // namespace
 
-DeviceIdentity appliance_identity(std::string_view register_map_path) {
+std::string status_page_url(int web_port) { return "http://<appliance>:" + std::to_string(web_port) + "/"; }
+
+DeviceIdentity appliance_identity(std::string_view register_map_path, std::string_view status_page_url) {
   return {{"EPA project", "epa", std::string(core::kVersion),
            // No public project address exists yet: the appliance's own status page, where its documentation
            // for the integrator lives (README, "The status page and HTTP API").
-           "http://<appliance>:8080/", "EPA electro-pneumatic axis controller", "epa appliance",
+           std::string(status_page_url), "EPA electro-pneumatic axis controller", "epa appliance",
            std::filesystem::path(register_map_path).filename().string()}};
 }
 

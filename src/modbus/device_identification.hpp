@@ -27,9 +27,14 @@ struct DeviceIdentity {
   static constexpr int kMaxObjectBytes = kMaxPduBytes - 7 - 2;  // the response's own 7 bytes, the object's id and length
 };
 
-// This appliance's objects: the version of project() in CMakeLists.txt as the revision, and
+// The address of the appliance's status page served on `web_port`, as VendorUrl names it: the
+// appliance cannot know the name its clients reach it by, so the host stays "<appliance>".
+std::string status_page_url(int web_port);
+
+// This appliance's objects: the version of project() in CMakeLists.txt as the revision,
+// `status_page_url` (status_page_url(), or "" with no status page) as the vendor's URL, and
 // `register_map_path`'s file name as the user application (the map is what a site configures).
-DeviceIdentity appliance_identity(std::string_view register_map_path);
+DeviceIdentity appliance_identity(std::string_view register_map_path, std::string_view status_page_url);
 
 // `data` is the request PDU after the function code (MEI type, read code, object id), `length`
 // bytes. Returns 0 with the whole response PDU (function code first) in `pdu`, or the exception:

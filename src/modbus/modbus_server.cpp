@@ -59,7 +59,7 @@ struct ModbusServer::Impl {
   Log log;
 
   Impl(const ServerConfig& c, const RegisterMap& map, points::WriteGate& gate, runtime::LoopChannels& ch, Log l)
-      : config(c), handler(map, c.policy, unit_ids(c), gate, ch, l), log(std::move(l)) {}
+      : config(c), handler(map, c.policy, unit_ids(c), c.status_page_url, gate, ch, l), log(std::move(l)) {}
   static std::vector<int> unit_ids(const ServerConfig& c) {
     std::vector<int> ids = {c.unit_id};
     ids.insert(ids.end(), c.alias_unit_ids.begin(), c.alias_unit_ids.end());

@@ -27,6 +27,7 @@ struct ServerConfig {
   double idle_timeout_s = 60.0;      // a client without a complete request this long is disconnected
   double frame_timeout_s = 1.0;      // a frame not complete this long after its first byte: disconnected
   WritePolicy policy;
+  std::string status_page_url;       // FC43's VendorUrl: status_page_url(the web port), "" with no status page
 };
 
 class ModbusServer {

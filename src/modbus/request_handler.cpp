@@ -28,9 +28,9 @@ std::uint8_t* table_bits(_modbus_mapping_t* m, Table t) { return t == Table::kCo
 
 }  // namespace
 
-RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, std::vector<int> unit_ids, points::WriteGate& gate,
-                               runtime::LoopChannels& channels, Log log)
-    : map_(map), policy_(std::move(policy)), unit_ids_(std::move(unit_ids)), identity_(appliance_identity(map.source())), gate_(gate),
+RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, std::vector<int> unit_ids, std::string_view status_page_url,
+                               points::WriteGate& gate, runtime::LoopChannels& channels, Log log)
+    : map_(map), policy_(std::move(policy)), unit_ids_(std::move(unit_ids)), identity_(appliance_identity(map.source(), status_page_url)), gate_(gate),
       channels_(channels), log_(std::move(log)), unlock_(policy_.unlock_key) {}
 
 points::InterfaceStatus RequestHandler::status(const Session& session, std::int64_t now_ns) const {

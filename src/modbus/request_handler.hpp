@@ -23,6 +23,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "modbus/device_identification.hpp"
@@ -63,10 +64,11 @@ inline const std::vector<int> kDefaultAliasUnitIds = {0, 0xFF};
 class RequestHandler {
  public:
   using Log = std::function<void(const std::string&)>;
-  // `unit_ids`: every unit id answered as this device (others get 0B). The map, gate and channels
-  // must outlive the handler.
-  RequestHandler(const RegisterMap& map, WritePolicy policy, std::vector<int> unit_ids, points::WriteGate& gate,
-                 runtime::LoopChannels& channels, Log log = {});
+  // `unit_ids`: every unit id answered as this device (others get 0B); `status_page_url`: the
+  // device identification's VendorUrl (appliance_identity). The map, gate and channels must
+  // outlive the handler.
+  RequestHandler(const RegisterMap& map, WritePolicy policy, std::vector<int> unit_ids, std::string_view status_page_url,
+                 points::WriteGate& gate, runtime::LoopChannels& channels, Log log = {});
 
   // `req` is a whole Modbus TCP ADU (7-byte MBAP header, then the PDU); `image` is the register
   // image of new_register_image(), which the reply's modbus_reply reads.

@@ -47,11 +47,13 @@ SRC = None
 class ApplianceTest(unittest.TestCase):
     REGISTER_MAP = None  # relative to the source dir
     EXTRA_CONFIG = ""
+    STATUS_PAGE = False  # the status page on a free port too (FC43's VendorUrl names it)
     app = None
 
     @classmethod
     def setUpClass(cls):
-        cls.app = Appliance(EPA, os.path.join(SRC, cls.REGISTER_MAP), cls.EXTRA_CONFIG)
+        cls.app = Appliance(EPA, os.path.join(SRC, cls.REGISTER_MAP), cls.EXTRA_CONFIG,
+                            web_static_dir=os.path.join(SRC, "web") if cls.STATUS_PAGE else None)
         cls.c = cls.app.client
         cls.failed = False
 
@@ -128,6 +130,7 @@ class EpaMapTest(ApplianceTest):
     REGISTER_MAP = "registers/epa.csv"
     # A supervising client must change the heartbeat in RUN; test_5 lets it lapse for a fault.
     EXTRA_CONFIG = f"[limits]\nheartbeat_timeout_s = {HEARTBEAT_TIMEOUT_S}\n"
+    STATUS_PAGE = True
 
     # Input register blocks of epa.csv (address, count): each contiguous run of mapped registers.
     INPUT_BLOCKS = [(0, 11), (12, 3), (16, 2), (20, 42), (70, 14), (90, 14), (110, 17)]
@@ -325,7 +328,8 @@ class EpaMapTest(ApplianceTest):
         regular = self.ok(self.device_information(REGULAR), "FC43/14 read code 02 (regular)")
         print(f"  FC43 regular: conformity {regular.conformity:#04x}, objects {regular.information}", file=sys.stderr)
         self.assertEqual(regular.information, {
-            0x00: b"EPA project", 0x01: b"epa", 0x02: version, 0x03: b"http://<appliance>:8080/",
+            0x00: b"EPA project", 0x01: b"epa", 0x02: version,
+            0x03: f"http://<appliance>:{self.app.web_port}/".encode(),  # the status page, on the port it runs on
             0x04: b"EPA electro-pneumatic axis controller", 0x05: b"epa appliance", 0x06: b"epa.csv"})
         self.assertEqual((regular.conformity, regular.more_follows, regular.number_of_objects), (0x82, 0, 7))
         extended = self.ok(self.device_information(EXTENDED), "FC43/14 read code 03: answered at the regular level")
@@ -416,6 +420,8 @@ class LegacyHmiMapTest(ApplianceTest):
         # Device identification names this map as the user application.
         app = self.ok(c.execute(ReadDeviceInformationRequest(read_code=0x04, object_id=0x06, unit=UNIT)), "FC43 object 6")
         self.assertEqual(app.information, {0x06: b"legacy-hmi.csv"}, "UserApplicationName: the map's file name")
+        url = self.ok(c.execute(ReadDeviceInformationRequest(read_code=0x04, object_id=0x03, unit=UNIT)), "FC43 object 3")
+        self.assertEqual(url.information, {0x03: b""}, "VendorUrl: empty, this appliance runs no status page")
 
     def test_2_exceptions(self):
         c = self.c

@@ -54,7 +54,7 @@ class Handler : public ::testing::Test {
     gate_ = std::make_unique<points::WriteGate>(std::move(*limits), loop_,
                                                 control::paper_controller_config(control::ControllerKind::kPpFfidz), channels_,
                                                 &sink_);
-    handler_ = std::make_unique<RequestHandler>(*map_, std::move(policy), std::move(unit_ids), *gate_, channels_,
+    handler_ = std::make_unique<RequestHandler>(*map_, std::move(policy), std::move(unit_ids), status_page_url(8080), *gate_, channels_,
                                                 [this](const std::string& line) { log_.push_back(line); });
     if (image_) modbus_mapping_free(image_);
     image_ = new_register_image(*map_);
@@ -457,6 +457,13 @@ TEST_F(Handler, DeviceIdentificationExceptions) {
   EXPECT_EQ(send({0x2B}), 0x03);                          // no MEI type at all
   const Reply r = reply({0x2B, 0x0E, 0x04, 0x07});
   EXPECT_TRUE(r.pdu.empty());  // an exception carries no PDU of its own
+}
+
+// VendorUrl is the status page on the port the web server runs on, empty without one (serve passes
+// the bound port: tests/interop/pymodbus_test.py reads it with pymodbus from a running appliance).
+TEST(DeviceIdentification, TheVendorUrlIsTheStatusPageOnItsPortOrEmptyWithoutOne) {
+  EXPECT_EQ(appliance_identity("/etc/epa/epa.csv", status_page_url(8123)).objects[3], "http://<appliance>:8123/");
+  EXPECT_EQ(appliance_identity("/etc/epa/epa.csv", "").objects[3], "");
 }
 
 TEST(DeviceIdentification, AStreamLongerThanAPduIsSplitWithMoreFollows) {
