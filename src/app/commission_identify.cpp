@@ -66,14 +66,14 @@ commission::Identify identify_for_commissioning(double mm_per_volt) {
     if (!identified) return identified.error();
     const core::HammersteinModel model = identified->model(Ts, mm_per_volt);
     if (auto s = model.validate(); !s) return core::numerical_error("the identified model is not valid: " + s.error().message);
-    const ModelFitSummary fits = summarise_fit(identified->fit, est, val);
+    const ModelFitSummary fits = summarise_fit(identified->fit, est, val, identified->selection.first);
 
     commission::IdentifiedModel out{model, fits.estimation.simulation_pct, fits.validation.simulation_pct, {}, {}};
     // The held-out run's free run, where its first segment lies (NaN elsewhere: end stops).
     out.validation_simulated_mm.assign(validation.size(), std::nan(""));
     const auto ud = ident::through_dead_zone(val, identified->fit.dead_zone);
     if (!ud.empty()) {
-      const auto yhat = ident::simulate_free_run(identified->fit.arx.model, ud.front(), identified->fit.arx.model.orders.first_row());
+      const auto yhat = ident::simulate_free_run(identified->fit.arx.model, ud.front(), fits.first_sample);
       const auto first = static_cast<std::size_t>(std::llround((ud.front().t0_s - validation.t_s.front()) / Ts));
       for (std::size_t k = 0; k < yhat.size() && first + k < out.validation_simulated_mm.size(); ++k)
         out.validation_simulated_mm[first + k] = yhat[k] * mm_per_volt;

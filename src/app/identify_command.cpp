@@ -208,7 +208,7 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   const core::HammersteinModel model = fit.model(*Ts, o.mm_per_volt);
   if (auto s = model.validate(); !s) return fail("the identified model is not valid: " + s.error().message);
 
-  const ModelFitSummary summary = summarise_fit(fit, est_segments, val_segments);
+  const ModelFitSummary summary = summarise_fit(fit, est_segments, val_segments, identified->selection.first);
   print_identified_model(out, fit, model, summary, o.m_l);
 
   std::optional<ident::StickSlipIdentification> stick_slip;

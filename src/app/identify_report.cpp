@@ -12,9 +12,10 @@
 namespace epa::app {
 
 ModelFitSummary summarise_fit(const ident::HammersteinFit& fit, const std::vector<ident::Segment>& est,
-                              const std::vector<ident::Segment>& val) {
+                              const std::vector<ident::Segment>& val, std::size_t first_sample) {
   ModelFitSummary s;
-  const std::size_t first = fit.arx.model.orders.first_row();
+  const std::size_t first = std::max(first_sample, fit.arx.model.orders.first_row());
+  s.first_sample = first;
   s.estimation = ident::fit_percent(fit.arx.model, ident::through_dead_zone(est, fit.dead_zone), first);
   s.validated = !val.empty();
   if (s.validated) s.validation = ident::fit_percent(fit.arx.model, ident::through_dead_zone(val, fit.dead_zone), first);
@@ -57,8 +58,9 @@ void print_identified_model(std::ostream& out, const ident::HammersteinFit& fit,
                 dz.b_r, dz.b_l);
   out << buf;
   std::snprintf(buf, sizeof buf,
-                "  fit (free-run simulation / one-step prediction): estimation %.2f %% / %.2f %%", s.estimation.simulation_pct,
-                s.estimation.one_step_pct);
+                "  fit (free-run simulation / one-step prediction, from sample %zu of each run as in the order table): "
+                "estimation %.2f %% / %.2f %%",
+                s.first_sample, s.estimation.simulation_pct, s.estimation.one_step_pct);
   out << buf;
   if (s.validated) {
     std::snprintf(buf, sizeof buf, ", validation %.2f %% / %.2f %%", s.validation.simulation_pct, s.validation.one_step_pct);

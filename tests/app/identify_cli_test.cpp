@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
 
@@ -111,6 +112,18 @@ TEST_F(IdentifyCli, IdentifiesThePhysicsPlant) {
   EXPECT_NE(o.output.find("right break point kept in [+1.3"), std::string::npos) << o.output;
   EXPECT_NE(o.output.find("Refinement:"), std::string::npos);
   EXPECT_NE(o.output.find("simulation error V ="), std::string::npos);
+  // The model's fits are its row's in the order table: the same model scored from the same first
+  // sample (from its own, two samples earlier, it read 68.08 % against the row's 70.20 % once).
+  std::smatch row, summary;
+  ASSERT_TRUE(std::regex_search(o.output, row, std::regex(R"(\|\s+([0-9.]+)\s+([0-9.]+)\s+\|\s+([0-9.]+)\s+([0-9.]+)\s+\|[^\n]*<- recommended)")))
+      << o.output;
+  ASSERT_TRUE(std::regex_search(o.output, summary,
+                                std::regex(R"(estimation ([0-9.]+) % / ([0-9.]+) %, validation ([0-9.]+) % / ([0-9.]+) %)")))
+      << o.output;
+  EXPECT_EQ(row[2], summary[1]) << "estimation free-run";
+  EXPECT_EQ(row[1], summary[2]) << "estimation one-step";
+  EXPECT_EQ(row[4], summary[3]) << "validation free-run";
+  EXPECT_EQ(row[3], summary[4]) << "validation one-step";
   auto model = epa::core::read_model_file(path("model.toml"));
   ASSERT_TRUE(model.has_value()) << model.error().message;
   const auto& dz = model->model.dead_zone;
