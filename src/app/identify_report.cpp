@@ -58,7 +58,7 @@ void print_identified_model(std::ostream& out, const ident::HammersteinFit& fit,
                 dz.b_r, dz.b_l);
   out << buf;
   std::snprintf(buf, sizeof buf,
-                "  fit (free-run simulation / one-step prediction, from sample %zu of each run as in the order table): "
+                "  fit (free-run simulation / one-step prediction, scored from sample %zu of each run as the order table is): "
                 "estimation %.2f %% / %.2f %%",
                 s.first_sample, s.estimation.simulation_pct, s.estimation.one_step_pct);
   out << buf;
