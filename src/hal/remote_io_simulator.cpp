@@ -82,6 +82,7 @@ struct RemoteIoSimulator::Impl {
   std::atomic<double> last_valve_v{0.0};
   std::atomic<std::int64_t> last_request_ns{0};       // 0: no request yet (the watchdog waits for one)
   std::atomic<std::int64_t> last_valve_write_ns{0};   // when the last write to the valve arrived; 0: none yet
+  std::atomic<std::int64_t> next_step_due_ns{0};      // when the step the plant thread waits for is due
   std::atomic<bool> watchdog_tripped{false};
   std::atomic<std::int64_t> sensor_fault_step{-1};    // plant step at which a sensor fault was injected
   std::atomic<long> steps_to_safe{-1};
@@ -241,6 +242,7 @@ void RemoteIoSimulator::Impl::run_plant() noexcept {
     if (config.sync_to_valve_writes && write_ns > step_before_ns)
       next_ns = std::clamp(write_ns + period_ns + period_ns / 2, last_step_ns + period_ns / 2, last_step_ns + period_ns * 3 / 2);
     step_before_ns = last_step_ns;
+    next_step_due_ns.store(next_ns);
     const timespec deadline = from_ns(next_ns);
     while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
     }
@@ -369,6 +371,9 @@ int RemoteIoSimulator::port() const { return impl_->bound_port; }
 double RemoteIoSimulator::position_mm() const { return impl_->position_mm.load(); }
 std::uint64_t RemoteIoSimulator::steps() const { return impl_->steps.load(); }
 std::uint64_t RemoteIoSimulator::overruns() const { return impl_->overruns.load(); }
+std::chrono::steady_clock::time_point RemoteIoSimulator::next_step_due() const {
+  return std::chrono::steady_clock::time_point(std::chrono::nanoseconds(impl_->next_step_due_ns.load()));
+}
 std::uint64_t RemoteIoSimulator::requests() const { return impl_->requests.load(); }
 int RemoteIoSimulator::clients() const { return impl_->clients.load(); }
 void RemoteIoSimulator::stop() { impl_->stop(); }

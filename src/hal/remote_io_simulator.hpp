@@ -27,6 +27,7 @@
 // disconnects, sends garbage or stalls mid-frame for more than 100 ms is dropped; the server
 // carries on. The register mapping is shared under a std::mutex: this is a test tool, not the
 // real-time loop.
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -84,6 +85,9 @@ class RemoteIoSimulator {
   double position_mm() const;     // true piston position, for tests and logs
   std::uint64_t steps() const;    // plant steps done
   std::uint64_t overruns() const; // times the plant thread gave up catching up (see above)
+  // When the step the plant thread waits for (or is doing) is due, on steady_clock (which is
+  // CLOCK_MONOTONIC): tells a test a thread that woke late on a loaded machine from a wrong schedule.
+  std::chrono::steady_clock::time_point next_step_due() const;
   std::uint64_t requests() const; // Modbus requests answered (including exceptions)
   int clients() const;            // clients connected now
   double valve_v() const;         // the valve command the plant got at its last step
