@@ -7,9 +7,8 @@
 namespace epa::core {
 
 Status DeadZone::validate() const {
-  const double values[] = {m_r, m_l, b_r, b_l};  // kDeadZoneKeys' order
-  for (std::size_t i = 0; i < std::size(values); ++i) {
-    if (!std::isfinite(values[i]))
+  for (std::size_t i = 0; i < std::size(kDeadZoneMembers); ++i) {
+    if (!std::isfinite(this->*kDeadZoneMembers[i]))
       return invalid_argument("dead zone: " + std::string(kDeadZoneKeys[i]) + " is not a finite number");
   }
   if (m_r <= 0.0) return invalid_argument("dead zone: slope m_r must be > 0, got " + std::to_string(m_r));

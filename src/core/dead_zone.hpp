@@ -1,6 +1,7 @@
 #pragma once
 // The valve's asymmetric dead zone (paper eq 2) and its inverse (eq 5). Shared by the plant
 // (which applies it) and the controllers (which invert it), hence in core.
+#include <iterator>
 #include <string_view>
 
 #include "core/result.hpp"
@@ -36,5 +37,10 @@ struct DeadZone {
 
   bool operator==(const DeadZone&) const = default;
 };
+
+// The members kDeadZoneKeys name, in the same order: the one list that validate(), the files'
+// readers and their writers walk, so that a field cannot be left out of one of them.
+inline constexpr double DeadZone::*kDeadZoneMembers[] = {&DeadZone::m_r, &DeadZone::m_l, &DeadZone::b_r, &DeadZone::b_l};
+static_assert(std::size(kDeadZoneMembers) == std::size(kDeadZoneKeys));
 
 }  // namespace epa::core

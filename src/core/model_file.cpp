@@ -125,11 +125,10 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
   const auto* dz = root["dead_zone"].as_table();
   if (!dz) return parse_error(src + ": table [dead_zone] is missing");
   if (auto s = only_keys(*dz, kDeadZoneKeys, src + ": [dead_zone]"); !s) return s.error();
-  double* fields[] = {&f.model.dead_zone.m_r, &f.model.dead_zone.m_l, &f.model.dead_zone.b_r, &f.model.dead_zone.b_l};
-  for (int i = 0; i < 4; ++i) {
+  for (std::size_t i = 0; i < std::size(kDeadZoneKeys); ++i) {
     auto v = number_at(*dz, "dead_zone", kDeadZoneKeys[i].data(), src);  // literals: terminated
     if (!v) return v.error();
-    *fields[i] = *v;
+    f.model.dead_zone.*kDeadZoneMembers[i] = *v;
   }
   if (auto s = f.model.validate(); !s) return invalid_argument(src + ": " + s.error().message);
   if (root.contains("stick_slip")) {
@@ -173,6 +172,13 @@ std::string format_stick_slip(const StickSlipParams& p) {
 
 }  // namespace
 
+std::string format_dead_zone_table(const DeadZone& dead_zone) {
+  std::string table = "[dead_zone]\n";
+  for (std::size_t i = 0; i < std::size(kDeadZoneKeys); ++i)
+    table += std::string(kDeadZoneKeys[i]) + " = " + toml_float(dead_zone.*kDeadZoneMembers[i]) + "\n";
+  return table;
+}
+
 std::string format_model_toml(const ModelFile& f) {
   auto num = [](double v) { return toml_float(v); };
   auto list = [](const Polynomial& p) { return toml_float_array(p.coefficients()); };
@@ -182,9 +188,7 @@ std::string format_model_toml(const ModelFile& f) {
   return "schema = \"" + std::string(kSchema) + "\"\nTs = " + num(m.Ts) + "\nmm_per_volt = " + num(m.mm_per_volt) +
          "\nsource = " + source.str() + "\n" +
          (f.axis_model == AxisModel::kStickSlip ? "axis_model = \"stick-slip\"\n" : "") + "\n[arx]\nA = " + list(m.A) + "\nB = " + list(m.B) +
-         "\n\n[dead_zone]\nm_r = " + num(m.dead_zone.m_r) + "\nm_l = " + num(m.dead_zone.m_l) +
-         "\nb_r = " + num(m.dead_zone.b_r) + "\nb_l = " + num(m.dead_zone.b_l) + "\n" +
-         (f.stick_slip ? format_stick_slip(*f.stick_slip) : std::string());
+         "\n\n" + format_dead_zone_table(m.dead_zone) + (f.stick_slip ? format_stick_slip(*f.stick_slip) : std::string());
 }
 
 Status write_model_file(const std::string& path, const ModelFile& file) {

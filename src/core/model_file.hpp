@@ -44,6 +44,8 @@ struct ModelFile {
 Result<ModelFile> parse_model_toml(const std::string& text, const std::string& source_name);
 Result<ModelFile> read_model_file(const std::string& path);
 std::string format_model_toml(const ModelFile& file);
+// The [dead_zone] table, header and one line per key, as the model file and the tuning file write it.
+std::string format_dead_zone_table(const DeadZone& dead_zone);
 Status write_model_file(const std::string& path, const ModelFile& file);
 
 }  // namespace epa::core

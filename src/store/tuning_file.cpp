@@ -62,9 +62,7 @@ std::string format_tuning_toml(const TuningSet& t, const ModelRecord& m) {
   s += "design = " + quoted(t.design_json) + "\n";
   s += "\n[rst]\nF = " + toml_float_array(t.F.coefficients()) + "\nG = " + toml_float_array(t.G.coefficients()) +
        "\nH = " + toml_float_array(t.H.coefficients()) + "\n";
-  const auto& dz = t.dead_zone;
-  s += "\n[dead_zone]\nm_r = " + toml_float(dz.m_r) + "\nm_l = " + toml_float(dz.m_l) + "\nb_r = " + toml_float(dz.b_r) +
-       "\nb_l = " + toml_float(dz.b_l) + "\n";
+  s += "\n" + core::format_dead_zone_table(t.dead_zone);
   s += "\n[trajectory]  # pp-traj's parameters (README \"pp-traj\")\n";
   for (const auto& [key, value] : trajectory_setting_values(t.trajectory)) s += key + " = " + toml_float(value) + "\n";
   // The model section is the model file's own text, moved under [model].
@@ -120,11 +118,10 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
   const auto* dz = root["dead_zone"].as_table();
   if (!dz) return core::parse_error(src + ": table [dead_zone] is missing");
   if (auto s = core::only_keys(*dz, core::kDeadZoneKeys, src + ": [dead_zone]"); !s) return s.error();
-  double* fields[] = {&t.dead_zone.m_r, &t.dead_zone.m_l, &t.dead_zone.b_r, &t.dead_zone.b_l};
-  for (int i = 0; i < 4; ++i) {
+  for (std::size_t i = 0; i < std::size(core::kDeadZoneKeys); ++i) {
     auto v = number(*dz, core::kDeadZoneKeys[i].data(), src + ": [dead_zone]");  // literals: terminated
     if (!v) return v.error();
-    *fields[i] = *v;
+    t.dead_zone.*core::kDeadZoneMembers[i] = *v;
   }
 
   if (const auto* trajectory = root["trajectory"].as_table()) {  // optional: files from before pp-traj have none
