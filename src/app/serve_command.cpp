@@ -153,11 +153,12 @@ core::Result<ControlSetup> prepare_control(config::ApplianceConfig& c, const std
   return ControlSetup{std::move(*plant_model), std::move(*store), base, *tuning};
 }
 
-// `web_port`: where the status page listens (its VendorUrl), 0 with none.
+// `status_page_url`: the status page's address (FC43's VendorUrl), "" with none.
 core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const config::ApplianceConfig& c, const modbus::RegisterMap& map,
-                                                                 points::WriteGate& gate, runtime::LoopChannels& channels, int web_port) {
+                                                                 points::WriteGate& gate, runtime::LoopChannels& channels,
+                                                                 std::string status_page_url) {
   modbus::ServerConfig mc = c.modbus;
-  mc.status_page_url = web_port > 0 ? modbus::status_page_url(web_port) : "";
+  mc.status_page_url = std::move(status_page_url);
   auto server = modbus::ModbusServer::start(mc, map, gate, channels, [](const std::string& line) { spdlog::info("{}", line); });
   if (!server) return server.error();
   const auto& p = c.modbus.policy;
@@ -374,7 +375,8 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
     web_server = std::move(*server);
   }
   if (register_map) {
-    auto server = start_modbus(c, *register_map, gate, channels, web_server ? web_server->port() : 0);
+    auto server = start_modbus(c, *register_map, gate, channels,
+                               web_server ? modbus::status_page_url(web_server->port()) : std::string());
     if (!server) return spdlog::error("{}", server.error().message), 1;
     modbus_server = std::move(*server);
     modbus_for_web = modbus_server.get();

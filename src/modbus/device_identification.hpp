@@ -30,6 +30,9 @@ struct DeviceIdentity {
 // The address of the appliance's status page served on `web_port`, as VendorUrl names it: the
 // appliance cannot know the name its clients reach it by, so the host stays "<appliance>".
 std::string status_page_url(int web_port);
+// The same with the port given as text: the register document writes "<[web] port>", since the
+// port is a setting of the web server, which this layer does not see.
+std::string status_page_url(std::string_view web_port);
 
 // This appliance's objects: the version of project() in CMakeLists.txt as the revision,
 // `status_page_url` (status_page_url(), or "" with no status page) as the vendor's URL, and
