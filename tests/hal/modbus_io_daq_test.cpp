@@ -561,7 +561,19 @@ struct MasterPhaseTally {
   int shift_ms = 0, judged = 0, landed = 0;
 };
 
-std::vector<MasterPhaseTally> tally_steps_in_master_cycles(const RemoteIoSimulator& sim, ModbusIoDaq& daq) {
+// A module with a 20 ms period, synchronised to valve writes or free-running, and the tally at each
+// of the master's two phases; empty (with the failure recorded) when the module does not start.
+// Fails too when a thread woke late so often that fewer than half the cycles could be judged.
+std::vector<MasterPhaseTally> tally_steps_in_master_cycles(bool synchronised) {
+  RemoteIoSimulatorConfig c = sim_config();
+  c.model.Ts = 0.020;
+  c.sync_to_valve_writes = synchronised;
+  auto sim = start_sim(c);
+  ModbusIoDaq daq(daq_config(sim ? sim->port() : 0));
+  if (!sim || !daq.open().has_value()) {
+    ADD_FAILURE() << "the module did not start or the master could not reach it";
+    return {};
+  }
   constexpr int kCycles = 30, kLockCycles = 3;
   constexpr auto kLate = 2ms;
   std::vector<MasterPhaseTally> tallies;
@@ -574,8 +586,8 @@ std::vector<MasterPhaseTally> tally_steps_in_master_cycles(const RemoteIoSimulat
       // The module's due time is read before its count: a step that comes between the two reads
       // is then either counted or excused, never missed unexcused.
       auto look = [&](Clock::time_point due) {
-        const auto module_due = sim.next_step_due();
-        const auto steps = sim.steps();
+        const auto module_due = sim->next_step_due();
+        const auto steps = sim->steps();
         const auto now = Clock::now();
         late = late || now - due > kLate || now - module_due > kLate;
         return steps;
@@ -583,7 +595,7 @@ std::vector<MasterPhaseTally> tally_steps_in_master_cycles(const RemoteIoSimulat
       std::this_thread::sleep_until(cycle_start);
       if (daq.write_valve(0.0) != IoStatus::kOk) {
         ADD_FAILURE() << "valve write failed in cycle " << k;
-        return tallies;
+        return {};
       }
       const auto at_write = look(cycle_start);
       std::this_thread::sleep_until(cycle_start + 5ms);
@@ -594,6 +606,7 @@ std::vector<MasterPhaseTally> tally_steps_in_master_cycles(const RemoteIoSimulat
       ++tally.judged;
       if (quarter == at_write && three_quarters == at_write + 1) ++tally.landed;
     }
+    EXPECT_GE(tally.judged, (kCycles - kLockCycles) / 2) << "phase shift " << tally.shift_ms << " ms: a thread woke late too often to judge";
     tallies.push_back(tally);
   }
   return tallies;
@@ -603,39 +616,20 @@ std::vector<MasterPhaseTally> tally_steps_in_master_cycles(const RemoteIoSimulat
 // master's clock: every master cycle sees exactly one step, and it lands between its write and the
 // next read. A 20 ms period leaves 5 ms of slack either side.
 TEST(RemoteIoSimulator, SynchronisedStepsLandHalfAPeriodAfterEachValveWrite) {
-  RemoteIoSimulatorConfig c = sim_config();
-  c.model.Ts = 0.020;
-  c.sync_to_valve_writes = true;
-  auto sim = start_sim(c);
-  ASSERT_NE(sim, nullptr);
-  ModbusIoDaq daq(daq_config(sim->port()));
-  ASSERT_TRUE(daq.open().has_value());
-  const auto tallies = tally_steps_in_master_cycles(*sim, daq);
+  const auto tallies = tally_steps_in_master_cycles(true);
   ASSERT_EQ(tallies.size(), 2u);
-  for (const MasterPhaseTally& t : tallies) {
-    EXPECT_GE(t.judged, 27 / 2) << "phase shift " << t.shift_ms << " ms: a thread woke late too often to judge";
+  for (const MasterPhaseTally& t : tallies)
     EXPECT_EQ(t.landed, t.judged) << "phase shift " << t.shift_ms << " ms: " << t.landed << " of " << t.judged;
-  }
 }
 
 // The check above can fail: a free-running module keeps one phase, so at one of the master's two
 // phases (half a period apart) its steps fall outside the window between the looks, or on its
 // edges, in many cycles.
 TEST(RemoteIoSimulator, AFreeRunningModuleFailsTheSynchronisedCheckAtOnePhase) {
-  RemoteIoSimulatorConfig c = sim_config();
-  c.model.Ts = 0.020;
-  c.sync_to_valve_writes = false;
-  auto sim = start_sim(c);
-  ASSERT_NE(sim, nullptr);
-  ModbusIoDaq daq(daq_config(sim->port()));
-  ASSERT_TRUE(daq.open().has_value());
-  const auto tallies = tally_steps_in_master_cycles(*sim, daq);
+  const auto tallies = tally_steps_in_master_cycles(false);
   ASSERT_EQ(tallies.size(), 2u);
   int worst_missed = 0;
-  for (const MasterPhaseTally& t : tallies) {
-    EXPECT_GE(t.judged, 27 / 2) << "phase shift " << t.shift_ms << " ms: a thread woke late too often to judge";
-    worst_missed = std::max(worst_missed, t.judged - t.landed);
-  }
+  for (const MasterPhaseTally& t : tallies) worst_missed = std::max(worst_missed, t.judged - t.landed);
   EXPECT_GE(worst_missed, 27 / 4) << "a free-running module landed in nearly every cycle at both phases";
 }
 
