@@ -1,5 +1,6 @@
 #include "ident/arx_metrics.hpp"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 
@@ -28,11 +29,46 @@ std::vector<double> predict_one_step(const ArxModel& m, const Segment& s, std::s
   return yhat;
 }
 
+std::vector<double> initial_past(const ArxModel& m, const Segment& s, std::size_t first) {
+  const auto na = static_cast<std::size_t>(m.orders.na);
+  std::vector<double> past(na);
+  for (std::size_t i = 0; i < na; ++i) past[i] = s.y[first - 1 - i];
+  if (na == 0 || s.size() < first + kInitialStateSamples) return past;  // too short to average over: as measured
+  const std::size_t samples = kInitialStateSamples;
+  // The free run over those samples is affine in the past: its answer to the input from a past of
+  // zeros, plus one column per past value (that value 1, the rest 0, no input).
+  auto run = [&](std::size_t unit, bool with_input) {
+    std::vector<double> y(na + samples, 0.0);  // y[na - 1 - i] is y(first - 1 - i)
+    if (unit < na) y[na - 1 - unit] = 1.0;
+    for (std::size_t j = 0; j < samples; ++j) {
+      const std::size_t k = first + j;
+      double v = 0.0;
+      for (std::size_t i = 0; i < na; ++i) v -= m.a[i] * y[na + j - 1 - i];
+      if (with_input)
+        for (int b = 0; b < m.orders.nb; ++b) v += m.b[static_cast<std::size_t>(b)] * s.u[k - static_cast<std::size_t>(m.orders.nk + b)];
+      y[na + j] = v;
+    }
+    return Eigen::Map<const Eigen::VectorXd>(y.data() + na, static_cast<Eigen::Index>(samples)).eval();
+  };
+  Eigen::MatrixXd columns(static_cast<Eigen::Index>(samples), static_cast<Eigen::Index>(na));
+  for (std::size_t i = 0; i < na; ++i) columns.col(static_cast<Eigen::Index>(i)) = run(i, false);
+  const Eigen::VectorXd measured = Eigen::Map<const Eigen::VectorXd>(s.y.data() + first, static_cast<Eigen::Index>(samples));
+  const Eigen::VectorXd input_answer = run(na, true);
+  if (!columns.allFinite() || !input_answer.allFinite()) return past;  // a diverging model: as measured
+  const Eigen::VectorXd estimate = columns.colPivHouseholderQr().solve(measured - input_answer);
+  if (!estimate.allFinite()) return past;
+  for (std::size_t i = 0; i < na; ++i) past[i] = estimate(static_cast<Eigen::Index>(i));
+  return past;
+}
+
 std::vector<double> simulate_free_run(const ArxModel& m, const Segment& s, std::size_t first) {
   first = std::max(first, m.orders.first_row());
   std::vector<double> yhat = s.y;
+  if (first >= s.size()) return yhat;
+  const std::vector<double> past = initial_past(m, s, first);
+  auto before = [&](std::size_t i) { return i >= first ? yhat[i] : first - 1 - i < past.size() ? past[first - 1 - i] : s.y[i]; };
   for (std::size_t k = first; k < s.size(); ++k) {
-    const double y = arx_output(m, s, k, [&](std::size_t i) { return yhat[i]; });
+    const double y = arx_output(m, s, k, before);
     if (!(std::abs(y) <= kSimulationDivergedV)) {
       std::fill(yhat.begin() + static_cast<std::ptrdiff_t>(k), yhat.end(), std::copysign(kSimulationDivergedV, y));
       break;

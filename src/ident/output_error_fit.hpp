@@ -17,7 +17,9 @@
 //   V_sim = (1/N) sum over segments and samples (y(k) - yhat(k))^2
 // is minimised: the free-run fit that `epa identify` reports, as a loss. Its initial state is the
 // measured y before the segment smoothed by a line (sensor noise would otherwise start an
-// integrating model with a velocity it carries as an offset ever after). With `window_s` > 0 the
+// integrating model with a velocity it carries as an offset ever after); the reported fit starts
+// from the past that best follows the first samples (arx_metrics.hpp), which for the same reason
+// differs from this one by the noise alone. With `window_s` > 0 the
 // simulation restarts from the measured y every window_s (multiple shooting): a weaker criterion
 // for the slow behaviour, kept for data whose drift no model explains.
 //

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/paper_reference.hpp"
@@ -62,6 +63,33 @@ TEST(ArxMetrics, FreeRunShowsTheGainErrorThatOneStepHides) {
   const auto f = fit_percent(wrong, {s}, 0);
   EXPECT_GT(f.one_step_pct, 99.9);
   EXPECT_LT(f.simulation_pct, f.one_step_pct - 1.0);
+}
+
+// The truth: the paper's model itself, on an excitation run read with 0.1 mm of sensor noise. Its
+// free-run fit should not depend on the sample the simulation starts from: the plant integrates,
+// so a past taken as measured starts it with the noise of those few samples as a velocity, which
+// it keeps as an offset for the whole run.
+TEST(ArxMetrics, TheFreeRunFitOfTheTrueModelHardlyMovesWithItsFirstSample) {
+  const auto paper = core::paper::model();
+  const auto segments = through_dead_zone(testdata::paper_segments(3, 60.0, 0.1), paper.dead_zone);
+  const ArxModel model{.orders = {.na = 3, .nb = 3, .nk = 1}, .a = {paper.A[1], paper.A[2], paper.A[3]},
+                       .b = {paper.B[1], paper.B[2], paper.B[3]}};
+  double lowest = 100.0, highest = -100.0;
+  for (std::size_t first = 3; first <= 14; ++first) {
+    const double fit = fit_percent(model, segments, first).simulation_pct;
+    lowest = std::min(lowest, fit), highest = std::max(highest, fit);
+  }
+  EXPECT_GT(lowest, 95.0);
+  EXPECT_LT(highest - lowest, 0.1) << "from " << lowest << " to " << highest << " %";
+}
+
+TEST(ArxMetrics, TheInitialPastOfNoiseFreeDataIsTheMeasuredOne) {
+  const auto m = core::paper::model();
+  const auto s = testdata::linear_arx_segment(m.A, m.B, 200, 4);
+  const ArxModel model{.orders = {.na = 3, .nb = 3, .nk = 1}, .a = {m.A[1], m.A[2], m.A[3]}, .b = {m.B[1], m.B[2], m.B[3]}};
+  const auto past = initial_past(model, s, 50);
+  ASSERT_EQ(past.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(past[i], s.y[49 - i], 1e-9) << i;
 }
 
 TEST(ArxMetrics, ADivergingModelGetsAFiniteNegativeFit) {
