@@ -186,7 +186,7 @@ core::AxisModel axis_model_verdict(const ident::StickSlipIdentification& r, cons
   const bool validated = !std::isnan(r.validation_pct);
   const double stick = validated ? r.validation_pct : r.estimation_pct;
   const double hamm = validated ? hammerstein.validation.simulation_pct : hammerstein.estimation.simulation_pct;
-  return stick > hamm ? core::AxisModel::kStickSlip : core::AxisModel::kHammerstein;
+  return core::axis_model_from_fits(stick, hamm);
 }
 
 nlohmann::json stick_slip_json(const ident::StickSlipIdentification& r, bool validated) {

@@ -49,7 +49,8 @@ IdentifiedModel keep_cross_validated(std::vector<IdentifiedModel> candidates) {
   }
   const double hammerstein_pct = candidates[best_hammerstein].validation_fit_pct;
   const double stick_slip_pct = candidates[best_stick_slip].stick_slip_validation_fit_pct;
-  const bool stick_slip = every_split_has_stick_slip && stick_slip_pct > hammerstein_pct;
+  const bool stick_slip =
+      every_split_has_stick_slip && core::axis_model_from_fits(stick_slip_pct, hammerstein_pct) == core::AxisModel::kStickSlip;
   const std::size_t splits = candidates.size();
   IdentifiedModel kept = std::move(candidates[stick_slip ? best_stick_slip : best_hammerstein]);
   kept.axis_model = stick_slip ? core::AxisModel::kStickSlip : core::AxisModel::kHammerstein;

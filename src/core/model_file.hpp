@@ -33,6 +33,17 @@ namespace epa::core {
 // Which model describes the axis: epa identify's verdict, the one that follows held-out runs better.
 enum class AxisModel { kHammerstein, kStickSlip };
 
+// Fits closer than this are equal (as order selection's tolerance holds two orders' to be).
+inline constexpr double kAxisModelMarginPct = 0.5;
+
+// The verdict from the two models' free-run fits on the same runs (held-out ones when there are
+// any), for epa identify and epa commission alike: the stick-slip model only when it follows them
+// better by more than kAxisModelMarginPct; within that, the Hammerstein model, the linear one the
+// laws are designed on (67.4 against 67.3 % is no evidence of stick-slip).
+inline AxisModel axis_model_from_fits(double stick_slip_fit_pct, double hammerstein_fit_pct) {
+  return stick_slip_fit_pct > hammerstein_fit_pct + kAxisModelMarginPct ? AxisModel::kStickSlip : AxisModel::kHammerstein;
+}
+
 struct ModelFile {
   HammersteinModel model;
   std::string source;  // provenance text

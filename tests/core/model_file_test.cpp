@@ -370,5 +370,17 @@ TEST(ModelFile, WritingIntoAMissingDirectoryIsAnError) {
   EXPECT_TRUE(contains(s.error().message, path));
 }
 
+// Two fits within the margin are equal, and then the axis is the Hammerstein model's: the verdict
+// changes pp-traj's arrival, which takes evidence (identify and commission both ask this).
+TEST(AxisModelVerdict, TheStickSlipModelMustFollowTheRunsBetterByMoreThanTheMargin) {
+  EXPECT_EQ(axis_model_from_fits(67.4, 67.3), AxisModel::kHammerstein);
+  EXPECT_EQ(axis_model_from_fits(70.0, 70.0), AxisModel::kHammerstein);
+  EXPECT_EQ(axis_model_from_fits(67.3 + kAxisModelMarginPct, 67.3), AxisModel::kHammerstein);
+  EXPECT_EQ(axis_model_from_fits(67.3 + kAxisModelMarginPct + 0.01, 67.3), AxisModel::kStickSlip);
+  EXPECT_EQ(axis_model_from_fits(92.5, 69.4), AxisModel::kStickSlip);
+  EXPECT_EQ(axis_model_from_fits(66.3, 99.7), AxisModel::kHammerstein);
+  EXPECT_EQ(axis_model_from_fits(NAN, 60.0), AxisModel::kHammerstein);  // no stick-slip figure: no evidence
+}
+
 }  // namespace
 }  // namespace epa::core
