@@ -42,8 +42,9 @@ inline constexpr std::size_t kInitialStateSamples = 20;  // 0.1 s at 5 ms
 // past itself when fewer samples follow or the model diverges. `first` >= the model's first_row().
 std::vector<double> initial_past(const ArxModel& model, const Segment& segment, std::size_t first);
 
-// Free-run simulation for k >= first, from initial_past(); y(k) before. A diverging model is stopped at |yhat| > 1e12
-// (the rest is left at the last value), so its fit is hugely negative but finite.
+// Free-run simulation for k >= first, from initial_past(); y(k) before. A diverging model is
+// stopped at |yhat| > 1e12 (the rest is left at the last value), so its fit is hugely negative but
+// finite.
 std::vector<double> simulate_free_run(const ArxModel& model, const Segment& segment, std::size_t first);
 
 struct Fit {

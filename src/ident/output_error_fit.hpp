@@ -17,11 +17,11 @@
 //   V_sim = (1/N) sum over segments and samples (y(k) - yhat(k))^2
 // is minimised: the free-run fit that `epa identify` reports, as a loss. Its initial state is the
 // measured y before the segment smoothed by a line (sensor noise would otherwise start an
-// integrating model with a velocity it carries as an offset ever after); the reported fit starts
-// from the past that best follows the first samples (arx_metrics.hpp), which for the same reason
-// differs from this one by the noise alone. With `window_s` > 0 the
-// simulation restarts from the measured y every window_s (multiple shooting): a weaker criterion
-// for the slow behaviour, kept for data whose drift no model explains.
+// integrating model with a velocity it carries as an offset ever after). The reported fit starts
+// from the past that best follows the first samples instead (arx_metrics.hpp), which keeps that
+// noise out as well and is exact on noise-free data. With `window_s` > 0 the simulation restarts
+// from the measured y every window_s (multiple shooting): a weaker criterion for the slow
+// behaviour, kept for data whose drift no model explains.
 //
 // Whole segments, not windows, by default: the piston integrates, so what the model gets wrong
 // slowly (the balance between the two sides' gains, friction that creeps) shows only over long
