@@ -1,6 +1,7 @@
 #include "config/appliance_config.hpp"
 
 #include "core/format.hpp"
+#include "core/toml_keys.hpp"
 #include "core/text_file.hpp"
 #include "modbus/unlock_guard.hpp"
 
@@ -109,11 +110,14 @@ class TableReader {
     used_.insert(key);
     return table_ ? (*table_)[key].as_table() : nullptr;
   }
+  // Every key the reader asked for is a known one; the message lists them (core/toml_keys.hpp).
   void refuse_unknown_keys() {
     if (!table_ || error_) return;
     for (const auto& [k, node] : *table_) {
-      if (!used_.count(std::string(k.str())))
-        return fail(node, std::string(k.str()).c_str(), "is not a known setting (check the spelling against config/epa.toml)");
+      if (used_.count(std::string(k.str()))) continue;
+      const std::vector<std::string_view> expected(used_.begin(), used_.end());
+      error_ = core::unknown_key(file_, node.source(), k.str(), name_, expected);
+      return;
     }
   }
   std::string key_path(const char* key) const { return name_.empty() ? key : name_ + "." + key; }

@@ -67,7 +67,7 @@ Result<StickSlipParams> stick_slip_at(const toml::table& t, const std::string& s
                           {"spool_lag_s", &p.spool_lag_s}};
   std::vector<std::string_view> keys{"delay_samples"};  // the table's keys: the fields and the delay
   for (const auto& f : fields) keys.push_back(f.key);
-  if (auto s = only_keys(t, keys, src + ": [stick_slip]"); !s) return s.error();
+  if (auto s = only_keys(t, keys, src, "stick_slip"); !s) return s.error();
   for (const auto& f : fields) {
     auto v = number_at(t, "stick_slip", f.key, src);
     if (!v) return v.error();
@@ -114,7 +114,7 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
 
   const auto* arx = root["arx"].as_table();
   if (!arx) return parse_error(src + ": table [arx] is missing");
-  if (auto s = only_keys(*arx, {"A", "B"}, src + ": [arx]"); !s) return s.error();
+  if (auto s = only_keys(*arx, {"A", "B"}, src, "arx"); !s) return s.error();
   auto A = array_at(*arx, "A", src);
   if (!A) return A.error();
   auto B = array_at(*arx, "B", src);
@@ -124,7 +124,7 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
 
   const auto* dz = root["dead_zone"].as_table();
   if (!dz) return parse_error(src + ": table [dead_zone] is missing");
-  if (auto s = only_keys(*dz, kDeadZoneKeys, src + ": [dead_zone]"); !s) return s.error();
+  if (auto s = only_keys(*dz, kDeadZoneKeys, src, "dead_zone"); !s) return s.error();
   for (std::size_t i = 0; i < std::size(kDeadZoneKeys); ++i) {
     auto v = number_at(*dz, "dead_zone", kDeadZoneKeys[i].data(), src);  // literals: terminated
     if (!v) return v.error();

@@ -1,7 +1,10 @@
 #pragma once
 // Every key of a TOML table must be one the reader knows: a misspelt key is refused with its name
 // and line, never left out in silence (a model file's `mm_per_vlot = 25` ran on the default
-// 50 mm/V until 2026-11-29). Shared by the files' readers (model, tuning).
+// 50 mm/V until 2026-11-29). One wording for every TOML file the product reads (the model and
+// tuning files, the physics parameters, the configuration), in the compiler's form editors jump to:
+//   file:line: unknown key 'key' in [table] (expected one of: a, b, c)
+// (" in [table]" left out at the top level, the line when the parser gave none).
 #include <initializer_list>
 #include <span>
 #include <string>
@@ -12,22 +15,30 @@
 
 namespace epa::core {
 
-inline Status only_keys(const toml::table& table, std::span<const std::string_view> allowed, const std::string& where) {
-  for (const auto& [key, node] : table) {
+inline Error unknown_key(const std::string& file, const toml::source_region& where, std::string_view key,
+                         std::string_view table, std::span<const std::string_view> expected) {
+  std::string names;
+  for (const std::string_view e : expected) names += (names.empty() ? "" : ", ") + std::string(e);
+  const auto line = where.begin.line;
+  return parse_error(file + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": unknown key '" + std::string(key) +
+                     "'" + (table.empty() ? std::string() : " in [" + std::string(table) + "]") +
+                     " (expected one of: " + names + ")");
+}
+
+// The first key of `t` that is not in `allowed`, as unknown_key(); `table`: its name, "" at the top.
+inline Status only_keys(const toml::table& t, std::span<const std::string_view> allowed, const std::string& file,
+                        std::string_view table = {}) {
+  for (const auto& [key, node] : t) {
     bool known = false;
     for (const std::string_view a : allowed) known = known || key.str() == a;
-    if (known) continue;
-    std::string names;
-    for (const std::string_view a : allowed) names += (names.empty() ? "" : ", ") + std::string(a);
-    const auto line = node.source().begin.line;
-    return parse_error(where + ": unknown key '" + std::string(key.str()) + "' (" +
-                       (line > 0 ? "line " + std::to_string(line) + "; " : std::string()) + "expected one of: " + names + ")");
+    if (!known) return unknown_key(file, node.source(), key.str(), table, allowed);
   }
   return ok();
 }
 
-inline Status only_keys(const toml::table& table, std::initializer_list<std::string_view> allowed, const std::string& where) {
-  return only_keys(table, std::span<const std::string_view>(allowed.begin(), allowed.size()), where);
+inline Status only_keys(const toml::table& t, std::initializer_list<std::string_view> allowed, const std::string& file,
+                        std::string_view table = {}) {
+  return only_keys(t, std::span<const std::string_view>(allowed.begin(), allowed.size()), file, table);
 }
 
 }  // namespace epa::core

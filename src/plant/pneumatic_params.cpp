@@ -8,9 +8,11 @@
 #include <cmath>
 #include <string_view>
 #include <toml++/toml.h>
+#include <vector>
 
 #include "core/atomic_file.hpp"
 #include "core/format.hpp"
+#include "core/toml_keys.hpp"
 
 namespace epa::plant {
 
@@ -113,16 +115,21 @@ core::Result<PneumaticParams> parse_pneumatic_toml(const std::string& text, cons
     const std::string_view k = key.str();
     if (k == "schema" || k == "source") continue;
     const bool known_table = std::find(kTables.begin(), kTables.end(), k) != kTables.end();
-    if (!known_table)
-      return core::parse_error(at_line(src, key.source()) + "unknown key '" + std::string(k) +
-                               "' (expected [supply], [cylinder], [friction] or [valve])");
+    if (!known_table) {
+      std::vector<std::string_view> expected{"schema", "source"};
+      expected.insert(expected.end(), kTables.begin(), kTables.end());
+      return core::unknown_key(src, key.source(), k, "", expected);
+    }
     const toml::table* table = node.as_table();
     if (table == nullptr) return core::parse_error(at_line(src, key.source()) + "'" + std::string(k) + "' must be a table");
     for (const auto& [inner_key, value] : *table) {
       const Field* f = find_field(k, inner_key.str());
-      if (f == nullptr)
-        return core::parse_error(at_line(src, inner_key.source()) + "unknown key '" + std::string(inner_key.str()) +
-                                 "' in [" + std::string(k) + "]");
+      if (f == nullptr) {
+        std::vector<std::string_view> expected;
+        for (const Field& field : kFields)
+          if (k == field.table) expected.emplace_back(field.key);
+        return core::unknown_key(src, inner_key.source(), inner_key.str(), k, expected);
+      }
       const auto v = value.value<double>();  // integers are accepted as numbers too
       if (!v) return core::parse_error(at_line(src, value.source()) + name_of(*f) + " must be a number");
       p.*f->member = *v;

@@ -62,6 +62,12 @@ control::TrajectoryConfig to_trajectory_config(const TrajectorySettings& s, doub
   return c;
 }
 
+std::vector<std::string_view> trajectory_setting_keys() {
+  std::vector<std::string_view> out;
+  for (const auto& [key, member] : kKeys) out.emplace_back(key);
+  return out;
+}
+
 std::vector<std::pair<std::string, double>> trajectory_setting_values(const TrajectorySettings& s) {
   std::vector<std::pair<std::string, double>> out;
   for (const auto& [key, member] : kKeys) out.emplace_back(key, s.*member);

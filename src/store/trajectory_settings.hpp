@@ -4,6 +4,7 @@
 // their defaults (control::TrajectoryConfig's); 0 in accel_mm_s2 and integral_gain_per_mm_s means
 // "derived from the model". Unknown keys are refused with their name.
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -52,6 +53,8 @@ core::Result<TrajectorySettings> trajectory_settings_from_json_text(const std::s
 
 // Every parameter with its key, in a fixed order (files, pages).
 std::vector<std::pair<std::string, double>> trajectory_setting_values(const TrajectorySettings& s);
+// The keys alone, in the same order (what an unknown key's message lists).
+std::vector<std::string_view> trajectory_setting_keys();
 
 // Sets one parameter by its key (the JSON and TOML key); false for an unknown key.
 bool set_trajectory_setting(TrajectorySettings& s, const std::string& key, double value);

@@ -108,7 +108,7 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
   const auto* rst = root["rst"].as_table();
   if (!rst) return core::parse_error(src + ": table [rst] is missing");
   constexpr std::string_view rst_keys[] = {"F", "G", "H"};
-  if (auto s = core::only_keys(*rst, rst_keys, src + ": [rst]"); !s) return s.error();
+  if (auto s = core::only_keys(*rst, rst_keys, src, "rst"); !s) return s.error();
   core::Polynomial* polys[] = {&t.F, &t.G, &t.H};
   for (int i = 0; i < 3; ++i) {
     auto p = polynomial(*rst, rst_keys[i].data(), src + ": [rst]");  // literals: terminated
@@ -117,7 +117,7 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
   }
   const auto* dz = root["dead_zone"].as_table();
   if (!dz) return core::parse_error(src + ": table [dead_zone] is missing");
-  if (auto s = core::only_keys(*dz, core::kDeadZoneKeys, src + ": [dead_zone]"); !s) return s.error();
+  if (auto s = core::only_keys(*dz, core::kDeadZoneKeys, src, "dead_zone"); !s) return s.error();
   for (std::size_t i = 0; i < std::size(core::kDeadZoneKeys); ++i) {
     auto v = number(*dz, core::kDeadZoneKeys[i].data(), src + ": [dead_zone]");  // literals: terminated
     if (!v) return v.error();
@@ -130,13 +130,13 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
       auto v = number(*trajectory, name.c_str(), src + ": [trajectory]");
       if (!v) return v.error();
       if (!set_trajectory_setting(t.trajectory, name, *v))
-        return core::parse_error(src + ": [trajectory]: unknown key '" + name + "'");
+        return core::unknown_key(src, node.source(), name, "trajectory", trajectory_setting_keys());
     }
   }
 
   const auto* model = root["model"].as_table();
   if (!model) return core::parse_error(src + ": table [model] is missing");
-  if (auto s = core::only_keys(*model, {"name", "fit", "source", "Ts", "mm_per_volt", "arx", "dead_zone"}, src + ": [model]"); !s)
+  if (auto s = core::only_keys(*model, {"name", "fit", "source", "Ts", "mm_per_volt", "arx", "dead_zone"}, src, "model"); !s)
     return s.error();
   f.model.name = (*model)["name"].value_or(std::string());
   if (f.model.name.empty()) return core::parse_error(src + ": [model] name is missing");

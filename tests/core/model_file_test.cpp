@@ -102,10 +102,13 @@ TEST(ModelFile, NumbersOutsideAnyPhysicalRangeAreRefusedNamingKeyAndLine) {
 // `mm_per_vlot = 25` had run on the default 50 mm/V, and `b_rx` in [dead_zone] had been ignored.
 TEST(ModelFile, AMisspeltKeyIsRefusedNamingItAndItsLine) {
   for (const auto& [from, to, expected] :
-       {std::tuple{"Ts = 0.005", "Ts = 0.005\nmm_per_vlot = 25.0", "m.toml: unknown key 'mm_per_vlot' (line 3;"},
-        std::tuple{"Ts = 0.005", "Ts = 0.005\naxis_modle = \"stick-slip\"", "m.toml: unknown key 'axis_modle'"},
-        std::tuple{"[dead_zone]", "[dead_zone]\nb_rx = 9.0", "m.toml: [dead_zone]: unknown key 'b_rx'"},
-        std::tuple{"[arx]", "[arx]\nC = [1.0]", "m.toml: [arx]: unknown key 'C'"}}) {
+       {std::tuple{"Ts = 0.005", "Ts = 0.005\nmm_per_vlot = 25.0",
+                   "m.toml:3: unknown key 'mm_per_vlot' (expected one of: schema, Ts, mm_per_volt, source, axis_model, arx, "
+                   "dead_zone, stick_slip)"},
+        std::tuple{"Ts = 0.005", "Ts = 0.005\naxis_modle = \"stick-slip\"", "m.toml:3: unknown key 'axis_modle' (expected"},
+        std::tuple{"[dead_zone]", "[dead_zone]\nb_rx = 9.0",
+                   "unknown key 'b_rx' in [dead_zone] (expected one of: m_r, m_l, b_r, b_l)"},
+        std::tuple{"[arx]", "[arx]\nC = [1.0]", "unknown key 'C' in [arx] (expected one of: A, B)"}}) {
     expect_refused(from, to, expected);
   }
 }

@@ -96,11 +96,14 @@ TEST(TuningFile, BadFilesAreRefusedNamingWhatIsWrong) {
     std::string text, expected;
   };
   const Case cases[] = {
-      {replaced(good, "lc_mm = ", "lc_millimetres = "), "unknown key 'lc_millimetres'"},
+      {replaced(good, "lc_mm = ", "lc_millimetres = "), "unknown key 'lc_millimetres' (expected one of: schema, name, "},
       {replaced(good, "schema = \"epa-tuning/1\"", "schema = \"epa-tuning/9\""), "epa-tuning/9"},
       {replaced(good, "controller = \"pp-ngidz\"", "controller = \"pid\""), "controller"},
       {replaced(good, "b_l = -1.722", "b_l = 3.0"), "b_l"},  // b_l > b_r: refused whole
-      {replaced(good, "[rst]\n", "[rst]\nX = [1.0]\n"), "[rst]: unknown key 'X'"},
+      {replaced(good, "[rst]\n", "[rst]\nX = [1.0]\n"), "unknown key 'X' in [rst] (expected one of: F, G, H)"},
+      {replaced(good, "[trajectory]  # pp-traj's parameters (README \"pp-traj\")\n",
+                "[trajectory]  # pp-traj's parameters (README \"pp-traj\")\ncoast = 1.0\n"),
+       "unknown key 'coast' in [trajectory] (expected one of: "},
       {replaced(good, "lc_mm = 5.0", "lc_mm = \"five\""), "lc_mm must be a number"},
       {replaced(good, "lc_mm = 5.0", "lc_mm = = 5"), "x.toml:"},
       {replaced(good, "lc_mm = 5.0", "lc_mm = 1e300"), "lc_mm 1e+300 is outside [-1e6, 1e6]"},
