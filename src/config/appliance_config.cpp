@@ -1,6 +1,7 @@
 #include "config/appliance_config.hpp"
 
 #include "core/format.hpp"
+#include "core/toml_at_line.hpp"
 #include "core/toml_keys.hpp"
 #include "core/text_file.hpp"
 #include "modbus/unlock_guard.hpp"
@@ -130,7 +131,7 @@ class TableReader {
   }
   void fail(const toml::node& n, const char* key, const std::string& why) {
     if (error_) return;
-    error_ = core::parse_error(file_ + ":" + std::to_string(n.source().begin.line) + ": " + key_path(key) + " " + why);
+    error_ = core::parse_error(core::at_line(file_, n.source()) + key_path(key) + " " + why);
   }
 
   const toml::table* table_;
@@ -209,7 +210,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   try {
     root = toml::parse(text, file);
   } catch (const toml::parse_error& e) {
-    return core::parse_error(file + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()));
+    return core::parse_error(core::at_line(file, e.source()) + std::string(e.description()));
   }
   ApplianceConfig c;
   auto& r = c.runtime;

@@ -11,6 +11,7 @@
 #include "core/atomic_file.hpp"
 #include "core/format.hpp"
 #include "core/text_file.hpp"
+#include "core/toml_at_line.hpp"
 #include "core/toml_keys.hpp"
 #include "core/toml_number.hpp"
 
@@ -93,7 +94,7 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
   try {
     root = toml::parse(text, src);
   } catch (const toml::parse_error& e) {
-    return parse_error(src + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()));
+    return parse_error(at_line(src, e.source()) + std::string(e.description()));
   }
   const auto schema = root["schema"].value<std::string>();
   if (!schema) return parse_error(src + ": schema is missing (expected \"" + kSchema + "\")");

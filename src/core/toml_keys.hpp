@@ -4,7 +4,7 @@
 // 50 mm/V until 2026-11-29). One wording for every TOML file the product reads (the model and
 // tuning files, the physics parameters, the configuration), in the compiler's form editors jump to:
 //   file:line: unknown key 'key' in [table] (expected one of: a, b, c)
-// (" in [table]" left out at the top level, the line when the parser gave none).
+// (" in [table]" left out at the top level; the place as core::at_line() writes it).
 #include <initializer_list>
 #include <span>
 #include <string>
@@ -12,6 +12,7 @@
 #include <toml++/toml.h>
 
 #include "core/result.hpp"
+#include "core/toml_at_line.hpp"
 
 namespace epa::core {
 
@@ -19,10 +20,8 @@ inline Error unknown_key(const std::string& file, const toml::source_region& whe
                          std::string_view table, std::span<const std::string_view> expected) {
   std::string names;
   for (const std::string_view e : expected) names += (names.empty() ? "" : ", ") + std::string(e);
-  const auto line = where.begin.line;
-  return parse_error(file + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": unknown key '" + std::string(key) +
-                     "'" + (table.empty() ? std::string() : " in [" + std::string(table) + "]") +
-                     " (expected one of: " + names + ")");
+  return parse_error(at_line(file, where) + "unknown key '" + std::string(key) + "'" +
+                     (table.empty() ? std::string() : " in [" + std::string(table) + "]") + " (expected one of: " + names + ")");
 }
 
 // The first key of `t` that is not in `allowed`, as unknown_key(); `table`: its name, "" at the top.

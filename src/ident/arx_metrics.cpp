@@ -34,26 +34,19 @@ std::vector<double> initial_past(const ArxModel& m, const Segment& s, std::size_
   std::vector<double> past(na);
   for (std::size_t i = 0; i < na; ++i) past[i] = s.y[first - 1 - i];
   if (na == 0 || s.size() < first + kInitialStateSamples) return past;  // too short to average over: as measured
-  const std::size_t samples = kInitialStateSamples;
+  const auto samples = static_cast<Eigen::Index>(kInitialStateSamples);
   // The free run over those samples is affine in the past: its answer to the input from a past of
-  // zeros, plus one column per past value (that value 1, the rest 0, no input).
-  auto run = [&](std::size_t unit, bool with_input) {
-    std::vector<double> y(na + samples, 0.0);  // y[na - 1 - i] is y(first - 1 - i)
-    if (unit < na) y[na - 1 - unit] = 1.0;
-    for (std::size_t j = 0; j < samples; ++j) {
-      const std::size_t k = first + j;
-      double v = 0.0;
-      for (std::size_t i = 0; i < na; ++i) v -= m.a[i] * y[na + j - 1 - i];
-      if (with_input)
-        for (int b = 0; b < m.orders.nb; ++b) v += m.b[static_cast<std::size_t>(b)] * s.u[k - static_cast<std::size_t>(m.orders.nk + b)];
-      y[na + j] = v;
-    }
-    return Eigen::Map<const Eigen::VectorXd>(y.data() + na, static_cast<Eigen::Index>(samples)).eval();
+  // zeros, plus one column per past value (the run from that value 1 and the rest 0, less that answer).
+  auto run = [&](std::size_t unit) {  // unit == na: from a past of zeros
+    Eigen::VectorXd y(samples);
+    auto before = [&](std::size_t i) { return i >= first ? y(static_cast<Eigen::Index>(i - first)) : first - 1 - i == unit ? 1.0 : 0.0; };
+    for (Eigen::Index j = 0; j < samples; ++j) y(j) = arx_output(m, s, first + static_cast<std::size_t>(j), before);
+    return y;
   };
-  Eigen::MatrixXd columns(static_cast<Eigen::Index>(samples), static_cast<Eigen::Index>(na));
-  for (std::size_t i = 0; i < na; ++i) columns.col(static_cast<Eigen::Index>(i)) = run(i, false);
-  const Eigen::VectorXd measured = Eigen::Map<const Eigen::VectorXd>(s.y.data() + first, static_cast<Eigen::Index>(samples));
-  const Eigen::VectorXd input_answer = run(na, true);
+  const Eigen::VectorXd input_answer = run(na);
+  Eigen::MatrixXd columns(samples, static_cast<Eigen::Index>(na));
+  for (std::size_t i = 0; i < na; ++i) columns.col(static_cast<Eigen::Index>(i)) = run(i) - input_answer;
+  const Eigen::VectorXd measured = Eigen::Map<const Eigen::VectorXd>(s.y.data() + first, samples);
   if (!columns.allFinite() || !input_answer.allFinite()) return past;  // a diverging model: as measured
   const Eigen::VectorXd estimate = columns.colPivHouseholderQr().solve(measured - input_answer);
   if (!estimate.allFinite()) return past;
@@ -66,7 +59,7 @@ std::vector<double> simulate_free_run(const ArxModel& m, const Segment& s, std::
   std::vector<double> yhat = s.y;
   if (first >= s.size()) return yhat;
   const std::vector<double> past = initial_past(m, s, first);
-  auto before = [&](std::size_t i) { return i >= first ? yhat[i] : first - 1 - i < past.size() ? past[first - 1 - i] : s.y[i]; };
+  auto before = [&](std::size_t i) { return i >= first ? yhat[i] : past[first - 1 - i]; };  // arx_output reaches back na
   for (std::size_t k = first; k < s.size(); ++k) {
     const double y = arx_output(m, s, k, before);
     if (!(std::abs(y) <= kSimulationDivergedV)) {

@@ -61,7 +61,7 @@ void write_protocol_notes(std::ostream& out, const RegisterMap& map) {
   out << " Readable bits of this map: " << (bits.empty() ? "none" : bits) << ".\n\n";
   out << "Unit id: `[modbus] unit_id` (1 by default), and 0 and 0xFF, which TCP clients send for \"the server itself\" "
          "(`[modbus] alias_unit_ids = [0, 255]`, the default; `[]` for unit_id only); another unit id gets exception 0B.\n\n";
-  const DeviceIdentity identity = appliance_identity(map.source(), status_page_url(std::string_view("<[web] port>")));
+  const DeviceIdentity identity = appliance_identity(map.source(), status_page_url("<[web] port>"));
   out << "Device identification (FC43, MEI type 0x0E), conformity level 0x82 (basic and regular objects, stream and "
          "individual access). Read code 01 gives objects 0x00-0x02, 02 and 03 give 0x00-0x06 (there are no extended "
          "objects), 04 the object asked for (another id: exception 02); another read code is exception 03, another MEI "

@@ -12,6 +12,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/format.hpp"
+#include "core/toml_at_line.hpp"
 #include "core/toml_keys.hpp"
 
 namespace epa::plant {
@@ -74,10 +75,6 @@ std::string number_text(double v) {
   return s;
 }
 
-std::string at_line(const std::string& src, const toml::source_region& where) {
-  return src + ":" + std::to_string(where.begin.line) + ": ";
-}
-
 }  // namespace
 
 core::Status PneumaticParams::validate() const {
@@ -103,7 +100,7 @@ core::Result<PneumaticParams> parse_pneumatic_toml(const std::string& text, cons
   try {
     root = toml::parse(text, src);
   } catch (const toml::parse_error& e) {
-    return core::parse_error(at_line(src, e.source()) + std::string(e.description()));
+    return core::parse_error(core::at_line(src, e.source()) + std::string(e.description()));
   }
   const auto schema = root["schema"].value<std::string>();
   if (!schema) return core::parse_error(src + ": schema is missing (expected \"" + kSchema + "\")");
@@ -121,7 +118,7 @@ core::Result<PneumaticParams> parse_pneumatic_toml(const std::string& text, cons
       return core::unknown_key(src, key.source(), k, "", expected);
     }
     const toml::table* table = node.as_table();
-    if (table == nullptr) return core::parse_error(at_line(src, key.source()) + "'" + std::string(k) + "' must be a table");
+    if (table == nullptr) return core::parse_error(core::at_line(src, key.source()) + "'" + std::string(k) + "' must be a table");
     for (const auto& [inner_key, value] : *table) {
       const Field* f = find_field(k, inner_key.str());
       if (f == nullptr) {
@@ -131,7 +128,7 @@ core::Result<PneumaticParams> parse_pneumatic_toml(const std::string& text, cons
         return core::unknown_key(src, inner_key.source(), inner_key.str(), k, expected);
       }
       const auto v = value.value<double>();  // integers are accepted as numbers too
-      if (!v) return core::parse_error(at_line(src, value.source()) + name_of(*f) + " must be a number");
+      if (!v) return core::parse_error(core::at_line(src, value.source()) + name_of(*f) + " must be a number");
       p.*f->member = *v;
     }
   }
@@ -140,7 +137,7 @@ core::Result<PneumaticParams> parse_pneumatic_toml(const std::string& text, cons
     for (const Field& f : kFields) {
       if (s.error().message.find(name_of(f) + " ") == std::string::npos) continue;
       if (const toml::node* n = root.at_path(std::string(f.table) + "." + f.key).node())
-        return core::invalid_argument(at_line(src, n->source()) + s.error().message);
+        return core::invalid_argument(core::at_line(src, n->source()) + s.error().message);
     }
     return core::invalid_argument(src + ": " + s.error().message);
   }

@@ -7,6 +7,7 @@
 
 #include "core/format.hpp"
 #include "core/model_file.hpp"
+#include "core/toml_at_line.hpp"
 #include "core/toml_keys.hpp"
 #include "core/toml_number.hpp"
 
@@ -81,7 +82,7 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
   try {
     root = toml::parse(text, src);
   } catch (const toml::parse_error& e) {
-    return core::parse_error(src + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()));
+    return core::parse_error(core::at_line(src, e.source()) + std::string(e.description()));
   }
   const auto schema = root["schema"].value<std::string>();
   if (!schema) return core::parse_error(src + ": schema is missing (expected \"" + kSchema + "\")");
