@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "core/paper_reference.hpp"
 #include "ident/arx_metrics.hpp"
@@ -53,6 +55,10 @@ TEST(HammersteinFit, PaperPlantWithNoiseGivesBreakPointsAndSlopeRatio) {
   const auto validation = testdata::paper_segments(2, 40.0, 0.1);
   const auto f = fit_percent(fit->arx.model, through_dead_zone(validation, fit->dead_zone), 0);
   EXPECT_GE(f.simulation_pct, kValidationFitMinPct);
+  // The README's "Checks" line quotes these (--gtest_output=json:FILE shows them).
+  RecordProperty("validation_fit_pct", std::to_string(f.simulation_pct));
+  RecordProperty("break_point_error_V", std::to_string(std::max(std::abs(fit->dead_zone.b_r - p.b_r), std::abs(fit->dead_zone.b_l - p.b_l))));
+  RecordProperty("slope_ratio_error_pct", std::to_string(100.0 * std::abs(fit->ratio / kPaperRatio - 1.0)));
 }
 
 TEST(HammersteinFit, NoiseFreeDataGiveEq9And10) {

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "core/paper_reference.hpp"
 #include "ident/arx_metrics.hpp"
@@ -50,6 +52,10 @@ TEST(HammersteinIdentification, ThePapersPlantComesBackWithItsBreakPoints) {
   EXPECT_EQ(fit.arx.model.orders, (ArxOrders{.na = 3, .nb = 3, .nk = 1}));  // eq 9's order, the fewest within tolerance
   const auto f = fit_percent(fit.arx.model, through_dead_zone(validation(), fit.dead_zone), 0);
   EXPECT_GE(f.simulation_pct, kValidationFitMinPct);
+  // The README's "Checks" line quotes these (--gtest_output=json:FILE shows them).
+  RecordProperty("validation_fit_pct", std::to_string(f.simulation_pct));
+  RecordProperty("break_point_error_V", std::to_string(std::max(std::abs(fit.dead_zone.b_r - kPaperDz.b_r), std::abs(fit.dead_zone.b_l - kPaperDz.b_l))));
+  RecordProperty("slope_ratio_error_pct", std::to_string(100.0 * std::abs(fit.ratio / (kPaperDz.m_r / kPaperDz.m_l) - 1.0)));
   ASSERT_TRUE(id->dead_band.has_value());
   EXPECT_TRUE(id->dead_band->right && id->dead_band->left);
   EXPECT_GT(id->swarm_evaluations, 0u);
