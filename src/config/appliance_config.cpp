@@ -2,6 +2,7 @@
 
 #include "core/format.hpp"
 #include "core/toml_at_line.hpp"
+#include "core/toml_document.hpp"
 #include "core/toml_keys.hpp"
 #include "core/text_file.hpp"
 #include "modbus/unlock_guard.hpp"
@@ -206,12 +207,9 @@ const char* to_string(HalBackend b) {
 }
 
 core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, const std::string& file) {
-  toml::table root;
-  try {
-    root = toml::parse(text, file);
-  } catch (const toml::parse_error& e) {
-    return core::parse_error(core::at_line(file, e.source()) + std::string(e.description()));
-  }
+  auto document = core::parse_toml(text, file);
+  if (!document) return document.error();
+  const toml::table& root = *document;
   ApplianceConfig c;
   auto& r = c.runtime;
   std::optional<core::Error> error;

@@ -11,7 +11,7 @@
 #include "core/atomic_file.hpp"
 #include "core/format.hpp"
 #include "core/text_file.hpp"
-#include "core/toml_at_line.hpp"
+#include "core/toml_document.hpp"
 #include "core/toml_keys.hpp"
 #include "core/toml_number.hpp"
 
@@ -90,15 +90,9 @@ Result<StickSlipParams> stick_slip_at(const toml::table& t, const std::string& s
 }  // namespace
 
 Result<ModelFile> parse_model_toml(const std::string& text, const std::string& src) {
-  toml::table root;
-  try {
-    root = toml::parse(text, src);
-  } catch (const toml::parse_error& e) {
-    return parse_error(at_line(src, e.source()) + std::string(e.description()));
-  }
-  const auto schema = root["schema"].value<std::string>();
-  if (!schema) return parse_error(src + ": schema is missing (expected \"" + kSchema + "\")");
-  if (*schema != kSchema) return parse_error(src + ": schema \"" + *schema + "\" is not supported (expected \"" + kSchema + "\")");
+  auto document = parse_toml_with_schema(text, src, kSchema);
+  if (!document) return document.error();
+  const toml::table& root = *document;
 
   if (auto s = only_keys(root, {"schema", "Ts", "mm_per_volt", "source", "axis_model", "arx", "dead_zone", "stick_slip"}, src); !s)
     return s.error();

@@ -13,6 +13,7 @@
 #include "core/atomic_file.hpp"
 #include "core/format.hpp"
 #include "core/toml_at_line.hpp"
+#include "core/toml_document.hpp"
 #include "core/toml_keys.hpp"
 
 namespace epa::plant {
@@ -96,16 +97,9 @@ core::Status PneumaticParams::validate() const {
 }
 
 core::Result<PneumaticParams> parse_pneumatic_toml(const std::string& text, const std::string& src) {
-  toml::table root;
-  try {
-    root = toml::parse(text, src);
-  } catch (const toml::parse_error& e) {
-    return core::parse_error(core::at_line(src, e.source()) + std::string(e.description()));
-  }
-  const auto schema = root["schema"].value<std::string>();
-  if (!schema) return core::parse_error(src + ": schema is missing (expected \"" + kSchema + "\")");
-  if (*schema != kSchema)
-    return core::parse_error(src + ": schema \"" + *schema + "\" is not supported (expected \"" + kSchema + "\")");
+  auto document = core::parse_toml_with_schema(text, src, kSchema);
+  if (!document) return document.error();
+  const toml::table& root = *document;
 
   PneumaticParams p;
   for (const auto& [key, node] : root) {

@@ -7,7 +7,7 @@
 
 #include "core/format.hpp"
 #include "core/model_file.hpp"
-#include "core/toml_at_line.hpp"
+#include "core/toml_document.hpp"
 #include "core/toml_keys.hpp"
 #include "core/toml_number.hpp"
 
@@ -78,15 +78,9 @@ std::string format_tuning_toml(const TuningSet& t, const ModelRecord& m) {
 }
 
 core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::string& src) {
-  toml::table root;
-  try {
-    root = toml::parse(text, src);
-  } catch (const toml::parse_error& e) {
-    return core::parse_error(core::at_line(src, e.source()) + std::string(e.description()));
-  }
-  const auto schema = root["schema"].value<std::string>();
-  if (!schema) return core::parse_error(src + ": schema is missing (expected \"" + kSchema + "\")");
-  if (*schema != kSchema) return core::parse_error(src + ": schema \"" + *schema + "\" is not supported (expected \"" + kSchema + "\")");
+  auto document = core::parse_toml_with_schema(text, src, kSchema);
+  if (!document) return document.error();
+  const toml::table& root = *document;
   if (auto s = core::only_keys(root, {"schema", "name", "source", "controller", "lc_mm", "valve_limit_v", "design", "rst", "dead_zone", "trajectory", "model"}, src); !s)
     return s.error();
 
