@@ -21,13 +21,16 @@ plant::EffectSet fitted(const diag::Diagnosis& d, std::initializer_list<EffectKi
   return e;
 }
 
+// With the drive's fitted gain (at a run's start, if it drifts): beside a position dependence a gain
+// that holds is its level, not an effect of its own (selection.cpp), so the curve shows it.
 Panel position_gain(const diag::Diagnosis& d) {
-  plant::DriveEffects drive(fitted(d, {EffectKind::kPositionDependentGain}), core::DeadZone{}, 0.0, 0.0);
+  plant::DriveEffects drive(fitted(d, {EffectKind::kPositionDependentGain, EffectKind::kGainChange}), core::DeadZone{}, 0.0, 0.0);
   Panel p{"position_dependent_gain: gain along the stroke", "position (mm)", "gain / nominal", {}, {}, {}, {}, {}, {}};
   Series out{"extending", "#1f77b4", {}, {}, false}, in{"retracting", "#d62728", {}, {}, true};
+  const double level = drive.gain_at(0.0);
   for (double x = 0.0; x <= d.final_model.stroke_mm + 1e-9; x += d.final_model.stroke_mm / 100.0) {
-    out.x.push_back(x), out.y.push_back(drive.finish(1.0, x));
-    in.x.push_back(x), in.y.push_back(-drive.finish(-1.0, x));
+    out.x.push_back(x), out.y.push_back(level * drive.finish(1.0, x));
+    in.x.push_back(x), in.y.push_back(-level * drive.finish(-1.0, x));
   }
   p.series = {out, in};
   p.y_min = 0.0;

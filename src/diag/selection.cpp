@@ -98,32 +98,29 @@ double gain_off_by(const plant::EffectSet& fitted, const std::vector<const core:
   return std::max(std::abs(drive.gain_at(0.0) - 1.0), std::abs(drive.gain_at(longest_run_s(runs)) - 1.0));
 }
 
-// Whether the drive's gain, with the position dependence fitted beside it, is beyond the
-// tolerance on the same side over the stroke the runs worked in (5th to 95th percentile of the
-// readings: the model's swings and a touch of an end stop are not where it works): only then is
-// it a gain change (supply pressure, valve gain). A gain that equals its nominal value somewhere
-// along the stroke and differs elsewhere is the position dependence alone; its level against the
-// nominal is part of its shape (a dip at mid-stroke lowers the mean gain without changing the supply).
-bool gain_off_along_the_whole_stroke(const plant::EffectSet& fitted, const std::vector<const core::Run*>& runs,
-                                     double tolerance) {
+// The drive's gain relative to nominal along the stroke the runs worked in (5th to 95th percentile
+// of the readings: the model's swings and a touch of an end stop are not where it works), both
+// directions, with the position dependence and the gain (mid-run, if it drifts) as fitted.
+struct GainAlongStroke {
+  double from_mm = 0, to_mm = 0, lowest = 1, highest = 1;
+};
+GainAlongStroke gain_along_the_stroke(const plant::EffectSet& fitted, const std::vector<const core::Run*>& runs) {
   std::vector<double> y;
   for (const auto* r : runs) y.insert(y.end(), r->y_mm.begin(), r->y_mm.end());
-  if (y.empty()) return false;
+  if (y.empty()) return {};
   std::sort(y.begin(), y.end());
-  const double lo_mm = y[y.size() * 5 / 100], hi_mm = y[y.size() * 95 / 100];
+  GainAlongStroke g{y[y.size() * 5 / 100], y[y.size() * 95 / 100], 1e9, -1e9};
   const plant::DriveEffects position(fitted, core::DeadZone{.m_r = 1.0, .m_l = 1.0, .b_r = 0.0, .b_l = 0.0}, 0.0, 0.0);
-  const double gain = position.gain_at(0.5 * longest_run_s(runs));  // mid-run, if it drifts
-  bool all_above = true, all_below = true;
+  const double gain = position.gain_at(0.5 * longest_run_s(runs));
   constexpr int kPoints = 50;
   for (int i = 0; i <= kPoints; ++i) {
-    const double x = lo_mm + (hi_mm - lo_mm) * i / kPoints;
+    const double x = g.from_mm + (g.to_mm - g.from_mm) * i / kPoints;
     for (double direction : {1.0, -1.0}) {
-      const double g = gain * position.finish(direction, x) / direction;
-      all_above = all_above && g > 1.0 + tolerance;
-      all_below = all_below && g < 1.0 - tolerance;
+      const double v = gain * position.finish(direction, x) / direction;
+      g.lowest = std::min(g.lowest, v), g.highest = std::max(g.highest, v);
     }
   }
-  return all_above || all_below;
+  return g;
 }
 
 std::string names(const std::vector<EffectKind>& kinds) {
@@ -427,10 +424,23 @@ Diagnosis diagnose(const ReplayModel& nominal, const std::vector<const core::Run
     return cost > chance_threshold_pct(parameter) * o.threshold_scale;
   };
   const bool position_named = std::find(d.effects.begin(), d.effects.end(), EffectKind::kPositionDependentGain) != d.effects.end();
+  // Beside a position dependence, a gain that holds is that dependence's level: the runs cannot
+  // tell a lower supply with compressibility on top from a gain that dips along the stroke they
+  // work in (blind rigs of both kinds gave the same fits; notes/diagnosis-experiments.md,
+  // 2026-12-02), so the level is reported in the position family's shape and said here. A gain
+  // that drifts during each run is a gain change whatever the stroke does.
+  if (position_named) {
+    const auto g = gain_along_the_stroke(fe, all_runs);
+    std::snprintf(buf, sizeof buf, "the gain along the stroke the runs worked in (%.0f-%.0f mm): %.2f-%.2f of nominal%s", g.from_mm,
+                  g.to_mm, g.lowest, g.highest,
+                  g.highest < 1.0 - o.gain_tolerance   ? ": below nominal everywhere, as a lower supply pressure or valve gain would also be"
+                  : g.lowest > 1.0 + o.gain_tolerance ? ": above nominal everywhere, as a higher supply pressure or valve gain would also be"
+                                                       : "");
+    say(buf);
+  }
   // A drift kept has beaten the gain's chance threshold itself (a sag can leave the gain that holds
   // no better than the nominal one on runs of other lengths).
-  if ((refit_significant || drift_kept) && gain_off_by(fe, all_runs) > o.gain_tolerance &&
-      (!position_named || gain_off_along_the_whole_stroke(fe, all_runs, o.gain_tolerance)) &&
+  if ((refit_significant || drift_kept) && gain_off_by(fe, all_runs) > o.gain_tolerance && (!position_named || drift_kept) &&
       earns(EffectKind::kGainChange))
     named.push_back(EffectKind::kGainChange);
   if (refit_significant &&

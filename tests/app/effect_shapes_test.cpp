@@ -38,6 +38,17 @@ TEST(EffectShapes, AChamberSlopeFallsAlongTheStrokeEachWayAndIsMirrored) {
   EXPECT_NEAR(at(retracting, 350.0), 1.2, 1e-9);
 }
 
+// Beside a position dependence the drive's re-fitted gain is not named: it is the curve's level.
+TEST(EffectShapes, TheGainAlongTheStrokeCarriesTheRefittedGainAsItsLevel) {
+  auto d = diagnosis_naming(EffectKind::kPositionDependentGain, {0.0, 0.2, 0.0});
+  d.final_model.effects.set(EffectKind::kGainChange, {0.7});
+  const auto panels = epa::app::effect_shape_panels(d);
+  ASSERT_EQ(panels.size(), 1u);
+  EXPECT_NEAR(at(panels[0].series[0], 250.0), 0.7, 1e-9);
+  EXPECT_NEAR(at(panels[0].series[0], 150.0), 0.7 * 1.2, 1e-9);
+  EXPECT_NEAR(at(panels[0].series[1], 150.0), 0.7 * 0.8, 1e-9);
+}
+
 TEST(EffectShapes, FrictionIsCoulombAgainstTheSpeedWhileSlidingAndHoldsUpToBreakawayWhileSticking) {
   const auto panels = epa::app::effect_shape_panels(diagnosis_naming(EffectKind::kStaticFriction, {0.6, 0.3, 0.0}));
   ASSERT_EQ(panels.size(), 1u);
