@@ -24,6 +24,8 @@
 //     effects, lie beyond tolerances calibrated on effect-free data from slightly perturbed models
 //     and holding them nominal costs more than their chance threshold of the baseline gap (a
 //     parameter that only absorbs the residue of an effect's imperfect form is not a finding).
+//     Beside a position dependence a gain that holds is that dependence's level (the runs
+//     cannot tell the two apart): it is said, not named; a gain that drifts is named.
 //  8. Unexplained: a held-out gap left above unexplained_factor times the noise floor (the gap
 //     that sensor noise alone gives a perfect model, estimated from the runs at rest, and never
 //     below min_floor_mm) and, when
