@@ -13,7 +13,9 @@ How each truth form differs from the fitted one:
                 which freezes the piston while stuck; and LuGre bristles (presliding, no hard stick).
                 Shared: how a force enters the printed model (through its slow pole, not B), a
                 physical choice both sides make; the friction laws differ.
-  position      fitted: one gain slope along the stroke, both directions alike.
+  position      fitted: a gain slope along the stroke, a chamber slope mirrored per direction and
+                a quadratic curvature, at the mean of the last few positions; a gain that holds
+                beside them is their level (since 2026-12-02).
                 truth: chamber compressibility, gain ~ 1/(dead volume + chamber length), mirrored
                 per direction; and a cosine dip of the gain around mid-stroke.
   spool         fitted: one lag, or two real lags in series (since 2026-11-27; critically or
