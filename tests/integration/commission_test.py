@@ -22,7 +22,9 @@ Under the sanitizers (EPA_SANITIZER_RUN=1, set by the asan test preset) the run 
 deployment's checks: it has reached every part of the appliance the rest does (excitation,
 identification, design, simulation, the switch to the new set and the store), and the sanitizers
 judge memory and undefined behaviour, not figures; the HMI moves after it and the roll-back are
-behaviour, judged by the release run (about 140 of 350 s under ASan).
+behaviour, judged by the release run (about 140 of 350 s under ASan). For the same reason a
+deployment rolled back there for a figure missed on the axis (the loop runs late under ASan) is
+judged by the state it leaves: the previous set running and stored active, the roll-back audited.
 Exit 1 on any failure. A run that failed while the machine itself stalled
 (tests/support/stall_monitor.py) is run once more; failing again on a machine as stalled, it has
 no verdict: exit 77, which ctest reports as skipped.
@@ -246,8 +248,17 @@ def run_once(epa, src):
 
         # Deployed.
         r, outcome, report, took = commission(epa, app, dict(base, name="rig-1"), folder, "deployed")
-        check(r.returncode == 0 and outcome and outcome["verdict"] == "deployed",
-              f"epa commission exits 0 with verdict deployed in {took:.0f} s (exit {r.returncode}; {outcome and outcome['reason']})\n{r.stdout}{r.stderr[-2000:]}")
+        deployed = r.returncode == 0 and bool(outcome) and outcome["verdict"] == "deployed"
+        # Under the sanitizers the loop runs late (ASan, 2026-12-02: 146 overruns, wake-ups late by
+        # 1.7 ms at the 99th percentile) and the axis's figures are not the product's: a roll-back
+        # for a figure missed on the axis is a whole outcome there too, judged below by the state it
+        # leaves; the release run judges the figures.
+        rolled_back_on_axis = (SANITIZER_RUN and r.returncode == 2 and bool(outcome) and outcome["verdict"] == "rolled-back"
+                               and outcome["reason"].startswith("on the axis:"))
+        check(deployed or rolled_back_on_axis,
+              f"epa commission exits 0 with verdict deployed in {took:.0f} s (exit {r.returncode}; {outcome and outcome['reason']})"
+              + (" (under the sanitizers: rolled back for a figure on the axis)" if rolled_back_on_axis else "")
+              + ("" if deployed else f"\n{r.stdout}{r.stderr[-2000:]}"))
         if outcome and outcome.get("model"):
             m = outcome["model"]
             print(f"      identified: b_l {m['dead_zone']['b_l']:.3f} V, b_r {m['dead_zone']['b_r']:.3f} V, "
@@ -257,9 +268,15 @@ def run_once(epa, src):
                   f"overshoot {v['overshoot_pct']}")
         check(os.path.getsize(report) > 2000 if os.path.exists(report) else False, "the report was written")
         status = http(app, "GET", "/api/status")[1]
-        check(status["store"]["tuning_set"] == "rig-1", f"the new set runs (running set {status['store']['tuning_set']})")
+        expected = before if rolled_back_on_axis else "rig-1"
+        check(status["store"]["tuning_set"] == expected,
+              f"the {'previous' if rolled_back_on_axis else 'new'} set runs (running set {status['store']['tuning_set']})")
         active, listing = stored_active_sets(epa, app)
-        check(any("rig-1" in line for line in active), f"the new set is the stored active set: {active or listing}")
+        check(len(active) == 1 and f" {expected} " in active[0],
+              f"the {'previous' if rolled_back_on_axis else 'new'} set is the stored active set: {active or listing}")
+        if rolled_back_on_axis:
+            audit = json.dumps(http(app, "GET", "/api/audit")[1])
+            check("running_tuning_set" in audit and "rolled-back" in audit, "the switch and the roll-back are audited")
         if SANITIZER_RUN:
             print("      under the sanitizers: the HMI moves and the roll-back are left to the release run")
             return
