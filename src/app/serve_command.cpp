@@ -202,8 +202,9 @@ void log_changes(const runtime::Snapshot& previous, const runtime::Snapshot& s) 
     spdlog::warn("{} fault(s) latched with the fault event ring full: counted in faults, missing from the fault history",
                  s.fault_events_dropped - previous.fault_events_dropped);
   if (s.moves != previous.moves)
-    spdlog::info("move {} {:.1f} -> {:.1f} mm: rise {:.3f} s, settling {:.3f} s, e_ss {:.2f} mm, overshoot {:.1f} %",
-                 s.last_move.number, s.last_move.from_mm, s.last_move.to_mm, s.last_move.rise_s, s.last_move.settling_s,
+    spdlog::info("move {} {:.1f} -> {:.1f} mm ({}, {}): rise {:.3f} s, settling {:.3f} s, e_ss {:.2f} mm, overshoot {:.1f} %",
+                 s.last_move.number, s.last_move.from_mm, s.last_move.to_mm, control::to_string(s.last_move.controller),
+                 core::to_string(static_cast<core::MoveEnd>(s.last_move.end)), s.last_move.rise_s, s.last_move.settling_s,
                  s.last_move.ess_mm, s.last_move.overshoot_pct);
 }
 

@@ -250,7 +250,8 @@ int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::os
       for (const auto& r : *runs)
         out << iso_time(r.recorded_ms) << "  " << r.controller << "  " << number_or_dash(r.from_mm) << " -> "
             << number_or_dash(r.to_mm) << " mm  rise " << number_or_dash(r.rise_s) << " s  settling "
-            << number_or_dash(r.settling_s) << " s  e_ss " << number_or_dash(r.ess_mm) << " mm  " << r.path << "\n";
+            << number_or_dash(r.settling_s) << " s  e_ss " << number_or_dash(r.ess_mm) << " mm  overshoot "
+            << number_or_dash(r.overshoot_pct) << " %  " << r.path << "\n";
       if (runs->empty()) out << "no runs recorded\n";
       return 0;
     }

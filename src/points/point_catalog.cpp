@@ -48,13 +48,15 @@ constexpr std::string_view kStatusBitText[runtime::kStatusBits] = {
     "status bit 0: no fault latched and the I/O works",
     "status bit 1: mode RUN (the law holds or moves the axis)",
     "status bit 2: a move, halt or jog is under way (a move ends in position, or standing off target: bit 12)",
-    "status bit 3: |target - position| within the window for in_position_time_s (RUN)",
-    "status bit 4: the last started move came into position (cleared by the next start)",
-    "status bit 5: |reference - position| beyond following_error_mm now (the fault follows after following_error_time_s)",
+    "status bit 3: |target - position| within the window for in_position_time_s (RUN); the target is the last move's, "
+    "so a halt short of it reads 0; a target written and not yet taken reads 0 from the write on",
+    "status bit 4: the last started move came into position (RUN; cleared by the next start, from its write on)",
+    "status bit 5: the piston beyond following_error_mm from the motion it is asked to follow (a speed-limited move's "
+    "profile, or for a step the model's planned motion, up to the target) now; the fault follows after following_error_time_s",
     "status bit 6: following error, off target, I/O errors or the store not saving",
     "status bit 7: a fault is latched (fault_code)",
     "status bit 8: acknowledge: mirrors the control word's start bit once the loop applied it",
-    "status bit 9: the last task was a halt",
+    "status bit 9: the last task was a halt (in_position then says whether it stopped at the move's target)",
     "status bit 10: a jog (or its braking) is under way",
     "status bit 11: mode MANUAL",
     "status bit 12: the move stopped outside its window: the piston has stood within one window's width for standstill_time_s (RUN); "
@@ -202,7 +204,7 @@ std::vector<PointDef> build() {
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.commission.verdict); }},
       {P::kCommissionProgress, "commission_progress_pct", "%", "commissioning: share of the sequence done", A::kRead, 0, 0, false, true,
        [](const Ctx& c, int) { return c.status.commission.percent; }},
-      // last move (NaN: never reached / never moved)
+      // last move (NaN: does not apply to how it ended, core/move_metrics.hpp)
       {P::kMoveNumber, "move_number", "", "moves measured since start", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.last_move.number); }},
       {P::kMoveFrom, "move_from_mm", "mm", "last move: start", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.from_mm; }},
       {P::kMoveTo, "move_to_mm", "mm", "last move: setpoint", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.to_mm; }},
@@ -210,8 +212,9 @@ std::vector<PointDef> build() {
       {P::kMoveSettling, "move_settling_s", "s", "last move: 2 % settling time", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.settling_s; }},
       {P::kMoveEss, "move_ess_mm", "mm", "last move: steady-state error", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.ess_mm; }},
       {P::kMoveOvershoot, "move_overshoot_pct", "%", "last move: overshoot", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.overshoot_pct; }},
-      {P::kMoveEnd, "move_end", "", "last move: how it ended: 0 complete (its whole window), 1 cut short by a new target, 2 halted, "
-                                    "3 stopped (mode change), 4 fault, 5 controller switched; its metrics are over the samples it had",
+      {P::kMoveEnd, "move_end", "", "last move: how it ended: 0 in position, 1 cut short by a new target, 2 halted (after its braking), "
+                                    "3 stopped (mode change), 4 fault, 5 controller switched, 6 timeout (not in position move_window_s "
+                                    "after its reference arrived), 7 off target (stood still outside its window); its metrics are over its own samples",
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.last_move.end); }},
       // loop statistics and counters
       {P::kLoopWakeP50, "loop_wake_p50_us", "us", "scan cycle wake-up latency, median", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.loop.wake_p50_us; }},

@@ -75,19 +75,35 @@ runtime::Snapshot WriteGate::snapshot() const {
   return with_unapplied(s);
 }
 
+namespace {
+// A target the loop has not taken yet: from the write on, nothing may read as done for the old
+// one. The move is under way as far as a client can tell.
+void target_pending(runtime::AxisView& axis) {
+  axis.moving = true;
+  axis.in_position = axis.target_reached = axis.off_target = axis.halted = false;
+}
+}  // namespace
+
 runtime::Snapshot WriteGate::with_unapplied(runtime::Snapshot s) const {
   while (!unapplied_.empty() && unapplied_.front().sequence <= s.last_sequence) unapplied_.pop_front();
+  bool entering_run = false;  // RUN entered by an unapplied write: a setpoint written with it moves
   for (const runtime::Command& c : unapplied_) {
     switch (c.kind) {
-      case runtime::CommandKind::kSetpoint: s.setpoint_mm = c.value; break;
+      case runtime::CommandKind::kSetpoint:
+        // The loop moves on a setpoint that changes in RUN (scan_cycle.cpp: kSetpoint).
+        if (s.mode == runtime::Mode::kRun && (c.value != s.setpoint_mm || entering_run)) target_pending(s.axis);
+        s.setpoint_mm = c.value;
+        break;
       case runtime::CommandKind::kMode:
         if (c.mode == runtime::Mode::kExcite && s.mode != runtime::Mode::kExcite) s.excitation_left_s = s.excitation.duration_s;  // all of it is left
         if (c.mode != s.mode) {
+          entering_run = c.mode == runtime::Mode::kRun;
           // The motion bits as the loop will show them in the new mode, not the old one's (a read
           // just after mode := MANUAL showed in_position and halted with manual_mode): nothing is
           // moving, in position or off target yet; RUN and MANUAL start from a hold.
-          s.axis.moving = s.axis.in_position = s.axis.jogging = s.axis.off_target = false;
-          if (c.mode == runtime::Mode::kRun || c.mode == runtime::Mode::kManual) s.axis.target_reached = s.axis.halted = false;
+          // target_reached is RUN's alone, and RUN starts without one.
+          s.axis.moving = s.axis.in_position = s.axis.target_reached = s.axis.jogging = s.axis.off_target = false;
+          if (c.mode == runtime::Mode::kRun || c.mode == runtime::Mode::kManual) s.axis.halted = false;
           if (s.mode == runtime::Mode::kManual || c.mode == runtime::Mode::kManual) s.manual_valve_v = loop_rules_.safe_valve_v;
         }
         s.mode = c.mode;
@@ -96,10 +112,19 @@ runtime::Snapshot WriteGate::with_unapplied(runtime::Snapshot s) const {
       case runtime::CommandKind::kController: s.controller = c.controller; break;
       case runtime::CommandKind::kHeartbeat: s.heartbeat = c.heartbeat; break;
       case runtime::CommandKind::kExcitation: s.excitation = c.excitation; break;
-      case runtime::CommandKind::kControl:
-        if (c.control_word & ~s.axis.control_word & runtime::kControlStart) s.setpoint_mm = c.value;
+      case runtime::CommandKind::kControl: {
+        const std::uint16_t rising = c.control_word & ~s.axis.control_word;
+        if ((rising & runtime::kControlStart) && s.mode == runtime::Mode::kRun) {
+          s.setpoint_mm = c.value;
+          target_pending(s.axis);
+        }
+        if ((rising & runtime::kControlHalt) && s.mode == runtime::Mode::kRun) {
+          s.axis.in_position = s.axis.target_reached = false;  // in position after the halt only if it stops within the window
+          s.axis.halted = true;
+        }
         s.axis.control_word = c.control_word;
         break;
+      }
       case runtime::CommandKind::kTuning:  // the gate's copy is what the loop takes
         s.tuning.set_writable(tuning_.dead_zone, tuning_.lc_v, tuning_.trajectory, loop_rules_.mm_per_volt);
         break;

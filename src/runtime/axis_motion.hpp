@@ -36,9 +36,11 @@ enum class MotionTask : std::uint8_t {
 
 struct MotionStatus {
   bool moving = false;          // a move, halt or jog under way (not in position, not stood still off target)
-  bool in_position = false;     // |target - position| <= window for in_position_time_s
+  bool in_position = false;     // |target - position| <= window for in_position_time_s; the target is the
+                                // last move's (or hold's): a halt short of it is not in position
   bool target_reached = false;  // the last started move came into position (cleared by the next start)
   bool halted = false;          // the last task was a halt (cleared by the next start)
+  bool settled = false;         // the task has ended at its own end point (a halt: where it braked to)
   bool jogging = false;         // a jog or its braking is under way
   bool off_target = false;      // a move or halt has stopped outside its window: the piston stands, the law
                                 // does not bring it in (a dead band, stiction); clears if it comes in later
@@ -64,6 +66,7 @@ class AxisMotion {
 
   double reference_mm() const noexcept { return reference_mm_; }
   double target_mm() const noexcept { return target_mm_; }  // where the task ends (a halt: its stop point)
+  double goal_mm() const noexcept { return goal_mm_; }      // the target in_position is judged against
   MotionTask task() const noexcept { return task_; }
   // True while the reference still moves (a jog or a braking not yet at its end).
   bool profile_running() const noexcept { return profiled_ && !control::motion_profile_arrived(limits_, profile_, target_mm_); }
@@ -75,11 +78,13 @@ class AxisMotion {
   MotionConfig config_;
   MotionTask task_ = MotionTask::kHold;
   double target_mm_ = 0.0, reference_mm_ = 0.0, window_mm_ = 1.0;
+  double goal_mm_ = 0.0;  // the last move's or hold's target; a halt or jog keeps it (jog: its stop point)
   bool profiled_ = false;  // the reference follows profile_ (else it is the target)
   control::MotionLimits limits_;
   control::MotionProfileState profile_;
-  std::uint32_t samples_in_window_ = 0, samples_needed_ = 1;
-  bool in_position_ = false, target_reached_ = false, halted_ = false;
+  std::uint32_t samples_in_window_ = 0, samples_needed_ = 1;  // of target_mm_: the task has settled
+  std::uint32_t samples_at_goal_ = 0;                          // of goal_mm_: in position
+  bool settled_ = false, in_position_ = false, target_reached_ = false, halted_ = false;
   // Standstill: the range of positions since still_samples_ began stays within the window's width
   // (a window, not a speed: sensor noise makes a speed estimate at 200 Hz useless near zero).
   double still_min_mm_ = 0.0, still_max_mm_ = 0.0;

@@ -34,7 +34,7 @@ struct Command {
   std::uint32_t heartbeat = 0;
   std::uint16_t control_word = 0;
   double speed_limit_mm_s = 0.0, window_mm = 0.0;  // a start's: 0 none / the configured window
-  bool start_controller = false;                    // a start switches to `controller` first
+  bool start_controller = false;                    // a start runs its move with `controller` (that move only)
   std::uint64_t sequence = 0;  // the producer's number for it: a refusal is reported with it
   Tuning tuning;
   ExcitationSettings excitation;

@@ -90,9 +90,14 @@ void Recorder::write(const RecordRequest& request) {
   char name[160];
   if (request.reason == RecordRequest::Reason::kMove) {
     const auto& m = request.move;
+    // What core::move_metrics needs to recompute the move's figures from this file alone.
     run.set_meta("move", std::to_string(m.number));
-    run.set_meta("from_mm", core::format_number(m.from_mm));
+    run.set_meta("from_mm", core::format_exact(m.from_mm));
     run.set_meta("step_mm", core::format_number(m.to_mm - m.from_mm));
+    run.set_meta("target_mm", core::format_exact(m.to_mm));
+    run.set_meta("move_end", std::string(core::to_string(m.end)));
+    run.set_meta("ess_window_s", core::format_number(request.ess_window_s));
+    if (first != request.first) run.set_meta("samples_lost", std::to_string(first - request.first));
     std::snprintf(name, sizeof name, "move-%04u-%s-%gto%gmm.csv", m.number,
                   std::string(control::to_string(request.controller)).c_str(), m.from_mm, m.to_mm);
   } else if (request.reason == RecordRequest::Reason::kExcitation) {

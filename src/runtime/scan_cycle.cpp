@@ -12,7 +12,6 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kSpeedFilterS = 0.02;  // the measured speed's low-pass (a halt brakes from it)
 constexpr double kSoftLimitRecoverySlackMm = 1.0;  // outside the soft limits: how far back out a recovery may go (noise)
-double or_nan(const std::optional<double>& v) { return v ? *v : kNaN; }
 
 MotionConfig motion_config(const RuntimeConfig& c) {
   return {.in_position_window_mm = c.in_position_window_mm, .in_position_time_s = c.in_position_time_s,
@@ -35,7 +34,7 @@ ScanCycle::ScanCycle(const RuntimeConfig& config, const Tuning& tuning, hal::Daq
       manual_valve_v_(config.safe_valve_v),
       valve_v_(config.safe_valve_v),
       excitation_settings_(config.excitation),
-      moves_(config.move_window_s, config.period_s),
+      moves_(ch.samples.capacity(), config.move_window_s, config.period_s, config.in_position_time_s),
       motion_(motion_config(config)) {
   if (config.start_fault != FaultCode::kNone) {
     mode_ = Mode::kFault;  // before any start mode: a fault found before the start is latched
@@ -102,17 +101,16 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
           refusal = CommandRefusal::kControllerUnavailable;
           break;
         }
-        // The RST laws share their history; pp-traj keeps its own, so a switch to or from it
-        // starts the new law where the piston is, at its speed. Either way the valve command
-        // does not step: the new law takes over from it (bumpless transfer).
-        if ((c.controller == control::ControllerKind::kPpTraj) != (law() == control::ControllerKind::kPpTraj))
-          start_law_at_the_piston(tuning_.for_kind(c.controller));
-        if (c.controller != law()) transfer_pending_ = mode_ == Mode::kRun;
-        // A move's record, metrics and run file belong to the controller that made it: a switch
-        // ends it here (the piston goes on to its target under the new law, not as a move).
+        // A move's record, metrics and run file belong to the law that made it: a switch ends
+        // it here (the piston goes on to its target under the new law, not as a move).
         if (c.controller != controller_ && moves_.active()) finish_move(MoveEnd::kControllerSwitched);
-        controller_ = c.controller;
-        profile_law_ = false;  // the law asked for runs from now on, a halt's hold included
+        {
+          const control::ControllerKind before = law();
+          controller_ = c.controller;
+          profile_law_ = false;  // the law asked for runs from now on, a halt's hold included
+          move_law_.reset();
+          take_over_from(before);
+        }
         break;
       case CommandKind::kTuning:  // takes effect in this cycle's step, whole, taking over from the valve's command
         if (controller_ == control::ControllerKind::kPpTraj && !c.tuning.traj_available) {
@@ -120,8 +118,10 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
           break;
         }
         tuning_ = c.tuning;
-        if (profile_law_ && !tuning_.traj_available) {  // a halt's or jog's pp-traj cannot go on: the selected law takes over
+        if ((profile_law_ || move_law_ == control::ControllerKind::kPpTraj) && !tuning_.traj_available) {
+          // a halt's, jog's or record's pp-traj cannot go on: the selected law takes over
           profile_law_ = false;
+          move_law_.reset();
           start_law_at_the_piston(tuning_.for_kind(controller_));
         }
         if (law() == control::ControllerKind::kPpTraj) start_law_at_the_piston(tuning_.traj);  // new limits: a new profile
@@ -172,16 +172,24 @@ void ScanCycle::enter_run(std::int64_t now_ns) noexcept {
   heartbeat_changed_ns_ = now_ns;  // the client gets a full timeout from here
   following_error_since_ns_ = -1;
   motion_.hold(position_mm_);
+  following_.follow_reference();
 }
 
 void ScanCycle::use_profile_law(bool on) noexcept {
   if (on == profile_law_ || (on && !tuning_.traj_available)) return;
   const control::ControllerKind before = law();
   profile_law_ = on;
-  if (law() == before) return;  // pp-traj is the selected law anyway
+  take_over_from(before);
+}
+
+void ScanCycle::take_over_from(control::ControllerKind before) noexcept {
+  if (law() == before) return;
+  // The RST laws share their history; pp-traj keeps its own, so a switch to or from it starts the
+  // new law where the piston is, at its speed. Either way the valve command does not step: the new
+  // law takes over from it (bumpless transfer) when a law is driving (RUN, or a jog).
   if ((before == control::ControllerKind::kPpTraj) != (law() == control::ControllerKind::kPpTraj))
     start_law_at_the_piston(tuning_.for_kind(law()));
-  transfer_pending_ = true;
+  transfer_pending_ = mode_ == Mode::kRun || jog_law_;
 }
 
 double ScanCycle::plausible_speed_mm_s() const noexcept {
@@ -210,9 +218,11 @@ void ScanCycle::apply_control(const Command& c, std::int64_t now_ns) noexcept {
   if (rising & kControlReset) reset_fault();
   if (rising & kControlHalt) {
     if (mode_ == Mode::kRun) {
-      if (moves_.active()) finish_move(MoveEnd::kHalted);
+      // A move under way goes on being recorded through the braking, and ends halted once it
+      // stands (track_move).
       use_profile_law(true);
       motion_.halt(position_mm_, plausible_speed_mm_s());
+      following_.follow_reference();
       setpoint_mm_ = motion_.target_mm();  // the setpoint tells where the axis now stops
       hold_on_enable_ = false;
     } else if (jog_law_) {
@@ -220,13 +230,8 @@ void ScanCycle::apply_control(const Command& c, std::int64_t now_ns) noexcept {
     }
   }
   if (rising & kControlStart) {  // checked: RUN, a target within the setpoint range
-    if (c.start_controller && c.controller != controller_) {
-      Command switch_law = controller_command(c.controller);
-      switch_law.sequence = c.sequence;
-      apply(switch_law, now_ns);  // refused (pp-traj unavailable): the move runs with the law it has
-    }
     setpoint_mm_ = c.value;
-    start_move(c.value, c.speed_limit_mm_s, c.window_mm);
+    start_move(c.value, c.speed_limit_mm_s, c.window_mm, c.start_controller ? std::optional(c.controller) : std::nullopt);
   }
   if (mode_ == Mode::kManual) {
     const bool plus = word & kControlJogPlus, minus = word & kControlJogMinus;
@@ -240,6 +245,7 @@ void ScanCycle::apply_control(const Command& c, std::int64_t now_ns) noexcept {
       }
       manual_valve_v_ = config_.safe_valve_v;  // after the jog: the valve rests
       motion_.jog(direction, position_mm_, speed_mm_s_);
+      following_.follow_reference();
     } else if (direction == 0 && jog_law_) {
       motion_.jog(0, position_mm_, speed_mm_s_);
     }
@@ -261,12 +267,43 @@ void ScanCycle::end_excitation(ExcitationEnd how) noexcept {
   if (r.end > r.first) ch_.record_requests.try_push(r);  // a full queue drops the file, never the loop
 }
 
-void ScanCycle::start_move(double target_mm, double speed_limit_mm_s, double window_mm) noexcept {
+void ScanCycle::start_move(double target_mm, double speed_limit_mm_s, double window_mm,
+                           std::optional<control::ControllerKind> record_law) noexcept {
   if (moves_.active()) finish_move(MoveEnd::kCutShort);
   hold_on_enable_ = false;  // RUN entered with a move: the move, not a hold
-  use_profile_law(false);   // after a halt: the selected law again, taking over bumplessly
-  moves_.start(position_mm_, target_mm, ch_.samples.written());
+  const control::ControllerKind before = law();
+  profile_law_ = false;  // after a halt: the selected law again, taking over bumplessly
+  // A record's law pp-traj on a model it cannot run on: the move runs with the selected law (its
+  // record says so).
+  const bool usable = record_law && (*record_law != control::ControllerKind::kPpTraj || tuning_.traj_available);
+  move_law_ = usable && *record_law != controller_ ? record_law : std::nullopt;
+  take_over_from(before);
+  moves_.start(position_mm_, target_mm, law(), ch_.samples.written());
   motion_.move(target_mm, speed_limit_mm_s, window_mm, position_mm_, speed_mm_s_);
+  if (speed_limit_mm_s > 0.0) {
+    following_.follow_reference();
+  } else {
+    const auto& planned = tuning_.traj.trajectory().limits;  // sensor volts: in mm for the watch
+    control::MotionLimits expected = planned;
+    expected.speed_pos_v_s *= config_.mm_per_volt;
+    expected.speed_neg_v_s *= config_.mm_per_volt;
+    expected.accel_v_s2 *= config_.mm_per_volt;
+    following_.start_step(expected, tuning_.traj_available, position_mm_, plausible_speed_mm_s());
+  }
+}
+
+void ScanCycle::track_move() noexcept {
+  const bool judge = moves_.add(position_mm_, !motion_.profile_running());
+  const MotionStatus m = motion_.status();
+  if (motion_.task() == MotionTask::kHalt) {
+    if (!m.moving || judge) finish_move(MoveEnd::kHalted);  // braked and standing (or judged)
+  } else if (m.in_position) {
+    finish_move(MoveEnd::kInPosition);
+  } else if (m.off_target) {
+    finish_move(MoveEnd::kOffTarget);
+  } else if (judge) {
+    finish_move(MoveEnd::kTimeout);
+  }
 }
 
 void ScanCycle::finish_move(MoveEnd end) noexcept {
@@ -276,8 +313,14 @@ void ScanCycle::finish_move(MoveEnd end) noexcept {
   r.first = last_move_.first_sample;
   r.end = last_move_.end_sample;
   r.move = last_move_;
-  r.controller = controller_;
+  r.controller = last_move_.controller;
+  r.ess_window_s = moves_.options().ess_window_s;
   ch_.record_requests.try_push(r);  // a full queue drops the file, never the loop
+  if (move_law_) {  // the record's law ran this move only: the selected one takes over again
+    const control::ControllerKind before = law();
+    move_law_.reset();
+    take_over_from(before);
+  }
 }
 
 FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
@@ -317,7 +360,7 @@ FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
     }
   }
   if (mode_ == Mode::kRun && read_ok && config_.following_error_time_s > 0.0) {
-    if (std::abs(motion_.reference_mm() - position_mm_) > config_.following_error_mm) {
+    if (following_error_mm() > config_.following_error_mm) {
       if (following_error_since_ns_ < 0) following_error_since_ns_ = now_ns;
       if (static_cast<double>(now_ns - following_error_since_ns_) > config_.following_error_time_s * 1e9)
         return FaultCode::kFollowingError;
@@ -326,6 +369,11 @@ FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
     }
   }
   return FaultCode::kNone;
+}
+
+double ScanCycle::following_error_mm() noexcept {
+  const double position = readings_ >= 2 ? 0.5 * (position_mm_ + previous_position_mm_) : position_mm_;
+  return following_.step(motion_.reference_mm(), motion_.target_mm(), position);
 }
 
 void ScanCycle::enter_fault(FaultCode code) noexcept {
@@ -431,7 +479,7 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
 
   ch_.samples.push({static_cast<double>(cycle_) * config_.period_s, setpoint_mm_, position_mm_, valve_v_, controller_v_});
   if (mode_ == Mode::kRun) run_samples_end_ = ch_.samples.written();
-  if (mode_ == Mode::kRun && moves_.active() && moves_.add(position_mm_)) finish_move(MoveEnd::kComplete);
+  if (mode_ == Mode::kRun && moves_.active()) track_move();
   ++cycle_;
   publish();
 }
@@ -478,11 +526,12 @@ void ScanCycle::publish(bool full_stats) noexcept {
   s.excitation = excitation_settings_;
   s.excitation_left_s = excitation_.left_s();
   const auto& m = last_move_.metrics;
-  s.last_move = {last_move_.number, last_move_.from_mm, last_move_.to_mm, or_nan(m.rise_s), or_nan(m.settling_s),
-                 last_move_.number ? m.ess_mm : kNaN, or_nan(m.overshoot_pct), static_cast<std::uint8_t>(last_move_.end)};
+  s.last_move = {last_move_.number, last_move_.from_mm, last_move_.to_mm, m.rise_s, m.settling_s,
+                 last_move_.number ? m.ess_mm : kNaN, m.overshoot_pct, static_cast<std::uint8_t>(last_move_.end),
+                 last_move_.controller};
   const MotionStatus motion = motion_.status();
   const bool axis_active = mode_ == Mode::kRun || (mode_ == Mode::kManual && jog_law_);
-  s.axis = {axis_active && motion.moving, mode_ == Mode::kRun && motion.in_position, motion.target_reached,
+  s.axis = {axis_active && motion.moving, mode_ == Mode::kRun && motion.in_position, mode_ == Mode::kRun && motion.target_reached,
             following_error_since_ns_ >= 0, (control_word_ & kControlStart) != 0, motion.halted, axis_active && motion.jogging,
             control_word_, axis_active ? motion_.reference_mm() : position_mm_, speed_mm_s_, mode_ == Mode::kRun && motion.off_target};
   s.last_sequence = last_sequence_;

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
 #include "control/bumpless_transfer.hpp"
 #include "runtime/axis_motion.hpp"
@@ -22,6 +23,7 @@
 #include "runtime/excitation_run.hpp"
 #include "runtime/fault_event.hpp"
 #include "runtime/fault_history.hpp"
+#include "runtime/following_watch.hpp"
 #include "runtime/loop_stats.hpp"
 #include "runtime/move_tracker.hpp"
 #include "runtime/runtime_config.hpp"
@@ -38,6 +40,7 @@ struct RecordRequest {
   enum class Reason : std::uint8_t { kMove, kRequest, kExcitation } reason = Reason::kRequest;
   std::uint64_t first = 0, end = 0;
   MoveResult move;  // for kMove
+  double ess_window_s = 0;  // for kMove: the window of its e_ss (core::move_metrics)
   control::ControllerKind controller = control::ControllerKind::kPpFfidz;
   bool open_loop = false;  // no controller drove any of the samples (MANUAL, EXCITE, STOP): controller=open-loop
   ExcitationSettings excitation;                          // for kExcitation
@@ -88,8 +91,12 @@ class ScanCycle {
   // tuning set's model allows it, whatever law is selected, and the selected law takes over again
   // (bumplessly) at the next start. law() is the one stepping.
   void use_profile_law(bool on) noexcept;
+  // After the law's flags changed: the new law() takes over from `before` where the piston is.
+  void take_over_from(control::ControllerKind before) noexcept;
   double plausible_speed_mm_s() const noexcept;  // the measured speed, within the model's top speeds
-  control::ControllerKind law() const noexcept { return profile_law_ ? control::ControllerKind::kPpTraj : controller_; }
+  control::ControllerKind law() const noexcept {
+    return profile_law_ ? control::ControllerKind::kPpTraj : move_law_ ? *move_law_ : controller_;
+  }
   // Runs the law towards `reference_mm` and sets valve_v_, controller_v_, saturated_ (or faults).
   void step_law(double reference_mm, double y_v) noexcept;
   // The calibrated position in sensor volts from the last reading: what the control laws read.
@@ -97,9 +104,15 @@ class ScanCycle {
   // Starts `law` on the piston where the last reading put it, at the speed of the last two readings.
   void start_law_at_the_piston(const control::ControllerParams& law) noexcept;
   void end_excitation(ExcitationEnd how) noexcept;
-  // A started move (a setpoint written in RUN, or a start): the one before it ends cut short.
-  void start_move(double target_mm, double speed_limit_mm_s, double window_mm) noexcept;
+  // A started move (a setpoint written in RUN, or a start): the one before it ends cut short. A
+  // record's own law runs this move only (the selected law, holding `controller`, stays).
+  void start_move(double target_mm, double speed_limit_mm_s, double window_mm,
+                  std::optional<control::ControllerKind> record_law = std::nullopt) noexcept;
+  // Adds this cycle's reading to the move and ends it when it has ended (in position, braked
+  // after a halt, standing off target, or judged after move_window_s).
+  void track_move() noexcept;
   void finish_move(MoveEnd end) noexcept;
+  double following_error_mm() noexcept;  // this cycle's, RUN (following_watch.hpp)
   FaultCode detect_fault(bool read_ok, std::int64_t now_ns) noexcept;
   void enter_fault(FaultCode code) noexcept;
   void publish(bool full_stats = false) noexcept;
@@ -113,7 +126,8 @@ class ScanCycle {
 
   Mode mode_ = Mode::kStop;
   FaultCode fault_ = FaultCode::kNone;
-  control::ControllerKind controller_;
+  control::ControllerKind controller_;  // the selected law (holding `controller`)
+  std::optional<control::ControllerKind> move_law_;  // a record's own law, for its move only
   control::ControllerState state_;
   bool init_state_on_next_read_ = false;
   control::BumplessTransfer transfer_;  // a law or tuning switched in RUN takes over from the valve's command
@@ -140,6 +154,7 @@ class ScanCycle {
 
   MoveTracker moves_;
   MoveResult last_move_;
+  FollowingWatch following_;
 
   // The positioning interface: the task and its reference, the control word and its handshake.
   AxisMotion motion_;

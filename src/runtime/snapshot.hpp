@@ -18,8 +18,10 @@ namespace epa::runtime {
 struct MoveMetricsView {
   std::uint32_t number = 0;  // 0: no move finished yet
   double from_mm = 0, to_mm = 0;
-  double rise_s = 0, settling_s = 0, ess_mm = 0, overshoot_pct = 0;  // NaN: never reached / never moved
-  std::uint8_t end = 0;      // MoveEnd: 0 complete, 1 cut short, 2 halted, 3 stopped, 4 fault, 5 controller switched
+  double rise_s = 0, settling_s = 0, ess_mm = 0, overshoot_pct = 0;  // NaN: n/a (core/move_metrics.hpp)
+  std::uint8_t end = 0;      // core::MoveEnd: 0 in position, 1 cut short, 2 halted, 3 stopped, 4 fault,
+                             // 5 controller switched, 6 timeout, 7 off target
+  control::ControllerKind controller = control::ControllerKind::kPpFfidz;  // the law that ran the move
 };
 
 struct TuningView {

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "control/controller_kind.hpp"
+#include "core/move_metrics.hpp"
 #include "core/version.hpp"
 #include "core/utc_stamp.hpp"
 #include "points/point_catalog.hpp"
@@ -26,7 +27,9 @@ json short_num(double v) { return std::isfinite(v) ? json(std::round(v * 1e4) / 
 
 json move_json(const runtime::MoveMetricsView& m) {
   return {{"number", m.number}, {"from_mm", num(m.from_mm)}, {"to_mm", num(m.to_mm)}, {"rise_s", num(m.rise_s)},
-          {"settling_s", num(m.settling_s)}, {"ess_mm", num(m.ess_mm)}, {"overshoot_pct", num(m.overshoot_pct)}};
+          {"settling_s", num(m.settling_s)}, {"ess_mm", num(m.ess_mm)}, {"overshoot_pct", num(m.overshoot_pct)},
+          {"end", std::string(core::to_string(static_cast<core::MoveEnd>(m.end)))},
+          {"controller", std::string(control::to_string(m.controller))}};
 }
 
 json poly(const std::array<double, control::kMaxLawOrder + 1>& c, std::size_t n) {
@@ -116,8 +119,7 @@ std::string trend_json(const std::vector<TrendPoint>& points, const runtime::Sna
 std::string moves_json(const std::vector<MoveRecord>& moves) {
   json a = json::array();
   for (const auto& m : moves) {
-    json e = move_json(m.metrics);
-    e[k(P::kController)] = std::string(control::to_string(m.controller));
+    json e = move_json(m.metrics);  // its controller: the law that ran the move
     e["finished_s"] = num(m.finished_s);
     a.push_back(std::move(e));
   }

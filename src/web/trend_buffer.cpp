@@ -13,7 +13,7 @@ void TrendBuffer::add(const runtime::Snapshot& s) {
   if (size_ < ring_.size()) ++size_;
   if (s.last_move.number != 0 && s.last_move.number != last_move_number_) {
     if (moves_.size() == kMaxMoves) moves_.erase(moves_.begin());
-    moves_.push_back({s.last_move, s.controller, s.time_s});
+    moves_.push_back({s.last_move, s.time_s});
   }
   last_move_number_ = s.last_move.number;
 }

@@ -16,8 +16,7 @@ struct TrendPoint {
 };
 
 struct MoveRecord {
-  runtime::MoveMetricsView metrics;
-  control::ControllerKind controller = control::ControllerKind::kPpFfidz;
+  runtime::MoveMetricsView metrics;  // with the law that ran it
   double finished_s = 0;  // snapshot time when it was seen
 };
 

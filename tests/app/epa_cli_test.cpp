@@ -188,7 +188,8 @@ TEST_F(EpaCli, ServeRefusesABadConfigurationNamingFileLineAndKey) {
 }
 
 TEST_F(EpaCli, ServeOnTheSimPlantMovesRecordsAndStopsCleanly) {
-  // move_window_s 0.5 so that the move is measured and recorded within the 1.5 s run.
+  // move_window_s 0.5 so that the move is judged (FF-IDZ rings on the paper's plant: a timeout) and
+  // recorded within the 1.5 s run.
   std::ofstream(path("fast.toml")) << "[recorder]\nmove_window_s = 0.5\n[log]\nstatus_interval_s = 0\n"
                                     << "[modbus]\nport = 0\nregister_map = \"" << EPA_SOURCE_DIR << "/registers/epa.csv\"\n"
                                     << "[web]\naddress = \"127.0.0.1\"\nport = 0\nstatic_dir = \"" << EPA_SOURCE_DIR << "/web\"\n";
@@ -200,7 +201,8 @@ TEST_F(EpaCli, ServeOnTheSimPlantMovesRecordsAndStopsCleanly) {
   EXPECT_NE(o.output.find("valve 0.000 V"), std::string::npos) << o.output;  // stopped with the valve safe
   auto run = epa::core::read_run_file(path("runs/move-0001-pp-ffidz-0to100mm.csv"), 0.005);
   ASSERT_TRUE(run.has_value()) << run.error().message;
-  EXPECT_EQ(run->size(), 100u);
+  EXPECT_EQ(run->meta("move_end"), "timeout");
+  EXPECT_EQ(run->size(), 100u);  // judged 0.5 s after its reference (a step: at once) arrived
 }
 
 TEST_F(EpaCli, ServeOnThePhysicsPlantMovesAndRecords) {

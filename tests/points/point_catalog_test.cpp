@@ -43,6 +43,7 @@ const std::map<std::string, std::string> kFormatFiles = {
     {"core/dead_zone.hpp", "epa-model/1 and epa-tuning/1 dead-zone keys"},
     {"core/model_file.cpp", "epa-model/1 keys"},
     {"core/run_file.cpp", "epa-run/1 metadata"},
+    {"core/move_metrics.cpp", "epa-run/1 metadata: a move's move_end values, which name how it ended, not the status bits"},
     {"runtime/recorder.cpp", "epa-run/1 metadata"},
     {"app/run_history.cpp", "epa-run/1 metadata"},
     {"app/identify_command.cpp", "epa-run/1 metadata"},

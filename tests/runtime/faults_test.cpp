@@ -127,10 +127,18 @@ TEST_F(Faults, FollowingErrorTooLargeForTooLong) {
   c.following_error_mm = 20.0;
   c.following_error_time_s = 0.5;
   c.sensor_frozen_time_s = 0.0;  // the fake sensor never moves: that is not what this test is about
-  start(c);    // cycles at 0, 5, 10 ms; the error (|300 - 100| mm) is there from t = 0
-  cycles(98);  // up to t = 500 ms: exactly the allowed time, not more
+  start(c);    // a move 100 -> 300 mm with the piston blocked (the fake sensor never moves)
+  // The error is against the motion the move is expected to make (pp-traj's plan on the model), not
+  // the step to 300 mm: it grows as that motion leaves the piston behind, and passes 20 mm within
+  // the first 0.3 s (the plan's acceleration).
+  int cycles_to_error = 0;
+  for (; cycles_to_error < 60 && !snap().axis.following_error; ++cycles_to_error) cycles(1);
+  ASSERT_TRUE(snap().axis.following_error) << "a blocked piston lagged less than 20 mm behind the planned motion after 0.3 s";
+  EXPECT_GT(cycles_to_error, 0);  // not a step: the planned motion starts where the piston stands
   EXPECT_EQ(snap().mode, Mode::kRun);
-  cycles(1);   // t = 505 ms
+  cycles(100);  // 500 ms after the error passed the limit: exactly the allowed time, not more
+  EXPECT_EQ(snap().mode, Mode::kRun);
+  cycles(1);    // 505 ms
   EXPECT_EQ(snap().mode, Mode::kFault);
   EXPECT_EQ(snap().fault, FaultCode::kFollowingError);
   EXPECT_EQ(daq_.last_written_v, kSafeV);

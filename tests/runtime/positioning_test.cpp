@@ -126,7 +126,7 @@ TEST(Positioning, AStartMovesSetsMovingThenInPositionAndTheAcknowledgeMirrorsSta
     EXPECT_TRUE(axis.snap().axis.target_reached) << "until the next start";
     axis.cycles(5 * kCyclesPerSecond);
     EXPECT_EQ(axis.snap().moves, 1u) << "one start, one move";
-    EXPECT_EQ(axis.snap().last_move.end, static_cast<std::uint8_t>(MoveEnd::kComplete));
+    EXPECT_EQ(axis.snap().last_move.end, static_cast<std::uint8_t>(MoveEnd::kInPosition));
   }
 }
 
@@ -196,10 +196,15 @@ HaltFigures halt_a_long_move(ControllerKind kind) {
   for (std::size_t k = kCyclesPerSecond / 2; k < after.size(); ++k)
     f.moved_after_half_second_mm = std::max(f.moved_after_half_second_mm, std::abs(after[k] - f.rest_mm));
   EXPECT_TRUE(axis.snap().axis.halted);
-  EXPECT_TRUE(axis.snap().axis.in_position) << control::to_string(kind) << ": rests at " << f.rest_mm << ", halt target "
-                                            << axis.snap().setpoint_mm;
+  // In position means at the move's target: a halt 100 mm short of it is not, and does not say so.
+  EXPECT_FALSE(axis.snap().axis.in_position) << control::to_string(kind) << ": rests at " << f.rest_mm;
+  EXPECT_NEAR(f.rest_mm, axis.snap().setpoint_mm, 1.0) << control::to_string(kind) << ": rests away from the halt's stop point";
   EXPECT_FALSE(axis.snap().axis.moving);
-  EXPECT_EQ(axis.snap().last_move.end, static_cast<std::uint8_t>(MoveEnd::kHalted));
+  EXPECT_FALSE(axis.snap().axis.off_target) << "a halt that stood where it braked to is no warning";
+  const auto& m = axis.snap().last_move;
+  EXPECT_EQ(m.end, static_cast<std::uint8_t>(MoveEnd::kHalted));
+  EXPECT_TRUE(std::isnan(m.overshoot_pct)) << "no overshoot for a move told to stop short";
+  EXPECT_TRUE(std::isnan(m.ess_mm));
   EXPECT_LT(f.rest_mm, 450.0 - 100.0) << control::to_string(kind) << ": the halt did not stop the move";
   return f;
 }
@@ -259,20 +264,32 @@ TEST(Positioning, AJogIsRefusedOutsideManual) {
   EXPECT_FALSE(axis.snap().axis.jogging);
 }
 
-TEST(Positioning, AMoveCutShortIsReportedAsCutShortWithItsOwnMetrics) {
+TEST(Positioning, AMoveEndsInPositionAndOneCutShortIsReportedAsCutShortWithItsOwnMetrics) {
   Axis axis(100.0, ControllerKind::kPpNgidz);
   axis.push(mode_command(Mode::kRun));
   axis.push(setpoint_command(150.0));
-  axis.cycles(3 * kCyclesPerSecond);  // settled, not yet the 5 s window
+  axis.cycles(3 * kCyclesPerSecond);
   const double settled_at = axis.daq.plant().position_mm();
   ASSERT_NEAR(settled_at, 150.0, 1.0);
+  {
+    const auto& m = axis.snap().last_move;  // ended when it came into position, not after a window
+    EXPECT_EQ(m.number, 1u);
+    EXPECT_EQ(m.end, static_cast<std::uint8_t>(MoveEnd::kInPosition));
+    EXPECT_LT(m.ess_mm, axis.config.in_position_window_mm) << "e_ss over its in-position dwell";
+    EXPECT_TRUE(std::isfinite(m.settling_s));
+    EXPECT_TRUE(std::isfinite(m.overshoot_pct));
+  }
   axis.push(setpoint_command(300.0));
+  axis.cycles(kCyclesPerSecond / 10);
+  const double cut_at = axis.snap().position_mm;
+  axis.push(setpoint_command(200.0));
   axis.cycles(1);
   const auto& m = axis.snap().last_move;
-  EXPECT_EQ(m.number, 1u);
+  EXPECT_EQ(m.number, 2u);
   EXPECT_EQ(m.end, static_cast<std::uint8_t>(MoveEnd::kCutShort));
-  EXPECT_NEAR(m.ess_mm, std::abs(150.0 - settled_at), 0.3) << "e_ss over its own end, not its transient";
-  EXPECT_TRUE(std::isfinite(m.settling_s)) << "it settled before it was cut";
+  EXPECT_EQ(m.to_mm, 300.0);
+  EXPECT_NEAR(m.ess_mm, 300.0 - cut_at, 30.0) << "e_ss: how far from its target it was cut, over its last 0.1 s";
+  EXPECT_TRUE(std::isnan(m.settling_s)) << "a move cut short was not let to settle";
 }
 
 // A switch of controller mid-move ends the move there, filed under the controller that made it
@@ -339,6 +356,8 @@ TEST(Positioning, AHaltDuringASlowMoveAfterAHoldStopsWhereItIsHaltedAndStays) {
     Command record4 = control_command(kControlStart);
     record4.value = 420.0;
     record4.speed_limit_mm_s = 15.0;
+    record4.start_controller = true;  // a record's law runs its own move only: the slow move is pp-traj's too
+    record4.controller = ControllerKind::kPpTraj;
     axis.push(record4);
     axis.cycles(2);
     axis.control(0);

@@ -64,7 +64,7 @@ TEST(ScanCycle, ReproducesSimulateExactlyForEachController) {
   }
 }
 
-TEST(ScanCycle, OnlineMoveMetricsAreSimulateMetricsOverTheMoveWindow) {
+TEST(ScanCycle, OnlineMoveMetricsAreMoveMetricsOverTheSimulatedSamplesOfTheMove) {
   const auto model = core::paper::model();
   auto daq = *hal::SimDaq::make(model, {});
   VirtualClock clock;
@@ -72,22 +72,34 @@ TEST(ScanCycle, OnlineMoveMetricsAreSimulateMetricsOverTheMoveWindow) {
   config.start_mode = Mode::kRun;
   config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
   config.start_setpoint_mm = 100.0;
+  config.controller = ControllerKind::kPpNgidz;  // settles into the 1 mm window (FF-IDZ rings on the printed B)
   config.move_window_s = 5.0;
   LoopChannels ch(8000);
   ScanCycle loop(config, paper_tuning(), daq, clock, ch);
-  run_cycles(loop, clock, 1001);  // the 5 s window is 1000 samples
+  for (int k = 0; k < 1000 && loop.last_snapshot().last_move.number == 0; ++k) run_cycles(loop, clock, 1);
+  RecordRequest r;
+  ASSERT_TRUE(ch.record_requests.try_pop(r));
+  const auto length = static_cast<std::size_t>(r.end - r.first);
 
-  auto params = *control::ControllerParams::make(control::paper_controller_config(ControllerKind::kPpFfidz));
+  // The loop reproduces `epa simulate` sample for sample: the move's figures are move_metrics over
+  // the same samples, its own and no more.
+  auto params = *control::ControllerParams::make(control::paper_controller_config(ControllerKind::kPpNgidz));
   const auto sim = *sim::simulate_step(model, params, {.step_mm = 100.0, .duration_s = 5.0});
-  const auto expected = core::step_metrics(sim.run.y_mm, 100.0, {.Ts = 0.005, .ess_window_s = 2.0});
+  ASSERT_LT(length, sim.run.y_mm.size());
+  const auto expected = core::move_metrics(std::span(sim.run.y_mm).first(length), 0.0, 100.0, core::MoveEnd::kInPosition,
+                                           {.Ts = 0.005, .ess_window_s = config.in_position_time_s});
   const auto& m = loop.last_snapshot().last_move;
   EXPECT_EQ(m.number, 1u);
+  EXPECT_EQ(m.end, static_cast<std::uint8_t>(core::MoveEnd::kInPosition));
   EXPECT_EQ(m.from_mm, 0.0);
   EXPECT_EQ(m.to_mm, 100.0);
-  EXPECT_EQ(m.rise_s, *expected.rise_s);
-  EXPECT_EQ(m.settling_s, *expected.settling_s);
+  EXPECT_EQ(m.controller, ControllerKind::kPpNgidz);
+  EXPECT_EQ(m.rise_s, expected.rise_s);
+  EXPECT_EQ(m.settling_s, expected.settling_s);
   EXPECT_EQ(m.ess_mm, expected.ess_mm);
-  EXPECT_EQ(m.overshoot_pct, *expected.overshoot_pct);
+  EXPECT_EQ(m.overshoot_pct, expected.overshoot_pct);
+  EXPECT_TRUE(std::isfinite(m.rise_s) && std::isfinite(m.settling_s) && std::isfinite(m.overshoot_pct));
+  EXPECT_LT(m.ess_mm, config.in_position_window_mm);
   EXPECT_EQ(loop.last_snapshot().moves, 1u);
 }
 
@@ -308,6 +320,7 @@ TEST(Recorder, WritesEachMoveAsAValidRunFile) {
   config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
   config.start_setpoint_mm = 50.0;
   config.move_window_s = 2.0;
+  config.controller = ControllerKind::kPpNgidz;
   LoopChannels ch(4000);
   ScanCycle loop(config, paper_tuning(), daq, clock, ch);
   Recorder recorder({.directory = dir.path.string(), .per_move = true, .Ts = 0.005, .source = "test"}, ch);
@@ -315,9 +328,23 @@ TEST(Recorder, WritesEachMoveAsAValidRunFile) {
   ASSERT_EQ(recorder.process_pending(), 1u);
   auto run = core::read_run_file(recorder.last_file(), 0.005);
   ASSERT_TRUE(run.has_value()) << run.error().message;
-  EXPECT_EQ(run->size(), 400u);  // the 2 s window
-  EXPECT_EQ(run->meta("controller"), "pp-ffidz");
+  // The move, from its first cycle until it was in position: its last in_position_time_s within
+  // the window (the move's metrics are recomputed from this alone: run_history).
+  const auto& last = loop.last_snapshot().last_move;
+  ASSERT_EQ(last.end, static_cast<std::uint8_t>(core::MoveEnd::kInPosition));
+  EXPECT_LT(run->size(), 400u);
+  for (std::size_t k = run->size() - 20; k < run->size(); ++k) EXPECT_NEAR(run->y_mm[k], 50.0, config.in_position_window_mm);
+  EXPECT_EQ(run->meta("controller"), "pp-ngidz");
   EXPECT_EQ(run->meta("step_mm"), "50");
+  EXPECT_EQ(run->meta("target_mm"), "50");
+  EXPECT_EQ(run->meta("from_mm"), "0");
+  EXPECT_EQ(run->meta("move_end"), "in_position");
+  EXPECT_EQ(run->meta("ess_window_s"), "0.1");
+  const auto again = core::move_metrics(run->y_mm, 0.0, 50.0, core::MoveEnd::kInPosition, {.Ts = 0.005, .ess_window_s = 0.1});
+  EXPECT_NEAR(again.ess_mm, last.ess_mm, 1e-3);
+  EXPECT_NEAR(again.rise_s, last.rise_s, 1e-9);
+  EXPECT_NEAR(again.settling_s, last.settling_s, 1e-9);
+  EXPECT_NEAR(again.overshoot_pct, last.overshoot_pct, 1e-3);
   EXPECT_EQ(run->t_s.front(), 0.0);
   EXPECT_EQ(run->r_mm.front(), 50.0);
 
