@@ -2,6 +2,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/text_file.hpp"
+
 namespace epa::app {
 
 core::Result<std::unique_ptr<httplib::Client>> appliance_client(const std::string& url) {
@@ -13,6 +15,19 @@ core::Result<std::unique_ptr<httplib::Client>> appliance_client(const std::strin
 }
 
 httplib::Headers bearer(const std::string& token) { return {{"Authorization", "Bearer " + token}}; }
+
+core::Result<std::string> appliance_token(const std::string& token, const std::string& token_file) {
+  if (token_file.empty()) {
+    if (token.empty()) return core::invalid_argument("no token: set EPA_TOKEN, or give --token-file FILE (or --token, which shows in ps), with the appliance's [web] token");
+    return token;
+  }
+  auto text = core::read_text_file(token_file, "token file");
+  if (!text) return text.error();
+  std::string first = text->substr(0, text->find('\n'));
+  if (!first.empty() && first.back() == '\r') first.pop_back();
+  if (first.empty()) return core::invalid_argument(token_file + ": the token file's first line is empty");
+  return first;
+}
 
 std::string http_failure(const httplib::Result& r, const std::string& url) {
   if (!r) return "no answer from " + url + " (" + httplib::to_string(r.error()) + "): is the appliance running there, with its [web] port?";

@@ -21,7 +21,9 @@ void add_commission_command(CLI::App& app, CommissionOptions& o) {
                                  "Commission the axis of a running appliance: excite, identify, design, verify in simulation, "
                                  "deploy, verify on the axis, keep or roll back");
   cmd->add_option("--url", o.url, "The appliance's status page, http://HOST:PORT")->capture_default_str();
-  cmd->add_option("--token", o.token, "The appliance's [web] token (commands and tuning need it)")->required();
+  cmd->add_option("--token", o.token, "The appliance's [web] token (commands and tuning need it); shows in ps: prefer EPA_TOKEN "
+                                      "or --token-file")->envname("EPA_TOKEN");
+  cmd->add_option("--token-file", o.token_file, "A file whose first line is the appliance's [web] token")->check(CLI::ExistingFile);
   cmd->add_option("--spec", o.spec_path, "Commissioning spec (JSON: experiment, design, verification limits); default: built in")
       ->check(CLI::ExistingFile);
   cmd->add_option("--json", o.json_path, "Write the outcome here (epa-commission/1 JSON)");
@@ -54,10 +56,12 @@ int run_commission(const CommissionOptions& o, std::ostream& out, std::ostream& 
     if (auto parsed = commission::parse_commission_spec(*text); !parsed) return fail(o.spec_path + ": " + parsed.error().message);
     spec = *text;
   }
+  auto token = appliance_token(o.token, o.token_file);
+  if (!token) return fail(token.error().message);
   auto made = appliance_client(o.url);
   if (!made) return fail(made.error().message);
   httplib::Client& client = **made;
-  const httplib::Headers auth = bearer(o.token);
+  const httplib::Headers auth = bearer(*token);
 
   auto started = client.Post("/api/commission", auth, spec, "application/json");
   if (!started || started->status != 202) return fail("the appliance did not start the commissioning: " + http_failure(started, o.url));

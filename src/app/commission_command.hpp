@@ -11,7 +11,8 @@ namespace epa::app {
 
 struct CommissionOptions {
   std::string url = "http://127.0.0.1:8080";
-  std::string token;
+  std::string token;       // --token or EPA_TOKEN
+  std::string token_file;  // --token-file: its first line
   std::string spec_path;    // JSON (commission/commission_spec.hpp); empty: the defaults
   std::string json_path;    // epa-commission/1 of the outcome
   std::string report_path;  // the HTML report

@@ -7,8 +7,8 @@
 
 namespace epa::app {
 
-CommissionService::CommissionService(AxisFactory make_axis, commission::Identify identify, Log log)
-    : make_axis_(std::move(make_axis)), identify_(std::move(identify)), log_(std::move(log)) {}
+CommissionService::CommissionService(AxisFactory make_axis, commission::Identify identify, commission::ApplianceBounds bounds, Log log)
+    : make_axis_(std::move(make_axis)), identify_(std::move(identify)), bounds_(std::move(bounds)), log_(std::move(log)) {}
 
 CommissionService::~CommissionService() {
   {
@@ -22,6 +22,7 @@ points::CommissionStartResult CommissionService::start(const std::string& spec_j
   auto spec = spec_json.find_first_not_of(" \t\r\n") == std::string::npos ? core::Result<commission::CommissionSpec>(commission::CommissionSpec{})
                                                                           : commission::parse_commission_spec(spec_json);
   if (!spec) return {points::CommissionStart::kBadSpec, spec.error().message};
+  if (auto s = commission::check_runnable(*spec, bounds_); !s) return {points::CommissionStart::kBadSpec, s.error().message};
   std::lock_guard lock(mutex_);
   if (running_) return {points::CommissionStart::kBusy, "a commissioning run is under way: " + sequence_->progress().message};
   if (thread_.joinable()) thread_.join();  // the last run's thread has ended (running_ is false)

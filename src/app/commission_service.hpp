@@ -11,6 +11,7 @@
 
 #include "commission/axis.hpp"
 #include "commission/commission_sequence.hpp"
+#include "commission/commission_spec.hpp"
 #include "web/commission_port.hpp"
 
 namespace epa::app {
@@ -21,7 +22,8 @@ class CommissionService final : public web::CommissionPort {
   // The axis for a run started by `source` (its commands are audited as coming from it).
   using AxisFactory = std::function<std::unique_ptr<commission::Axis>(const std::string& source)>;
 
-  CommissionService(AxisFactory make_axis, commission::Identify identify, Log log);
+  // `bounds`: what this appliance can run; a spec beyond them is refused before the axis is touched.
+  CommissionService(AxisFactory make_axis, commission::Identify identify, commission::ApplianceBounds bounds, Log log);
   ~CommissionService() override;  // aborts a run under way and waits for it (the valve safe)
   CommissionService(const CommissionService&) = delete;
   CommissionService& operator=(const CommissionService&) = delete;
@@ -39,6 +41,7 @@ class CommissionService final : public web::CommissionPort {
  private:
   AxisFactory make_axis_;
   commission::Identify identify_;
+  commission::ApplianceBounds bounds_;
   Log log_;
   mutable std::mutex mutex_;
   std::unique_ptr<commission::Axis> axis_;

@@ -24,7 +24,8 @@ CLI::App* add_records_command(CLI::App& app, RecordsOptions& o) {
   set->add_option("--speed-mm-s", o.speed_mm_s, "Speed limit, mm/s (0: none, the law's own step response)");
   set->add_option("--window-mm", o.window_mm, "In-position window, mm (0: [motion] in_position_window_mm)");
   set->add_option("--controller", o.controller, "The law: pp, pp-ngidz, pp-ffidz, pp-traj, or running (the one running then)");
-  set->add_option("--token", o.token, "The appliance's [web] token")->envname("EPA_TOKEN");
+  set->add_option("--token", o.token, "The appliance's [web] token; shows in ps: prefer EPA_TOKEN or --token-file")->envname("EPA_TOKEN");
+  set->add_option("--token-file", o.token_file, "A file whose first line is the appliance's [web] token")->check(CLI::ExistingFile);
   set->callback([&o] { o.set = true; });
   return cmd;
 }
@@ -66,10 +67,11 @@ int run_records(const RecordsOptions& o, std::ostream& out, std::ostream& err) {
     if (o.window_mm) body[K::kWindow] = *o.window_mm;
     if (o.controller) body[K::kController] = *o.controller;
     if (body.size() == 1) return fail("record " + std::to_string(o.record) + ": nothing to set: give --target-mm, --speed-mm-s, --window-mm or --controller");
-    if (o.token.empty()) return fail("record " + std::to_string(o.record) + ": no token: give --token or set EPA_TOKEN to the appliance's [web] token");
+    const auto token = appliance_token(o.token, o.token_file);
+    if (!token) return fail("record " + std::to_string(o.record) + ": " + token.error().message);
     for (const char* f : {K::kTarget, K::kSpeed, K::kWindow})
       if (body.contains(f) && !std::isfinite(body[f].get<double>())) return fail(std::string(f) + " must be a finite number");
-    auto r = client.Post("/api/records", bearer(o.token), body.dump(), "application/json");
+    auto r = client.Post("/api/records", bearer(*token), body.dump(), "application/json");
     if (!r) return fail("record " + std::to_string(o.record) + ": " + http_failure(r, o.url));
     if (r->status != 200) return fail("the appliance refused record " + std::to_string(o.record) + ": " + http_failure(r, o.url));
   }

@@ -19,7 +19,8 @@ struct RecordsOptions {
   int record = 0;
   std::optional<double> target_mm, speed_mm_s, window_mm;
   std::optional<std::string> controller;  // a law's name, or "running"
-  std::string token;
+  std::string token;       // --token or EPA_TOKEN
+  std::string token_file;  // --token-file: its first line
 };
 
 // Returns the subcommand (main asks it whether it was given).

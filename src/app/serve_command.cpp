@@ -361,7 +361,14 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
     return std::make_unique<ApplianceAxis>(c.runtime, channels, gate, store_writer, c.store_path, recorded,
                                            points::Requester{source, true, "", /*tuning_unlocked=*/true});
   };
-  auto commissioning = std::make_unique<CommissionService>(make_axis, identify_for_commissioning(c.runtime.mm_per_volt),
+  const auto& limits_now = gate.limits();
+  const commission::ApplianceBounds bounds{
+      .setpoint_min_mm = limits_now.range(points::PointId::kSetpoint).min.value,
+      .setpoint_max_mm = limits_now.range(points::PointId::kSetpoint).max.value,
+      .excitation_max_s = limits_now.range(points::PointId::kExciteDuration).max.value,
+      .excitation_max_source = limits_now.range(points::PointId::kExciteDuration).max.source,
+      .amplitude_max_v = limits_now.range(points::PointId::kExciteAmplitudeMax).max.value};
+  auto commissioning = std::make_unique<CommissionService>(make_axis, identify_for_commissioning(c.runtime.mm_per_volt), bounds,
                                                            [](const std::string& line) { spdlog::info("{}", line); });
   gate.attach_commission(commissioning.get());
   // The web server starts first, so the Modbus identity names the port it bound (VendorUrl; with

@@ -76,6 +76,18 @@ core::Status CommissionSpec::validate(double lo_mm, double hi_mm) const {
   return core::ok();
 }
 
+core::Status check_runnable(const CommissionSpec& spec, const ApplianceBounds& b) {
+  if (auto s = spec.validate(b.setpoint_min_mm, b.setpoint_max_mm); !s) return s;
+  if (spec.excitation_s > b.excitation_max_s)
+    return core::invalid_argument("commission spec: excitation_s " + core::format_number(spec.excitation_s) +
+                                  " s does not fit this appliance's recorder: at most " + core::format_number(b.excitation_max_s) +
+                                  " s (" + b.excitation_max_source + ")");
+  if (spec.amplitude_max_v > b.amplitude_max_v)
+    return core::invalid_argument("commission spec: amplitude_max_v " + core::format_number(spec.amplitude_max_v) +
+                                  " V is above this appliance's excite_amplitude_max_v limit of " + core::format_number(b.amplitude_max_v) + " V");
+  return core::ok();
+}
+
 core::Result<CommissionSpec> parse_commission_spec(const std::string& text) {
   nlohmann::json j;
   try {

@@ -392,12 +392,20 @@ GateResult WriteGate::replace_tuning(const control::ControllerConfig& replacemen
   auto t = runtime::make_tuning(tuning);
   if (!t) return refuse(Refusal::kInvalidValue, "the tuning set would not validate: " + t.error().message);
   std::lock_guard lock(mutex_);
+  const control::ControllerKind running = with_unapplied(channels_.snapshot.read()).controller;
   runtime::Command commands[] = {runtime::tuning_command(*t), runtime::controller_command(tuning.kind)};
   for (auto& c : commands) c.sequence = next_sequence_++;
   if (!channels_.commands.try_push_all(commands, std::size(commands)))
     return refuse(Refusal::kBusy, "the scan cycle's command queue is full: try again");
   tuning_ = tuning;
-  if (audit_) audit_->record({entry});
+  for (const auto& c : commands) unapplied_.push_back(c);
+  while (unapplied_.size() > kUnapplied) unapplied_.pop_front();
+  // Every change of the running law is in the audit trail, whoever made it: here the set's law.
+  std::vector<core::AuditEntry> entries{entry};
+  if (tuning.kind != running)
+    entries.push_back({entry.unix_time_ms, entry.source, std::string(name(PointId::kController)), static_cast<double>(running),
+                       static_cast<double>(tuning.kind)});
+  if (audit_) audit_->record(entries);
   return {};
 }
 
