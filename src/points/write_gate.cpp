@@ -80,7 +80,8 @@ namespace {
 // one. The move is under way as far as a client can tell.
 void target_pending(runtime::AxisView& axis) {
   axis.moving = true;
-  axis.in_position = axis.target_reached = axis.off_target = axis.halted = false;
+  // The new motion starts where the piston stands: an error against the old one no longer applies.
+  axis.in_position = axis.target_reached = axis.off_target = axis.halted = axis.following_error = false;
 }
 }  // namespace
 
@@ -134,6 +135,12 @@ runtime::Snapshot WriteGate::with_unapplied(runtime::Snapshot s) const {
   }
   s.error_mm = s.setpoint_mm - s.position_mm;
   return s;
+}
+
+ConfiguredLimits WriteGate::configured_limits() const {
+  const PointRange& setpoint = limits_.range(PointId::kSetpoint);
+  return {loop_rules_.soft_min_mm, loop_rules_.soft_max_mm, setpoint.min.value, setpoint.max.value,
+          loop_rules_.in_position_window_mm, loop_rules_.following_error_mm, loop_rules_.following_error_time_s};
 }
 
 control::ControllerConfig WriteGate::running_tuning() const {

@@ -38,6 +38,7 @@ class MoveTracker {
   bool active() const noexcept { return active_; }
   const MoveResult& current() const noexcept { return current_; }
 
+  // `from_mm`: the last reading, until the move's first sample replaces it (add()).
   void start(double from_mm, double to_mm, control::ControllerKind law, std::uint64_t sample_index) noexcept {
     active_ = true;
     count_ = since_arrival_ = 0;
@@ -49,6 +50,9 @@ class MoveTracker {
   // the reference arrived, or the buffer full).
   bool add(double y_mm, bool reference_arrived) noexcept {
     if (!active_ || count_ >= capacity_) return false;
+    // Its first sample is the reading of the cycle it started in: where its record and its run
+    // file begin (the reading before, in a move cut short at speed, is a few mm behind).
+    if (count_ == 0) current_.from_mm = y_mm;
     y_[count_++] = y_mm;
     current_.end_sample++;
     if (reference_arrived) ++since_arrival_;

@@ -35,6 +35,7 @@ ScanCycle::ScanCycle(const RuntimeConfig& config, const Tuning& tuning, hal::Daq
       valve_v_(config.safe_valve_v),
       excitation_settings_(config.excitation),
       moves_(ch.samples.capacity(), config.move_window_s, config.period_s, config.in_position_time_s),
+      following_(config.period_s),
       motion_(motion_config(config)) {
   if (config.start_fault != FaultCode::kNone) {
     mode_ = Mode::kFault;  // before any start mode: a fault found before the start is latched
@@ -171,8 +172,9 @@ void ScanCycle::enter_run(std::int64_t now_ns) noexcept {
   hold_on_enable_ = config_.enable_holds_position;  // until a move is started before the first reading
   heartbeat_changed_ns_ = now_ns;  // the client gets a full timeout from here
   following_error_since_ns_ = -1;
+  following_error_shown_ = false;
   motion_.hold(position_mm_);
-  following_.follow_reference();
+  following_.follow_reference(position_mm_);
 }
 
 void ScanCycle::use_profile_law(bool on) noexcept {
@@ -208,6 +210,7 @@ void ScanCycle::reset_fault() noexcept {
   fault_ = FaultCode::kNone;
   consecutive_read_errors_ = consecutive_write_errors_ = consecutive_overruns_ = 0;
   following_error_since_ns_ = -1;
+  following_error_shown_ = false;
 }
 
 void ScanCycle::apply_control(const Command& c, std::int64_t now_ns) noexcept {
@@ -222,7 +225,7 @@ void ScanCycle::apply_control(const Command& c, std::int64_t now_ns) noexcept {
       // stands (track_move).
       use_profile_law(true);
       motion_.halt(position_mm_, plausible_speed_mm_s());
-      following_.follow_reference();
+      following_.follow_reference(position_mm_);
       setpoint_mm_ = motion_.target_mm();  // the setpoint tells where the axis now stops
       hold_on_enable_ = false;
     } else if (jog_law_) {
@@ -245,7 +248,7 @@ void ScanCycle::apply_control(const Command& c, std::int64_t now_ns) noexcept {
       }
       manual_valve_v_ = config_.safe_valve_v;  // after the jog: the valve rests
       motion_.jog(direction, position_mm_, speed_mm_s_);
-      following_.follow_reference();
+      following_.follow_reference(position_mm_);
     } else if (direction == 0 && jog_law_) {
       motion_.jog(0, position_mm_, speed_mm_s_);
     }
@@ -281,7 +284,7 @@ void ScanCycle::start_move(double target_mm, double speed_limit_mm_s, double win
   moves_.start(position_mm_, target_mm, law(), ch_.samples.written());
   motion_.move(target_mm, speed_limit_mm_s, window_mm, position_mm_, speed_mm_s_);
   if (speed_limit_mm_s > 0.0) {
-    following_.follow_reference();
+    following_.follow_reference(position_mm_);
   } else {
     const auto& planned = tuning_.traj.trajectory().limits;  // sensor volts: in mm for the watch
     control::MotionLimits expected = planned;
@@ -362,10 +365,12 @@ FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
   if (mode_ == Mode::kRun && read_ok && config_.following_error_time_s > 0.0) {
     if (following_error_mm() > config_.following_error_mm) {
       if (following_error_since_ns_ < 0) following_error_since_ns_ = now_ns;
-      if (static_cast<double>(now_ns - following_error_since_ns_) > config_.following_error_time_s * 1e9)
-        return FaultCode::kFollowingError;
+      const auto for_ns = static_cast<double>(now_ns - following_error_since_ns_);
+      following_error_shown_ = for_ns >= kFollowingErrorShownAfterS * 1e9;
+      if (for_ns > config_.following_error_time_s * 1e9) return FaultCode::kFollowingError;
     } else {
       following_error_since_ns_ = -1;
+      following_error_shown_ = false;
     }
   }
   return FaultCode::kNone;
@@ -532,7 +537,7 @@ void ScanCycle::publish(bool full_stats) noexcept {
   const MotionStatus motion = motion_.status();
   const bool axis_active = mode_ == Mode::kRun || (mode_ == Mode::kManual && jog_law_);
   s.axis = {axis_active && motion.moving, mode_ == Mode::kRun && motion.in_position, mode_ == Mode::kRun && motion.target_reached,
-            following_error_since_ns_ >= 0, (control_word_ & kControlStart) != 0, motion.halted, axis_active && motion.jogging,
+            mode_ == Mode::kRun && following_error_shown_, (control_word_ & kControlStart) != 0, motion.halted, axis_active && motion.jogging,
             control_word_, axis_active ? motion_.reference_mm() : position_mm_, speed_mm_s_, mode_ == Mode::kRun && motion.off_target};
   s.last_sequence = last_sequence_;
   if (cycle_ % 200 == 0 || full_stats) s.loop = stats_.view();  // percentiles scan the bins: a few times a second

@@ -137,7 +137,8 @@ class ScanCycle {
   bool saturated_ = false, io_ok_ = true;
   int consecutive_read_errors_ = 0, consecutive_write_errors_ = 0, consecutive_overruns_ = 0;
   hal::IoStatus last_read_status_ = hal::IoStatus::kOk, last_write_status_ = hal::IoStatus::kOk;  // for a fault's cause
-  std::int64_t following_error_since_ns_ = -1;
+  std::int64_t following_error_since_ns_ = -1;  // beyond following_error_mm since then; -1: within
+  bool following_error_shown_ = false;          // ... for kFollowingErrorShownAfterS: the status bit
   std::int64_t frozen_since_ns_ = -1;
   // RUN or MANUAL entered with the piston outside the soft limits (after a soft-limit fault and its
   // reset): the innermost position reached since, so it can be brought back; NaN otherwise.

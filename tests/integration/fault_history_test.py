@@ -6,7 +6,8 @@ client this project did not write), in `epa faults` and in the log, in the order
     fault_history_test.py <epa binary> <source dir>
 
 `epa serve` on the simulated plant, with [limits] narrowed so that three faults can be caused
-from a client: following-error in RUN (a setpoint 50 mm away, 10 ms allowed for a 20 mm error),
+from a client: following-error in RUN (plain PP, which stalls in the dead band, asked for 10 mm: the
+piston stands while the motion it should follow goes on; 10 ms allowed for a 5 mm error),
 heartbeat-lost in MANUAL (the heartbeat stops for 0.3 s) and soft-limit in MANUAL (3 V drives the
 piston past soft_max_mm = 300), the piston at rest before each. A second client polls fault_active in a tight loop and writes
 reset the moment it reads 1, so each fault is latched for a cycle or two, far less than the
@@ -34,7 +35,7 @@ MANUAL_V = 1.5
 CONFIG = ("[limits]\n"
           f"soft_max_mm = {SOFT_MAX_MM}\n"
           "setpoint_max_mm = 290.0\n"
-          "following_error_mm = 20.0\n"
+          "following_error_mm = 5.0\n"
           "following_error_time_s = 0.01\n"
           "heartbeat_timeout_s = 0.3\n"
           "[hal.sim]\n"
@@ -137,11 +138,14 @@ def main():
     started_s = time.time()
     caused = []  # (name, mode, setpoint) in the order caused
     try:
-        # 1: following-error in RUN. RUN (which holds the piston), then a setpoint 50 mm above it:
-        # after 10 ms with more than 20 mm to go the loop faults.
+        # 1: following-error in RUN. Plain PP (controller 0) and RUN (which holds the piston), then a
+        # setpoint 10 mm above it, which PP's output never drives past the valve's dead band: the
+        # piston stands, the motion a move is expected to make leaves it behind, and 10 ms after the
+        # gap passed 5 mm the loop faults.
         start_mm = rig.position()
-        target = start_mm + 50.0
+        target = start_mm + 10.0
         before = rig.faults_counter()
+        rig.write(3, [0])
         rig.write(2, [1])
         rig.write(0, f32_words(target, "ABCD"))
         check(wait_until(lambda: rig.faults_counter() == before + 1, 3.0), "following-error: latched")
@@ -197,9 +201,9 @@ def main():
         check(abs(heart["valve_v"]) < 1e-6, f"heartbeat-lost: valve {heart['valve_v']} V (MANUAL at the safe command)")
         check(abs(heart["position_mm"] - position_before_soft_limit) < 5.0,
               f"heartbeat-lost: position {heart['position_mm']:.2f} mm where the piston stood")
-        check(start_mm - 5.0 < follow["position_mm"] < follow["setpoint_mm"] - 20.0,
-              f"following-error: position {follow['position_mm']:.2f} mm, on its way from {start_mm:.2f} mm and more than "
-              f"20 mm short of setpoint {follow['setpoint_mm']:.2f}")
+        check(abs(follow["position_mm"] - start_mm) < 1.0 and follow["position_mm"] < follow["setpoint_mm"] - 5.0,
+              f"following-error: position {follow['position_mm']:.2f} mm, standing at {start_mm:.2f} mm and more than "
+              f"5 mm short of setpoint {follow['setpoint_mm']:.2f}")
         check(soft["time_ms"] > heart["time_ms"] > follow["time_ms"], "the times are in the order the faults happened")
 
         # ---- Modbus: fault_history_count and the newest entries ----

@@ -163,14 +163,14 @@ sleep 0.1
 t0=$(now_ms)
 write16 "$A_CW" 2
 wait_status $HALTED 0 2000 "halted after halt=1"; t_halted=$waited
-wait_status $((HALTED | IN_POSITION)) $MOVING 5000 "halted and in position"
+wait_status $HALTED $((MOVING | IN_POSITION)) 5000 "halted, standing short of the target, not in position"
 write16 "$A_CW" 0
 rest=$(wait_standing "after the halt")
 end=$(mb -t 3 -r "$A_MOVE_END" -c 1 "$host" 2>/dev/null | value_of "$A_MOVE_END")
 [ "$end" = "2" ] || fail "(6) move_end after the halt: expected 2 (halted), got '$end'"
 [ "$(mode)" = "1" ] || fail "(6) mode after the halt: expected 1 (run)"
 near "$rest" 40 3 && fail "(6) the piston went on to the setpoint 40 mm ($rest mm): the halt did not stop it"
-pass "(6) halt 0.1 s into 250 -> 40 mm: halted after ${t_halted} ms, in position $(( $(now_ms) - t0 )) ms after halt=1 (incl. standing check), standing at $rest mm, move_end $end"
+pass "(6) halt 0.1 s into 250 -> 40 mm: halted after ${t_halted} ms, standing, not in position, $(( $(now_ms) - t0 )) ms after halt=1 (incl. standing check), standing at $rest mm, move_end $end"
 
 # ---- (7) jog in MANUAL ----
 step="(7) jog"

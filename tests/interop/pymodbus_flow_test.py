@@ -17,7 +17,7 @@ appliance (test_1_..., test_8_...); a failed step makes the later ones skip:
   5 the start/acknowledge handshake: start=1, ack=1 (with moving or in_position), start=0,
     ack=0, then in_position with target_reached at the record's target, move_end complete;
   6 halt: record 2 (speed-limited) started, halted mid-way: halted, move_end halted, the piston
-    stands short of the target, in position where it stopped;
+    stands short of the target, not moving and not in position (that is the target's);
   7 jog in MANUAL: jog_plus held (control word rewritten as a keep-alive) moves up at about
     jog_speed_mm_s, release brakes; jog_minus (the coil) with the client gone silent (no control
     word write, no heartbeat) brakes by itself after jog_keepalive_s;
@@ -268,8 +268,10 @@ class FlowTest(unittest.TestCase):
         t1 = time.monotonic()
         self.write("control_word", HALT)
         word, t_halted = self.wait_status(HALTED, 2.0, "halted after halt=1", since=t1)
-        word, t_stand = self.wait_status(HALTED | IN_POSITION, 5.0, "halted and in position where it stopped",
-                                         clear=MOVING, since=t1)
+        # Stood where it braked to, short of the record's target: halted, and not in position (that is
+        # the target's).
+        word, t_stand = self.wait_status(HALTED, 5.0, "halted and standing short of the target, not in position",
+                                         clear=MOVING | IN_POSITION, since=t1)
         self.write("control_word", 0)
         rest = self.wait_standing(5.0, "after the halt")
         self.assertEqual(self.inputs("move_end")[0], MOVE_HALTED, "move_end: halted")
@@ -278,7 +280,7 @@ class FlowTest(unittest.TestCase):
         self.assertLessEqual(abs(rest - self.f32("reference_mm")), 2.0, "it holds where the reference stopped")
         self.assertEqual(self.holding("mode")[0], 1, "still RUN")
         self.say(f"halt at {at_halt:.2f} mm ({time.monotonic() - t0:.2f} s into the move): halted after "
-                 f"{t_halted * 1000:.0f} ms, in position {t_stand:.2f} s after halt=1, standing at {rest:.2f} mm")
+                 f"{t_halted * 1000:.0f} ms, standing {t_stand:.2f} s after halt=1 at {rest:.2f} mm, not in position")
 
     def test_7_jog(self):
         t0 = time.monotonic()
