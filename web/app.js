@@ -5,7 +5,9 @@
 
 const FAST_MS = 250, SLOW_MS = 2000;
 const $ = (id) => document.getElementById(id);
-const fmt = (v, digits = 2) => (v === null || v === undefined || !Number.isFinite(v)) ? "never" : v.toFixed(digits);
+// A move's figure that does not apply to how it ended (overshoot of a halted move, the settling
+// of one cut short) comes as null: "n/a".
+const fmt = (v, digits = 2) => (v === null || v === undefined || !Number.isFinite(v)) ? "n/a" : v.toFixed(digits);
 const num = (v, digits = 2) => (v === null || v === undefined || !Number.isFinite(v)) ? "–" : v.toFixed(digits);
 const setText = (id, text) => { const e = $(id); if (e && e.textContent !== text) e.textContent = text; };
 
@@ -76,7 +78,8 @@ function showStatus(s) {
   setText("s-tuning-set", s.store.enabled ? s.store.tuning_set : "\u2013");
   setText("s-web", s.commands_enabled ? "enabled (token)" : "read-only");
   const m = s.last_move;
-  setText("last-move-head", m ? `#${m.number}: ${num(m.from_mm, 1)} → ${num(m.to_mm, 1)} mm` : "none yet");
+  setText("last-move-head", m ? `#${m.number}: ${num(m.from_mm, 1)} → ${num(m.to_mm, 1)} mm, ${m.controller}, ${m.end.replace("_", " ")}`
+    : "none yet");
   setText("lm-rise", m ? `${fmt(m.rise_s, 3)}${m.rise_s === null ? "" : " s"}` : "–");
   setText("lm-settling", m ? `${fmt(m.settling_s, 3)}${m.settling_s === null ? "" : " s"}` : "–");
   setText("lm-ess", m ? `${fmt(m.ess_mm, 2)}${m.ess_mm === null ? "" : " mm"}` : "–");
@@ -124,7 +127,7 @@ function showTrend(t) {
 
 function showMoves(d) {
   const body = $("moves").tBodies[0];
-  const rows = d.moves.map((m) => `<tr><td>${m.number}</td><td>${num(m.from_mm, 0)} → ${num(m.to_mm, 0)}</td>` +
+  const rows = d.moves.map((m) => `<tr title="ended: ${m.end.replace("_", " ")}"><td>${m.number}</td><td>${num(m.from_mm, 0)} → ${num(m.to_mm, 0)}</td>` +
     `<td>${m.controller}</td><td>${fmt(m.rise_s, 3)}</td><td>${fmt(m.settling_s, 3)}</td>` +
     `<td>${fmt(m.ess_mm, 2)}</td><td>${fmt(m.overshoot_pct, 1)}</td></tr>`);
   const html = rows.length ? rows.join("") : `<tr><td colspan="7" class="muted">no moves yet</td></tr>`;
@@ -145,10 +148,22 @@ function showTuning(t) {
 
 const escapeHtml = (s) => String(s).replace(/[&<>"']/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;", "'": "&#39;" }[c]));
 
+// Times as everywhere else in the appliance: ISO 8601, UTC.
+const isoUtc = (ms) => new Date(ms).toISOString().replace("T", " ").replace(/\.\d+Z$/, "Z");
+// An audited value as its point means it: the law and the mode by name, whole numbers as they are.
+const LAWS = ["pp", "pp-ngidz", "pp-ffidz", "pp-traj"], MODES = ["stop", "run", "manual", "fault", "excite"];
+function auditValue(point, v) {
+  if (v === null || v === undefined || !Number.isFinite(v)) return "–";
+  const names = point === "controller" ? LAWS : point === "mode" ? MODES : null;
+  if (names && Number.isInteger(v) && names[v]) return `${v} ${names[v]}`;
+  return Number.isInteger(v) ? String(v) : String(Number(v.toFixed(4)));
+}
+
 function showAudit(a) {
   const body = $("audit").tBodies[0];
-  const rows = a.entries.map((e) => `<tr><td>${new Date(e.unix_time_ms).toLocaleTimeString()}</td>` +
-    `<td>${escapeHtml(e.source)}</td><td>${escapeHtml(e.point)}</td><td>${num(e.old_value, 3)}</td><td>${num(e.new_value, 3)}</td></tr>`);
+  const rows = a.entries.map((e) => `<tr><td>${isoUtc(e.unix_time_ms)}</td>` +
+    `<td>${escapeHtml(e.source)}</td><td>${escapeHtml(e.point)}</td><td>${auditValue(e.point, e.old_value)}</td>` +
+    `<td>${auditValue(e.point, e.new_value)}</td></tr>`);
   const html = rows.length ? rows.join("") : `<tr><td colspan="5" class="muted">no changes yet</td></tr>`;
   if (body.innerHTML !== html) body.innerHTML = html;
 }
@@ -198,7 +213,7 @@ function showFaults(d) {
   card.dataset.count = String(d.count);
   setText("fh-head", d.count ? `${d.count} since the store was created; newest first` : "newest first");
   const body = $("faults").tBodies[0];
-  const rows = d.faults.map((f) => `<tr class="fh-cause"><td>${new Date(f.time_ms).toLocaleString()}</td>` +
+  const rows = d.faults.map((f) => `<tr class="fh-cause"><td>${isoUtc(f.time_ms)}</td>` +
     `<td class="fh-name">${escapeHtml(f.name)}</td><td>${escapeHtml(f.mode)}</td><td>${num(f.position_mm, 1)} mm</td>` +
     `<td>${num(f.setpoint_mm, 1)} mm</td><td>${num(f.valve_v, 3)} V</td></tr>` +
     `<tr><td colspan="6" class="fh-text">${escapeHtml(f.text)}</td></tr>`);

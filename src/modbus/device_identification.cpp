@@ -29,9 +29,15 @@ void append_object(std::vector<std::uint8_t>& pdu, int id, std::string_view valu
 
 }  // namespace
 
-std::string status_page_url(std::string_view web_port) { return "http://<appliance>:" + std::string(web_port) + "/"; }
+std::string status_page_url(std::string_view web_port) { return "http://" + std::string(kHostPlaceholder) + ":" + std::string(web_port) + "/"; }
 
 std::string status_page_url(int web_port) { return status_page_url(std::to_string(web_port)); }
+
+DeviceIdentity with_host(DeviceIdentity identity, std::string_view host) {
+  std::string& url = identity.objects[3];
+  if (const auto at = url.find(kHostPlaceholder); at != std::string::npos) url.replace(at, kHostPlaceholder.size(), host);
+  return identity;
+}
 
 DeviceIdentity appliance_identity(std::string_view register_map_path, std::string_view status_page_url) {
   return {{"EPA project", "epa", std::string(core::kVersion),

@@ -27,8 +27,10 @@ struct DeviceIdentity {
   static constexpr int kMaxObjectBytes = kMaxPduBytes - 7 - 2;  // the response's own 7 bytes, the object's id and length
 };
 
-// The address of the appliance's status page served on `web_port`, as VendorUrl names it: the
-// appliance cannot know the name its clients reach it by, so the host stays "<appliance>".
+// The address of the appliance's status page served on `web_port`, as VendorUrl names it, with
+// the host as a placeholder: each request's answer puts in the address its client reached the
+// appliance at (with_host), which names it on that client's network.
+inline constexpr std::string_view kHostPlaceholder = "<appliance>";
 std::string status_page_url(int web_port);
 // The same with the port given as text: the register document writes "<[web] port>", since the
 // port is a setting of the web server, which this layer does not see.
@@ -38,6 +40,9 @@ std::string status_page_url(std::string_view web_port);
 // `status_page_url` (status_page_url(), or "" with no status page) as the vendor's URL, and
 // `register_map_path`'s file name as the user application (the map is what a site configures).
 DeviceIdentity appliance_identity(std::string_view register_map_path, std::string_view status_page_url);
+// `identity` with the status page's host placeholder replaced by `host`: the address a client
+// reached this appliance at, which it can reach the status page at too.
+DeviceIdentity with_host(DeviceIdentity identity, std::string_view host);
 
 // `data` is the request PDU after the function code (MEI type, read code, object id), `length`
 // bytes. Returns 0 with the whole response PDU (function code first) in `pdu`, or the exception:

@@ -134,7 +134,12 @@ void ModbusServer::serve() {
           drop(eviction_candidate(m.clients), "evicted: max_clients reached and it was idle the longest");
         const int one = 1;
         setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-        m.clients.push_back({fd, {ip, std::string(ip) + ":" + std::to_string(ntohs(peer.sin_port)), 0}, {}, now, -1, false, 0});
+        sockaddr_in local{};
+        socklen_t local_len = sizeof local;
+        char local_ip[INET_ADDRSTRLEN] = "";
+        if (getsockname(fd, reinterpret_cast<sockaddr*>(&local), &local_len) == 0) inet_ntop(AF_INET, &local.sin_addr, local_ip, sizeof local_ip);
+        Session session{ip, std::string(ip) + ":" + std::to_string(ntohs(peer.sin_port)), 0, local_ip};
+        m.clients.push_back({fd, std::move(session), {}, now, -1, false, 0});
       }
     }
 

@@ -75,7 +75,7 @@ void write_protocol_notes(std::ostream& out, const RegisterMap& map) {
     out << "| " << id << " | " << kNames[i] << " | ";
     if (i == 2) out << "the firmware version, as `epa --version` prints it and version_major/minor/patch read";
     else out << "`" << identity.objects[i] << "`";
-    if (i == 3) out << " (the appliance's status page; empty with `[web] enabled = false`)";
+    if (i == 3) out << " (the appliance's status page, at the address the client reached it by; empty with `[web] enabled = false`)";
     if (i == 6) out << " (the register map's file name)";
     out << " |\n";
   }

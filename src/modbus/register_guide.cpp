@@ -123,8 +123,9 @@ void write_first_ten_minutes(std::ostream& out, const RegisterMap& map) {
          "it mbpoll assumes CDAB), `-0` makes `-r` the 0-based address, `-1` polls once | `mbpoll -m tcp -a 1 -0 -1 -B -t 4:float -r "
       << setpoint << " HOST 150` (values after the host) |\n"
       << "   | pymodbus 3.0 | `r = client.read_input_registers(" << position << ", 2, slave=1)` then "
-         "`struct.unpack('>f', struct.pack('>HH', *r.registers))[0]`; with `BinaryPayloadDecoder` pass "
-         "`wordorder=Endian.Big` (its default is CDAB) | `client.write_registers(" << setpoint
+         "`struct.unpack('>f', struct.pack('>HH', *r.registers))[0]`; with `BinaryPayloadDecoder` pass both "
+         "`byteorder=Endian.Big` and `wordorder=Endian.Big` (its defaults are little-endian: with the word order alone "
+         "150.0 decodes as 1.6e-25) | `client.write_registers(" << setpoint
       << ", list(struct.unpack('>HH', struct.pack('>f', 150.0))), slave=1)` |\n"
       << "   | Node modbus-serial | `(await client.readInputRegisters(" << position << ", 2)).buffer.readFloatBE(0)` | "
          "`b.writeFloatBE(150)` into a 4-byte Buffer, then `client.writeRegisters(" << setpoint

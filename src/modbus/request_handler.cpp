@@ -40,6 +40,7 @@ points::InterfaceStatus RequestHandler::status(const Session& session, std::int6
   s.records = gate_.records();
   s.record_select = gate_.record_select();
   s.fault_history_count = channels_.fault_history.copy_newest(s.recent_faults);
+  s.limits = gate_.configured_limits();
   return s;
 }
 
@@ -60,7 +61,10 @@ std::uint8_t RequestHandler::respond(const std::uint8_t* req, int length, Sessio
   const int fc = req[kHeader];
   const std::uint8_t* d = req + kHeader + 1;
   const int data_length = length - kHeader - 1;
-  if (fc == kDeviceIdentification) return read_device_identification(d, data_length, identity_, pdu);
+  if (fc == kDeviceIdentification) {
+    if (session.local_address.empty()) return read_device_identification(d, data_length, identity_, pdu);
+    return read_device_identification(d, data_length, with_host(identity_, session.local_address), pdu);
+  }
   const runtime::Snapshot snap = gate_.snapshot();  // with this client's (and others') accepted writes
   std::vector<Write> writes;
 
@@ -190,7 +194,9 @@ std::uint8_t RequestHandler::take_key(const Write& key, const Session& session, 
   if (a.lockout_started)
     what += "; unlock writes from " + session.address + " refused for " + std::to_string(a.backoff_ns / 1'000'000'000) + " s";
   if (log_) log_("modbus: " + session.peer + ": " + what + " (" + std::to_string(unlock_.failures()) + " refused attempts since start)");
-  gate_.record_event({{core::unix_time_ms(), "modbus " + session.peer + ": " + what, std::string(key.entry->point->name), NAN, NAN}});
+  // The audit trail says who and what, each in its column: an event on `unlock`, nothing changed
+  // (the why is in the log line above).
+  gate_.record_event({{core::unix_time_ms(), "modbus " + session.peer, std::string(key.entry->point->name), NAN, NAN}});
   return kIllegalValue;
 }
 
@@ -214,7 +220,15 @@ std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, Sess
   }
   if (!group.empty())
     if (const auto r = gate_.submit(group, who); !r.accepted()) return points::modbus_exception(r.refusal);
-  if (unlock) session.unlocked_until_ns = now_ns + static_cast<std::int64_t>(policy_.unlock_timeout_s * 1e9);
+  if (unlock) {
+    // An unlock opens the tuning to this connection: in the audit trail as unlock 0 -> 1 (once per
+    // unlock; a key written again while open renews it and is not a change).
+    if (now_ns >= session.unlocked_until_ns) {
+      if (log_) log_("modbus: " + session.peer + ": tuning unlocked for this connection");
+      gate_.record_event({{core::unix_time_ms(), "modbus " + session.peer, std::string(points::name(points::PointId::kUnlock)), 0.0, 1.0}});
+    }
+    session.unlocked_until_ns = now_ns + static_cast<std::int64_t>(policy_.unlock_timeout_s * 1e9);
+  }
   return 0;
 }
 

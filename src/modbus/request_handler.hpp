@@ -48,6 +48,7 @@ struct Session {
   std::string address;                 // the client's IPv4 address (write_clients, the unlock back-off)
   std::string peer;                    // "ip:port", for the log and the audit trail
   std::int64_t unlocked_until_ns = 0;  // the unlock is this connection's, until then or until it closes
+  std::string local_address;           // this appliance's address the client reached (FC43's VendorUrl)
 };
 
 // What goes back for one request.

@@ -254,6 +254,25 @@ std::vector<PointDef> build() {
                          A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.axis.reference_mm; }});
   positioning.push_back({P::kSpeed, "speed_mm_s", "mm/s", "measured piston speed (low-pass 20 ms)", A::kRead, 0, 0, false, true,
                          [](const Ctx& c, int) { return c.snapshot.axis.speed_mm_s; }});
+  positioning.push_back({P::kConfiguredSoftMin, "configured_soft_min_mm", "mm", "[limits] soft_min_mm: the piston below this in RUN, MANUAL or EXCITE faults",
+                         A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.status.limits.soft_min_mm; }});
+  positioning.push_back({P::kConfiguredSoftMax, "configured_soft_max_mm", "mm", "[limits] soft_max_mm: the piston above this in RUN, MANUAL or EXCITE faults",
+                         A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.status.limits.soft_max_mm; }});
+  positioning.push_back({P::kConfiguredSetpointMin, "configured_setpoint_min_mm", "mm",
+                         "the smallest setpoint or record target a write may carry ([limits] setpoint_min_mm, narrowed by the register map)",
+                         A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.status.limits.setpoint_min_mm; }});
+  positioning.push_back({P::kConfiguredSetpointMax, "configured_setpoint_max_mm", "mm",
+                         "the largest setpoint or record target a write may carry ([limits] setpoint_max_mm, narrowed by the register map)",
+                         A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.status.limits.setpoint_max_mm; }});
+  positioning.push_back({P::kConfiguredInPositionWindow, "configured_in_position_window_mm", "mm",
+                         "[motion] in_position_window_mm: in position within this of the target (a record may set its own)",
+                         A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.status.limits.in_position_window_mm; }});
+  positioning.push_back({P::kConfiguredFollowingError, "configured_following_error_mm", "mm",
+                         "[limits] following_error_mm: the following error's limit (status bit 5)",
+                         A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.status.limits.following_error_mm; }});
+  positioning.push_back({P::kConfiguredFollowingTime, "configured_following_error_time_s", "s",
+                         "[limits] following_error_time_s: beyond the limit this long faults (0: off)",
+                         A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.status.limits.following_error_time_s; }});
   const auto after_select = std::find_if(p.begin(), p.end(), [](const PointDef& d) { return d.id == P::kRecordSelect; }) + 1;
   p.insert(after_select, positioning.begin(), positioning.end());
 

@@ -19,6 +19,15 @@
 
 namespace epa::points {
 
+// The limits and windows an HMI works within, as this appliance runs them: the setpoint range as
+// writes are checked (the configuration narrowed by the register map), the rest as configured.
+struct ConfiguredLimits {
+  double soft_min_mm = 0, soft_max_mm = 0;          // [limits]: outside them in RUN, MANUAL or EXCITE faults
+  double setpoint_min_mm = 0, setpoint_max_mm = 0;  // a setpoint or record target outside is refused
+  double in_position_window_mm = 0;                 // [motion]: the default in-position window
+  double following_error_mm = 0, following_error_time_s = 0;  // [limits]: the following error's limit and time (0: off)
+};
+
 // What the interfaces know besides the loop's snapshot, for the points that describe them.
 struct InterfaceStatus {
   std::uint32_t change_counter = 0;  // accepted changes since start, every interface
@@ -33,6 +42,7 @@ struct InterfaceStatus {
   int record_select = 0;             // the record a start takes (0: the setpoint)
   std::uint64_t fault_history_count = 0;  // faults recorded (LoopChannels::fault_history)
   std::array<runtime::FaultRecord, kFaultHistoryPoints> recent_faults{};  // newest first; code kNone: an empty slot
+  ConfiguredLimits limits{};              // what the configuration and the register map allow (WriteGate::configured_limits)
 };
 
 // The status word (runtime/axis_words.hpp) of the loop's state and the interfaces' (warning

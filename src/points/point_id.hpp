@@ -25,6 +25,9 @@ enum class PointId : std::uint16_t {
   kControlWord, kRecordSelect, kControlBit0,
   kStatusWord = kControlBit0 + runtime::kControlBits, kStatusBit0,
   kReference = kStatusBit0 + runtime::kStatusBits, kSpeed,
+  // the limits and windows the configuration (and the register map) set, for an HMI to read
+  kConfiguredSoftMin, kConfiguredSoftMax, kConfiguredSetpointMin, kConfiguredSetpointMax, kConfiguredInPositionWindow,
+  kConfiguredFollowingError, kConfiguredFollowingTime,
   // the interfaces and the store
   kLocked, kStoreOk, kChangeCounter, kSavedCounter, kModbusRequests, kModbusClients, kUnlockFailures,
   // tuning

@@ -31,6 +31,7 @@
 #include "control/controller.hpp"
 #include "core/audit.hpp"
 #include "points/commission_control.hpp"
+#include "points/point_catalog.hpp"
 #include "points/point_id.hpp"
 #include "points/position_records.hpp"
 #include "points/write_limits.hpp"
@@ -109,6 +110,7 @@ class WriteGate {
   control::ControllerConfig running_tuning() const;
   runtime::ExcitationSettings excitation_settings() const;  // what the next EXCITE starts with
   const WriteLimits& limits() const { return limits_; }
+  ConfiguredLimits configured_limits() const;  // for the points an HMI reads them from
   core::ChangeCounters counters() const { return audit_ ? audit_->counters() : core::ChangeCounters{}; }
 
  private:

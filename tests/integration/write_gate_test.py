@@ -9,7 +9,8 @@ Checks: FC16 setpoint 400.0 gets exception 03, no audit entry, the setpoint regi
 value; POST /api/setpoint 400 gets HTTP 400 naming [limits] setpoint_max_mm; every writable point
 of GET /api/points written just beyond its range over HTTP gets 400 and over Modbus (where the
 map binds it and the register type can carry the value) exception 03; 300 is taken by both and
-audited once each; after a stop the database's audit log holds exactly the two accepted changes.
+audited once each; after a stop the database's audit log holds exactly the two accepted changes
+and the unlock that opened the tuning points for the walk (unlock 0 -> 1): no refused write.
 And start-up: a register map whose default lies outside the configuration's limits is refused,
 naming the map's file and line.
 """
@@ -99,13 +100,14 @@ def main():
         check(status == 200, f"POST /api/setpoint 250 is taken ({status} {body})")
         _, audit = http(app, "GET", "/api/audit")
         points = [(e["point"], e["new_value"]) for e in audit["entries"]]
-        check(sorted(points) == [("setpoint_mm", 250.0), ("setpoint_mm", 300.0)], f"the audit trail holds the two accepted writes only ({points})")
+        check(sorted(points) == [("setpoint_mm", 250.0), ("setpoint_mm", 300.0), ("unlock", 1.0)],
+              f"the audit trail holds the unlock and the two accepted writes only ({points})")
     finally:
         app.stop()
     db = sqlite3.connect(app.db)
     rows = db.execute("SELECT point, new_value FROM audit_log ORDER BY id").fetchall()
     db.close()
-    check(rows == [("setpoint_mm", 300.0), ("setpoint_mm", 250.0)], f"the database's audit log: {rows}")
+    check(rows == [("unlock", 1.0), ("setpoint_mm", 300.0), ("setpoint_mm", 250.0)], f"the database's audit log: {rows}")
     app.remove()
 
     # A map whose default the configuration's limits exclude: refused at start-up, naming file and line.

@@ -270,6 +270,11 @@ class EpaMapTest(ApplianceTest):
             self.wait_until(lambda: (self.mode() == 1, self.mode()), 2.0, "mode reads 1 (run)", every_s=0.02)
             self.ok(c.write_registers(0, f32_words(120.0, "ABCD"), slave=UNIT), "FC16 setpoint 120 (ABCD)")
             self.assertEqual(f32_value(self.regs(3, 0, 2), "ABCD"), 120.0, "setpoint reads back 120")
+            # docs/registers.md's hint for pymodbus' own decoder, as written there.
+            from pymodbus.constants import Endian
+            from pymodbus.payload import BinaryPayloadDecoder
+            decoder = BinaryPayloadDecoder.fromRegisters(self.regs(3, 0, 2), byteorder=Endian.Big, wordorder=Endian.Big)
+            self.assertEqual(decoder.decode_32bit_float(), 120.0, "the documented BinaryPayloadDecoder arguments decode it")
             start = time.monotonic()
             moving = self.position()
             self.move_to(120.0)
@@ -329,7 +334,7 @@ class EpaMapTest(ApplianceTest):
         print(f"  FC43 regular: conformity {regular.conformity:#04x}, objects {regular.information}", file=sys.stderr)
         self.assertEqual(regular.information, {
             0x00: b"EPA project", 0x01: b"epa", 0x02: version,
-            0x03: f"http://<appliance>:{self.app.web_port}/".encode(),  # the status page, on the port it runs on
+            0x03: f"http://127.0.0.1:{self.app.web_port}/".encode(),  # the status page, at the address it was reached by
             0x04: b"EPA electro-pneumatic axis controller", 0x05: b"epa appliance", 0x06: b"epa.csv"})
         self.assertEqual((regular.conformity, regular.more_follows, regular.number_of_objects), (0x82, 0, 7))
         extended = self.ok(self.device_information(EXTENDED), "FC43/14 read code 03: answered at the regular level")

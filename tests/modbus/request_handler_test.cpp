@@ -65,7 +65,7 @@ class Handler : public ::testing::Test {
   void publish() { channels_.snapshot.publish(snap_); }
   Reply reply(const Bytes& pdu, std::uint8_t unit = 1, const std::string& client = "127.0.0.1", std::int64_t now = 0) {
     const Bytes a = adu(pdu, unit);
-    Session& session = sessions_.try_emplace(client, Session{client, client + ":50000", 0}).first->second;
+    Session& session = sessions_.try_emplace(client, Session{client, client + ":50000", 0, ""}).first->second;
     return handler_->handle(a.data(), static_cast<int>(a.size()), session, now, image_);
   }
   // The exception code, 0 for a normal answer.
@@ -109,6 +109,27 @@ TEST_F(Handler, ReadsThePositionFloatFromTheSnapshot) {
   EXPECT_EQ(send({0x04, 0x00, 0x00, 0x00, 0x02}), 0);
   EXPECT_EQ(image_->tab_input_registers[0], 0x42F7);  // 123.5f
   EXPECT_EQ(image_->tab_input_registers[1], 0x0000);
+}
+
+// The limits an HMI works within read as input registers 146-159 (float32 ABCD): the soft limits,
+// the setpoint range writes are checked against, the in-position window, the following error's
+// limit and time, each the running configuration's.
+TEST_F(Handler, TheConfiguredLimitsReadAsInputRegisters) {
+  ASSERT_EQ(send({0x04, 0x00, 146, 0x00, 14}), 0);
+  auto f32 = [this](int address) {
+    const std::uint32_t bits = (std::uint32_t{image_->tab_input_registers[address]} << 16) | image_->tab_input_registers[address + 1];
+    float v;
+    std::memcpy(&v, &bits, sizeof v);
+    return static_cast<double>(v);
+  };
+  EXPECT_EQ(f32(146), static_cast<float>(loop_.soft_min_mm));
+  EXPECT_EQ(f32(148), static_cast<float>(loop_.soft_max_mm));
+  EXPECT_EQ(f32(150), static_cast<float>(loop_.setpoint_min_mm));
+  EXPECT_EQ(f32(152), static_cast<float>(loop_.setpoint_max_mm));
+  EXPECT_EQ(f32(154), static_cast<float>(loop_.in_position_window_mm));
+  EXPECT_EQ(f32(156), static_cast<float>(loop_.following_error_mm));
+  EXPECT_EQ(f32(158), static_cast<float>(loop_.following_error_time_s));
+  EXPECT_NE(loop_.soft_max_mm, loop_.setpoint_max_mm) << "the test tells the two apart only when they differ";
 }
 
 // Issue 16: fault_history_count (input 200-201) and the newest 8 entries of 10 registers each from
@@ -283,7 +304,8 @@ TEST_F(Handler, EveryWritablePointBeyondItsLimitsIs03AndLeavesNoTrace) {
   }
   EXPECT_GE(checked, 10);
   EXPECT_TRUE(drain().empty());
-  EXPECT_TRUE(sink_.entries.empty());
+  for (const auto& e : sink_.entries)  // the unlock that opened the tuning points, nothing refused
+    EXPECT_EQ(core::audit_text(e), "set unlock from 0 to 1") << e.point;
 }
 
 TEST_F(Handler, WriteToAnUnmappedRegisterIs02) {
@@ -463,6 +485,9 @@ TEST_F(Handler, DeviceIdentificationExceptions) {
 // the bound port: tests/interop/pymodbus_test.py reads it with pymodbus from a running appliance).
 TEST(DeviceIdentification, TheVendorUrlIsTheStatusPageOnItsPortOrEmptyWithoutOne) {
   EXPECT_EQ(appliance_identity("/etc/epa/epa.csv", status_page_url(8123)).objects[3], "http://<appliance>:8123/");
+  // Each answer names the address its client reached the appliance at.
+  EXPECT_EQ(with_host(appliance_identity("/etc/epa/epa.csv", status_page_url(8123)), "192.0.2.7").objects[3], "http://192.0.2.7:8123/");
+  EXPECT_EQ(with_host(appliance_identity("/etc/epa/epa.csv", ""), "192.0.2.7").objects[3], "") << "no status page: no URL";
   EXPECT_EQ(appliance_identity("/etc/epa/epa.csv", "").objects[3], "");
 }
 
@@ -530,21 +555,22 @@ TEST_F(Handler, TuningIsLockedUntilTheKeyThenLocksAgain) {
   EXPECT_EQ(c[0].kind, runtime::CommandKind::kTuning);
   EXPECT_DOUBLE_EQ(c[0].tuning.ffidz.lc_v(), 3.0 / 50.0);
   EXPECT_EQ(send(lc, 1, "127.0.0.1", 11 * kSecond), 0x04);  // the 10 s unlock has run out
-  // The wrong key is audited as a refused attempt; no key, right or wrong, is ever in the trail.
-  int unlock_entries = 0;
+  // The wrong key is audited as a refused attempt, the right one as the unlock it made (0 -> 1); each
+  // names the connection alone in its source (the why goes to the log). No key, right or wrong, is
+  // ever in the trail.
+  std::vector<std::string> unlock_entries;
   for (const auto& e : sink_.entries) {
     if (e.point != "unlock") continue;
-    ++unlock_entries;
-    EXPECT_TRUE(core::is_audit_event(e)) << "an event, no change: " << core::audit_text(e);
-    EXPECT_EQ(core::audit_text(e), "(unlock: nothing changed)");
+    unlock_entries.push_back(core::audit_text(e));
+    EXPECT_EQ(e.source, "modbus 127.0.0.1:50000");
     EXPECT_EQ(e.source.find("5e3a"), std::string::npos) << e.source;
   }
-  EXPECT_EQ(unlock_entries, 1);
+  EXPECT_EQ(unlock_entries, (std::vector<std::string>{"(unlock: nothing changed)", "set unlock from 0 to 1"}));
 }
 
 TEST_F(Handler, TheUnlockBelongsToTheConnectionThatSentTheKey) {
   const Bytes lc = {0x10, 0x00, 0x1C, 0x00, 0x02, 0x04, 0x40, 0x40, 0x00, 0x00};  // lc_mm = 3.0f
-  Session hmi{"127.0.0.1", "127.0.0.1:50001", 0}, other{"127.0.0.1", "127.0.0.1:50002", 0};
+  Session hmi{"127.0.0.1", "127.0.0.1:50001", 0, ""}, other{"127.0.0.1", "127.0.0.1:50002", 0, ""};
   auto on = [&](Session& s, const Bytes& pdu) {
     const Bytes a = adu(pdu);
     return handler_->handle(a.data(), static_cast<int>(a.size()), s, 0, image_).exception;
