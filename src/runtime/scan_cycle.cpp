@@ -419,6 +419,12 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
     ++consecutive_read_errors_;  // counted before the fault check: the N-th failure faults this cycle
     ++io_errors_;
   }
+  if (read_ok && init_state_on_next_read_ && readings_ == 1) {
+    // RUN from the start, with the first reading outside the soft limits: it may be brought back
+    // in, as when RUN is entered by command (detect_fault).
+    const bool outside = position_mm_ < config_.soft_min_mm || position_mm_ > config_.soft_max_mm;
+    if (outside) soft_limit_recovery_mm_ = position_mm_;
+  }
   if (mode_ != Mode::kFault) {
     if (const FaultCode f = detect_fault(read_ok, now_ns); f != FaultCode::kNone) enter_fault(f);
   }

@@ -146,6 +146,21 @@ TEST_F(Faults, FollowingErrorTooLargeForTooLong) {
   EXPECT_EQ(daq_.last_written_v, kSafeV);
 }
 
+// RUN from the start with the piston outside the soft limits (an axis at its end stop, soft limits
+// a few mm inside the stroke): it may be brought back in, as when RUN is entered by command; going
+// further out is the fault.
+TEST_F(Faults, RunFromTheStartOutsideTheSoftLimitsMayBringThePistonBack) {
+  RuntimeConfig c;
+  c.soft_min_mm = 102.0, c.setpoint_min_mm = 105.0;  // the fake sensor reads 100 mm: 2 mm outside
+  c.start_setpoint_mm = 150.0;
+  c.sensor_frozen_time_s = 0.0;  // the fake sensor never moves
+  start(c);
+  cycles(10);
+  EXPECT_EQ(snap().mode, Mode::kRun) << to_string(snap().fault);
+  daq_.sensor_v = 98.5 / 50.0;  // 1.5 mm further out than where it started
+  expect_safe_after_one_cycle(FaultCode::kSoftLimit);
+}
+
 TEST_F(Faults, HeartbeatLostWhenTheClientStopsCounting) {
   RuntimeConfig c;
   c.heartbeat_timeout_s = 0.1;
