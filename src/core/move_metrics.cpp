@@ -32,9 +32,9 @@ MoveMetrics move_metrics(std::span<const double> y_mm, double from_mm, double ta
   MoveMetrics m{kNaN, kNaN, kNaN, kNaN};
   const std::size_t n = y_mm.size();
   if (n == 0 || !(o.Ts > 0.0)) return m;
-  const bool halted = end == MoveEnd::kHalted;
+  const bool halted = end == MoveEnd::kHalted, ended = let_to_end(end);
 
-  if (!halted) {
+  if (ended) {
     const std::size_t window = std::clamp<std::size_t>(static_cast<std::size_t>(std::lround(o.ess_window_s / o.Ts)), 1, n);
     double sum = 0.0;
     for (std::size_t k = n - window; k < n; ++k) sum += std::abs(target_mm - y_mm[k]);
@@ -55,8 +55,8 @@ MoveMetrics move_metrics(std::span<const double> y_mm, double from_mm, double ta
     if (std::abs(y_mm[k] - target_mm) > band) last_outside = k;
   }
   if (k_low && k_high) m.rise_s = static_cast<double>(*k_high - *k_low) * o.Ts;
-  if (!halted) m.overshoot_pct = std::max(0.0, furthest - length) / length * 100.0;
-  if (let_to_end(end)) {
+  if (!halted && (ended || furthest > length)) m.overshoot_pct = std::max(0.0, furthest - length) / length * 100.0;
+  if (ended) {
     if (!last_outside) m.settling_s = 0.0;
     else if (*last_outside + 1 < n) m.settling_s = static_cast<double>(*last_outside + 1) * o.Ts;
   }

@@ -6,12 +6,15 @@
 // A move starts when a target is set in RUN and lasts until it ends (MoveEnd). Its samples are
 // the positions read from its first cycle to its last. Metrics that do not apply to how it ended
 // are NaN ("n/a"), never a number:
+// A move was let to end when it ended in position, off target or judged (timeout); one cut short,
+// halted, stopped, faulted or switched to another law was not.
 //   rise_s        10 % to 90 % of the way from `from` to the target; NaN: 90 % never reached
-//   overshoot_pct furthest travel beyond the target, % of the move; NaN: halted, or no move
+//   overshoot_pct furthest travel beyond the target, % of the move; NaN: halted, no move, or not
+//                 let to end without having passed the target (0 % would say it arrived cleanly)
 //   settling_s    into the band (2 % of the move) for good, from the start; NaN: still outside at
-//                 the end, or the move was not let to end (cut short, halted, stopped, fault, switched)
+//                 the end, or not let to end
 //   ess_mm        mean |target - position| over the last ess_window_s (the in-position dwell);
-//                 NaN: halted (it was told to stop short)
+//                 NaN: not let to end (a move cut on its way has no steady state)
 #include <cstdint>
 #include <optional>
 #include <span>

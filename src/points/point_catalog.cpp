@@ -273,6 +273,10 @@ std::vector<PointDef> build() {
   positioning.push_back({P::kConfiguredFollowingTime, "configured_following_error_time_s", "s",
                          "[limits] following_error_time_s: beyond the limit this long faults (0: off)",
                          A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.status.limits.following_error_time_s; }});
+  positioning.push_back({P::kRunningController, "running_controller", "",
+                         "the law stepping now (as controller): the selected one, a record's own law during its move, "
+                         "or pp-traj braking a halt or a jog",
+                         A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.running_law)); }});
   const auto after_select = std::find_if(p.begin(), p.end(), [](const PointDef& d) { return d.id == P::kRecordSelect; }) + 1;
   p.insert(after_select, positioning.begin(), positioning.end());
 

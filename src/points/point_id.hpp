@@ -27,7 +27,7 @@ enum class PointId : std::uint16_t {
   kReference = kStatusBit0 + runtime::kStatusBits, kSpeed,
   // the limits and windows the configuration (and the register map) set, for an HMI to read
   kConfiguredSoftMin, kConfiguredSoftMax, kConfiguredSetpointMin, kConfiguredSetpointMax, kConfiguredInPositionWindow,
-  kConfiguredFollowingError, kConfiguredFollowingTime,
+  kConfiguredFollowingError, kConfiguredFollowingTime, kRunningController,
   // the interfaces and the store
   kLocked, kStoreOk, kChangeCounter, kSavedCounter, kModbusRequests, kModbusClients, kUnlockFailures,
   // tuning

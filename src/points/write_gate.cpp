@@ -110,13 +110,14 @@ runtime::Snapshot WriteGate::with_unapplied(runtime::Snapshot s) const {
         s.mode = c.mode;
         break;
       case runtime::CommandKind::kManualValve: s.manual_valve_v = c.value; break;
-      case runtime::CommandKind::kController: s.controller = c.controller; break;
+      case runtime::CommandKind::kController: s.controller = s.running_law = c.controller; break;
       case runtime::CommandKind::kHeartbeat: s.heartbeat = c.heartbeat; break;
       case runtime::CommandKind::kExcitation: s.excitation = c.excitation; break;
       case runtime::CommandKind::kControl: {
         const std::uint16_t rising = c.control_word & ~s.axis.control_word;
         if ((rising & runtime::kControlStart) && s.mode == runtime::Mode::kRun) {
           s.setpoint_mm = c.value;
+          s.running_law = c.start_controller ? c.controller : s.controller;  // as the loop will run the move
           target_pending(s.axis);
         }
         if ((rising & runtime::kControlHalt) && s.mode == runtime::Mode::kRun) {

@@ -518,6 +518,7 @@ void ScanCycle::publish(bool full_stats) noexcept {
   s.mode = mode_;
   s.fault = fault_;
   s.controller = controller_;
+  s.running_law = law();
   s.saturated = saturated_;
   s.io_ok = io_ok_;
   s.setpoint_mm = setpoint_mm_;

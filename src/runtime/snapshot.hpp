@@ -57,7 +57,9 @@ struct Snapshot {
   double Ts = 0;
   Mode mode = Mode::kStop;
   FaultCode fault = FaultCode::kNone;  // the latched fault (kNone unless mode is kFault)
-  control::ControllerKind controller = control::ControllerKind::kPpFfidz;
+  control::ControllerKind controller = control::ControllerKind::kPpFfidz;  // the selected law (holding controller)
+  control::ControllerKind running_law = control::ControllerKind::kPpFfidz;  // the one stepping now: a record's own
+                                                                           // for its move, pp-traj braking a halt or jog
   bool saturated = false;
   bool io_ok = true;  // the last read and write both succeeded
   double setpoint_mm = 0, position_mm = 0, sensor_v = 0, error_mm = 0;

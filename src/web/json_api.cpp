@@ -62,6 +62,7 @@ std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, b
       {"fault_text", faulted ? json(std::string(runtime::describe(s.fault))) : json(nullptr)},
       {k(P::kController), std::string(control::to_string(s.controller))},
       {"controller_name", std::string(control::display_name(s.controller))},
+      {k(P::kRunningController), std::string(control::to_string(s.running_law))},
       {k(P::kSaturated), s.saturated},
       {k(P::kIoOk), s.io_ok},
       {k(P::kSetpoint), num(s.setpoint_mm)},

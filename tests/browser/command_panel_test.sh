@@ -168,8 +168,10 @@ word=$(grep -o 'id="sb-word"[^>]*>[^<]*' <<<"$dom" | sed 's/.*>//')
 expected=$(printf '0x%04X' "$(status_value '["status_word"]')")
 [ "$word" = "$expected" ] && pass "(4) the card shows status_word $word, as /api/status" || fail "(4) the card's word '$word', /api/status $expected"
 
-# (5) a halt during a slow move
-dom=$(probe "token=$token;edit=4,420,15,0,running;start=4")
+# (5) a halt during a slow move. Record 4 names pp-traj: a record's law runs its own move only, so
+# "running" would be the selected pp-ffidz, whose readings on the paper's printed model swing too
+# far for a halt to be judged to 0.5 mm (README, Halt).
+dom=$(probe "token=$token;edit=4,420,15,0,pp-traj;start=4")
 probe_ok "(5)" "$dom"
 if moving=$(wait_status 10 '["position_mm"]' 'v > 203'); then
   dom=$(probe "token=$token;halt")
