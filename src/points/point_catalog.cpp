@@ -52,7 +52,7 @@ constexpr std::string_view kStatusBitText[runtime::kStatusBits] = {
     "so a halt short of it reads 0; a target written and not yet taken reads 0 from the write on",
     "status bit 4: the last started move came into position (RUN; cleared by the next start, from its write on)",
     "status bit 5: the piston beyond following_error_mm from the motion it is asked to follow (a speed-limited move's "
-    "profile, or for a step the model's planned motion, up to the target) now; the fault follows after following_error_time_s",
+    "profile, or for a step the model's planned motion, up to the target) for 0.2 s; the fault follows after following_error_time_s",
     "status bit 6: following error, off target, I/O errors or the store not saving",
     "status bit 7: a fault is latched (fault_code)",
     "status bit 8: acknowledge: mirrors the control word's start bit once the loop applied it",

@@ -76,7 +76,7 @@ B_POLL_S = 0.02
 B_MOVE_BOUND_S = 8.0
 C_MIN_MOVES = 50                # moves verified (record of a move)
 C_TIME_BUDGET_S = 200.0         # no new move is started in C after this
-C_LO_MM, C_HI_MM = 60.0, 440.0  # C's setpoint targets
+C_LO_MM, C_HI_MM = 150.0, 350.0  # C's setpoint targets: FF-IDZ's swings reach the end stops from 70 mm
 C_HEARTBEAT_TIMEOUT_S = 1.5
 C_HEARTBEAT_PERIOD_S = 0.2
 
@@ -97,7 +97,7 @@ TOL_MM, TOL_S, TOL_PCT = 0.01, 0.005, 0.01
 # release run's.
 if os.environ.get("EPA_SANITIZER_RUN") == "1":
     A_SETPOINT_MOVES, A_RECORD_STARTS, B_MOVES_PER_LAW, C_MIN_MOVES = 40, 8, 10, 20
-    C_HEARTBEAT_TIMEOUT_S = 5.0  # the instrumented appliances and this script share two loaded cores
+    C_HEARTBEAT_TIMEOUT_S = 3.0  # the instrumented appliances and this script share two loaded cores
 
 # ---------------------------------------------------------------------------------------------
 # The register map (docs/registers.md)
@@ -1240,7 +1240,9 @@ def group_c(env):
                 capture(ex, SLOW_END_BOUND_S)
             elif kind == "fault":
                 pos = mb.pos()
-                t = pick_target(rng, pos, 100.0, 200.0, 20.0, 480.0)
+                # At least 150 mm at 30 mm/s (5 s): the heartbeat, stopped 0.8 s in, faults it on its
+                # way even with the sanitizer run's 3 s timeout.
+                t = pick_target(rng, pos, 150.0, 250.0, 20.0, 480.0)
                 ex = record_move("fault", law, 7, t, 30.0)
                 time.sleep(0.8)
                 hb.paused.set()
