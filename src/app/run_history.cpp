@@ -1,21 +1,16 @@
 #include "app/run_history.hpp"
 
-#include <charconv>
 #include <cmath>
 
 #include "core/audit.hpp"
 #include "core/move_metrics.hpp"
+#include "core/run_file.hpp"
 
 namespace epa::app {
 
 namespace {
 std::optional<double> finite(double v) { return std::isfinite(v) ? std::optional(v) : std::nullopt; }
-std::optional<double> meta_number(const core::Run& run, const std::string& key) {
-  const std::string text = run.meta(key);
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  return text.empty() || ec != std::errc() || end != text.data() + text.size() ? std::nullopt : std::optional(v);
-}
+std::optional<double> meta_number(const core::Run& run, const std::string& key) { return core::parse_number(run.meta(key)); }
 }  // namespace
 
 store::RunRecord to_run_record(const std::string& path, const core::Run& run) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/atomic_file.hpp"
+#include "core/format.hpp"
 #include "core/units.hpp"
 
 namespace epa::core {
@@ -56,22 +57,6 @@ bool is_meta_key(std::string_view key) {
 
 bool is_controller(std::string_view name) {
   return std::find(kControllers.begin(), kControllers.end(), name) != kControllers.end();
-}
-
-std::optional<double> parse_number(std::string_view text) {
-  text = trim(text);
-  if (text.size() > 1 && text.front() == '+' && text[1] != '-') text.remove_prefix(1);  // from_chars refuses '+'
-  double value = 0.0;
-  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (text.empty() || ec != std::errc() || ptr != text.data() + text.size() || !std::isfinite(value))
-    return std::nullopt;
-  return value;
-}
-
-// Shortest text that reads back as the same double (Ts in the file and in messages).
-std::string shortest(double v) {
-  char buf[64];
-  return std::string(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);
 }
 
 std::string approx(double v) {  // for steps in messages: 0.01 rather than 0.010000000000000002
@@ -119,7 +104,7 @@ std::string quoted_list(const std::vector<std::string_view>& names) {
 
 Result<Run> parse_run_impl(std::istream& in, const std::string& src, std::optional<double> expected_Ts) {
   if (expected_Ts && !(std::isfinite(*expected_Ts) && *expected_Ts > 0.0))
-    return invalid_argument(src + ": expected Ts must be a positive number of seconds, got " + shortest(*expected_Ts));
+    return invalid_argument(src + ": expected Ts must be a positive number of seconds, got " + format_exact(*expected_Ts));
   Run run;
   std::optional<double> file_Ts;
   std::size_t ts_line = 0, header_line = 0, line_no = 0;
@@ -206,7 +191,7 @@ Result<Run> parse_run_impl(std::istream& in, const std::string& src, std::option
   if (file_Ts) {
     if (expected_Ts && !same_sample_time(*file_Ts, *expected_Ts))
       // The reader does not know whose Ts it was given: a model's, or the first run's (identify).
-      return error_at(src, ts_line, "Ts=" + shortest(*file_Ts) + " s in the file, but " + shortest(*expected_Ts) +
+      return error_at(src, ts_line, "Ts=" + format_exact(*file_Ts) + " s in the file, but " + format_exact(*expected_Ts) +
                                         " s is expected (the model's Ts, or the other runs')");
     run.Ts = *file_Ts;
   } else if (expected_Ts) {
@@ -231,7 +216,7 @@ Result<Run> parse_run_impl(std::istream& in, const std::string& src, std::option
 
 // What read_run_file would refuse, so that write_run_file never writes a file we cannot read back.
 Status check_writable(const Run& run) {
-  if (!(std::isfinite(run.Ts) && run.Ts > 0.0)) return invalid_argument("Ts must be > 0 s, got " + shortest(run.Ts));
+  if (!(std::isfinite(run.Ts) && run.Ts > 0.0)) return invalid_argument("Ts must be > 0 s, got " + format_exact(run.Ts));
   const std::size_t n = run.t_s.size();
   if (n == 0) return invalid_argument("the run has no samples");
   for (const auto& spec : kColumns) {
@@ -265,9 +250,19 @@ std::string one_line(std::string text) {
 
 }  // namespace
 
+std::optional<double> parse_number(std::string_view text) {
+  text = trim(text);
+  if (text.size() > 1 && text.front() == '+' && text[1] != '-') text.remove_prefix(1);  // from_chars refuses '+'
+  double value = 0.0;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || ec != std::errc() || ptr != text.data() + text.size() || !std::isfinite(value))
+    return std::nullopt;
+  return value;
+}
+
 void write_run(std::ostream& out, const Run& run) {
   try {
-    std::string line = "# " + std::string(kVersionTag) + "\n# Ts=" + shortest(run.Ts) + "\n";
+    std::string line = "# " + std::string(kVersionTag) + "\n# Ts=" + format_exact(run.Ts) + "\n";
     for (const auto& [key, value] : run.metadata)
       if (key != "Ts") line += "# " + one_line(key) + "=" + one_line(value) + "\n";
     std::vector<const ColumnSpec*> columns;

@@ -6,11 +6,16 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "core/result.hpp"
 #include "core/run.hpp"
 
 namespace epa::core {
+
+// A number as a run file holds it (a metadata value or a field): finite, surrounding blanks and a
+// leading '+' allowed; nullopt otherwise. Values are written with format_exact (core/format.hpp).
+std::optional<double> parse_number(std::string_view text);
 
 // Writes `run` as epa-run/1: version line, `# Ts=...`, then run.metadata in order, header, rows.
 // Columns written: t_s, r_mm (if non-empty), y_mm, u_V, uc_V (if non-empty).

@@ -138,6 +138,11 @@ runtime::Snapshot WriteGate::with_unapplied(runtime::Snapshot s) const {
   return s;
 }
 
+void WriteGate::remember_unapplied(std::span<const runtime::Command> commands) {
+  for (const auto& c : commands) unapplied_.push_back(c);
+  while (unapplied_.size() > kUnapplied) unapplied_.pop_front();
+}
+
 ConfiguredLimits WriteGate::configured_limits() const {
   const PointRange& setpoint = limits_.range(PointId::kSetpoint);
   return {loop_rules_.soft_min_mm, loop_rules_.soft_max_mm, setpoint.min.value, setpoint.max.value,
@@ -343,8 +348,7 @@ GateResult WriteGate::submit(std::span<const PointWrite> writes, const Requester
   control_word_ = d.control_word;
   record_select_ = d.record_select;
   records_ = d.records;
-  for (const auto& c : d.commands) unapplied_.push_back(c);
-  while (unapplied_.size() > kUnapplied) unapplied_.pop_front();
+  remember_unapplied(d.commands);
 
   // Accepted: the audit trail (and so the store) gets the group. Each entry keeps its command's
   // sequence number while it is in flight, so a late refusal can be audited against it.
@@ -406,8 +410,7 @@ GateResult WriteGate::replace_tuning(const control::ControllerConfig& replacemen
   if (!channels_.commands.try_push_all(commands, std::size(commands)))
     return refuse(Refusal::kBusy, "the scan cycle's command queue is full: try again");
   tuning_ = tuning;
-  for (const auto& c : commands) unapplied_.push_back(c);
-  while (unapplied_.size() > kUnapplied) unapplied_.pop_front();
+  remember_unapplied(commands);
   // Every change of the running law is in the audit trail, whoever made it: here the set's law.
   std::vector<core::AuditEntry> entries{entry};
   if (tuning.kind != running)

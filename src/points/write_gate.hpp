@@ -144,6 +144,7 @@ class WriteGate {
   // snapshot's last_sequence.
   mutable std::deque<runtime::Command> unapplied_;
   runtime::Snapshot with_unapplied(runtime::Snapshot s) const;  // mutex_ held
+  void remember_unapplied(std::span<const runtime::Command> commands);  // queued: reads show them; mutex_ held
   static constexpr std::size_t kUnapplied = 256;
 };
 

@@ -90,8 +90,7 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
             motion_.hold(position_mm_);
           }
           if (c.mode == Mode::kExcite) heartbeat_changed_ns_ = now_ns;  // the client gets a full timeout from here
-          const bool outside = position_mm_ < config_.soft_min_mm || position_mm_ > config_.soft_max_mm;
-          soft_limit_recovery_mm_ = (c.mode == Mode::kRun || c.mode == Mode::kManual) && readings_ > 0 && outside ? position_mm_ : kNaN;
+          soft_limit_recovery_mm_ = (c.mode == Mode::kRun || c.mode == Mode::kManual) && readings_ > 0 && outside_soft_limits() ? position_mm_ : kNaN;
           if (mode_ == Mode::kManual) manual_valve_v_ = config_.safe_valve_v;  // it ends with MANUAL (read back so)
           mode_ = c.mode;
         }
@@ -337,7 +336,7 @@ FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
   }
   const bool moving = mode_ == Mode::kRun || mode_ == Mode::kManual || mode_ == Mode::kExcite;
   if (!moving) return FaultCode::kNone;
-  if (read_ok && (position_mm_ < config_.soft_min_mm || position_mm_ > config_.soft_max_mm)) {
+  if (read_ok && outside_soft_limits()) {
     // Entered outside (a soft-limit fault, then reset): the axis may be brought back in, by a jog,
     // the manual valve or a move; going 1 mm further out than the innermost point it reached since
     // is the fault again. Crossing the limit from inside is the fault at once, as always.
@@ -422,8 +421,7 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
   if (read_ok && init_state_on_next_read_ && readings_ == 1) {
     // RUN from the start, with the first reading outside the soft limits: it may be brought back
     // in, as when RUN is entered by command (detect_fault).
-    const bool outside = position_mm_ < config_.soft_min_mm || position_mm_ > config_.soft_max_mm;
-    if (outside) soft_limit_recovery_mm_ = position_mm_;
+    if (outside_soft_limits()) soft_limit_recovery_mm_ = position_mm_;
   }
   if (mode_ != Mode::kFault) {
     if (const FaultCode f = detect_fault(read_ok, now_ns); f != FaultCode::kNone) enter_fault(f);

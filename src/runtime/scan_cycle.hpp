@@ -101,6 +101,9 @@ class ScanCycle {
   void step_law(double reference_mm, double y_v) noexcept;
   // The calibrated position in sensor volts from the last reading: what the control laws read.
   double position_v() const noexcept;
+  bool outside_soft_limits() const noexcept {  // the last reading
+    return position_mm_ < config_.soft_min_mm || position_mm_ > config_.soft_max_mm;
+  }
   // Starts `law` on the piston where the last reading put it, at the speed of the last two readings.
   void start_law_at_the_piston(const control::ControllerParams& law) noexcept;
   void end_excitation(ExcitationEnd how) noexcept;
@@ -139,10 +142,10 @@ class ScanCycle {
   hal::IoStatus last_read_status_ = hal::IoStatus::kOk, last_write_status_ = hal::IoStatus::kOk;  // for a fault's cause
   std::int64_t following_error_since_ns_ = -1;  // beyond following_error_mm since then; -1: within
   bool following_error_shown_ = false;          // ... for kFollowingErrorShownAfterS: the status bit
-  std::int64_t frozen_since_ns_ = -1;
+  std::int64_t frozen_since_ns_ = -1;  // the reading has been bit-identical while driving since then
   // RUN or MANUAL entered with the piston outside the soft limits (after a soft-limit fault and its
   // reset): the innermost position reached since, so it can be brought back; NaN otherwise.
-  double soft_limit_recovery_mm_ = std::numeric_limits<double>::quiet_NaN();  // the reading has been bit-identical while driving since then
+  double soft_limit_recovery_mm_ = std::numeric_limits<double>::quiet_NaN();
   double previous_sensor_v_ = 0.0;
   std::uint32_t heartbeat_ = 0;
   std::int64_t heartbeat_changed_ns_ = 0;
