@@ -46,8 +46,13 @@ inline std::string audit_text(const AuditEntry& e) {
 struct ChangeCounters {
   std::uint64_t accepted = 0;
   std::uint64_t saved = 0;
-  bool saving = true;  // false while writes to disk fail (disk full, read-only): saved stands still
+  bool saving = true;     // false while writes to disk fail (disk full, read-only): saved stands still
+  bool disk_low = false;  // the store's disk has less free space than configured: run files stop, look now
 };
+
+// The audit log keeps at least its newest this many rows whatever the retention says (the store's
+// trigger refuses to delete them), so a misconfigured retention cannot erase the recent trail.
+inline constexpr std::int64_t kAuditMinRows = 1000;
 
 class AuditSink {
  public:

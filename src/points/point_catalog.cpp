@@ -53,7 +53,7 @@ constexpr std::string_view kStatusBitText[runtime::kStatusBits] = {
     "status bit 4: the last started move came into position (RUN; cleared by the next start, from its write on)",
     "status bit 5: the piston beyond following_error_mm from the motion it is asked to follow (a speed-limited move's "
     "profile, or for a step the model's planned motion, up to the target) for 0.2 s; the fault follows after following_error_time_s",
-    "status bit 6: following error, off target, I/O errors or the store not saving",
+    "status bit 6: following error, off target, I/O errors, the store not saving or its disk low",
     "status bit 7: a fault is latched (fault_code)",
     "status bit 8: acknowledge: mirrors the control word's start bit once the loop applied it",
     "status bit 9: the last task was a halt (in_position then says whether it stopped at the move's target)",
@@ -162,6 +162,8 @@ std::vector<PointDef> build() {
        [](const Ctx& c, int) { return b(c.status.locked); }},
       {P::kStoreOk, "store_ok", "", "1 while the tuning store saves changes; 0 while its writes fail (disk full, read-only): saved_counter stands still until they succeed",
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return b(c.status.saving); }},
+      {P::kDiskLow, "disk_low", "", "1 while the store's disk has less free space than [store] min_free_mb: run files are no longer written, and the store may stop saving next (status bit 6 too)",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return b(c.status.disk_low); }},
       {P::kChangeCounter, "change_counter", "", "accepted changes since start (Modbus and web); the heartbeat and the unlock key do not count",
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.change_counter); }},
       {P::kSavedCounter, "saved_counter", "", "how many of the accepted changes are on disk: once it reaches the change_counter read after a write, that write survives a crash",
@@ -246,10 +248,10 @@ std::vector<PointDef> build() {
   positioning.push_back({P::kStatusWord, "status_word", "", "bits 0 ready, 1 enabled, 2 moving, 3 in_position, 4 target_reached, "
                                                               "5 following_error, 6 warning, 7 fault, 8 ack, 9 halted, 10 jogging, 11 manual, "
                                                               "12 off_target",
-                         A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(status_word(c.snapshot, c.status.saving)); }});
+                         A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(status_word(c.snapshot, c.status.saving && !c.status.disk_low)); }});
   for (int i = 0; i < runtime::kStatusBits; ++i)
     positioning.push_back({indexed_id(P::kStatusBit0, static_cast<std::size_t>(i)), kStatusBitNames[i], "", kStatusBitText[i], A::kRead, 0, 0,
-                           true, true, [](const Ctx& c, int bit) { return b(status_word(c.snapshot, c.status.saving) & (1u << bit)); }, i});
+                           true, true, [](const Ctx& c, int bit) { return b(status_word(c.snapshot, c.status.saving && !c.status.disk_low) & (1u << bit)); }, i});
   positioning.push_back({P::kReference, "reference_mm", "mm", "what the control law follows: the target, or a halt's or jog's braking path",
                          A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.axis.reference_mm; }});
   positioning.push_back({P::kSpeed, "speed_mm_s", "mm/s", "measured piston speed (low-pass 20 ms)", A::kRead, 0, 0, false, true,
@@ -340,10 +342,10 @@ const std::vector<PointDef>& catalog() {
 
 }  // namespace
 
-std::uint16_t status_word(const runtime::Snapshot& s, bool store_saving) {
+std::uint16_t status_word(const runtime::Snapshot& s, bool store_well) {
   using namespace runtime;
   const bool fault = s.mode == Mode::kFault;
-  const bool warning = s.axis.following_error || s.axis.off_target || !s.io_ok || !store_saving;
+  const bool warning = s.axis.following_error || s.axis.off_target || !s.io_ok || !store_well;
   const bool bits[kStatusBits] = {!fault && s.io_ok, s.mode == Mode::kRun, s.axis.moving, s.axis.in_position, s.axis.target_reached,
                                   s.axis.following_error, warning, fault, s.axis.ack, s.axis.halted, s.axis.jogging, s.mode == Mode::kManual,
                                   s.axis.off_target};

@@ -43,11 +43,12 @@ struct InterfaceStatus {
   std::uint64_t fault_history_count = 0;  // faults recorded (LoopChannels::fault_history)
   std::array<runtime::FaultRecord, kFaultHistoryPoints> recent_faults{};  // newest first; code kNone: an empty slot
   ConfiguredLimits limits{};              // what the configuration and the register map allow (WriteGate::configured_limits)
+  bool disk_low = false;                  // the store's disk is below [store] min_free_mb
 };
 
 // The status word (runtime/axis_words.hpp) of the loop's state and the interfaces' (warning
-// includes a store that does not save).
-std::uint16_t status_word(const runtime::Snapshot& s, bool store_saving);
+// includes a store that does not save or whose disk is low: `store_well` false).
+std::uint16_t status_word(const runtime::Snapshot& s, bool store_well);
 
 struct PointContext {
   const runtime::Snapshot& snapshot;

@@ -29,7 +29,7 @@ enum class PointId : std::uint16_t {
   kConfiguredSoftMin, kConfiguredSoftMax, kConfiguredSetpointMin, kConfiguredSetpointMax, kConfiguredInPositionWindow,
   kConfiguredFollowingError, kConfiguredFollowingTime, kRunningController,
   // the interfaces and the store
-  kLocked, kStoreOk, kChangeCounter, kSavedCounter, kModbusRequests, kModbusClients, kUnlockFailures,
+  kLocked, kStoreOk, kDiskLow, kChangeCounter, kSavedCounter, kModbusRequests, kModbusClients, kUnlockFailures,
   // tuning
   kTs, kMr, kMl, kBr, kBl, kLc, kTrajSpeedFraction, kTrajBandwidth, kTrajHoldBand,
   // the excitation experiment (mode EXCITE)

@@ -336,6 +336,14 @@ GateResult WriteGate::submit(std::span<const PointWrite> writes, const Requester
   const runtime::Snapshot snap = with_unapplied(channels_.snapshot.read());  // decided on what reads show
   Decision d;
   if (GateResult r = build(writes, who, snap, tuning_, excitation_, d); !r.accepted()) return r;
+  // One recording at a time, paced: each is a file on disk, and a client's loop of record writes
+  // must not fill it (the recorder's quota is the second bound).
+  const auto now = std::chrono::steady_clock::now();
+  const bool records = std::ranges::any_of(d.commands, [](const runtime::Command& c) { return c.kind == runtime::CommandKind::kRecord; });
+  if (records && last_record_request_ != std::chrono::steady_clock::time_point{} &&
+      now - last_record_request_ < std::chrono::duration<double>(loop_rules_.record_min_interval_s))
+    return refuse(Refusal::kConflict, quoted(PointId::kRecord) + ": a recording was asked for less than " +
+                                          core::format_number(loop_rules_.record_min_interval_s) + " s ago: one at a time");
   const PositionRecords records_before = records_;  // the audit trail's old values
   const int record_select_before = record_select_;
   const std::uint64_t first = next_sequence_;
@@ -343,6 +351,7 @@ GateResult WriteGate::submit(std::span<const PointWrite> writes, const Requester
   if (!d.commands.empty() && !channels_.commands.try_push_all(d.commands.data(), d.commands.size()))
     return refuse(Refusal::kBusy, "the scan cycle's command queue is full: try again");
   next_sequence_ += d.commands.size();
+  if (records) last_record_request_ = now;
   if (d.tuning_changed) tuning_ = d.tuning;
   if (d.excitation_changed) excitation_ = d.excitation;
   control_word_ = d.control_word;

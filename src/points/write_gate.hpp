@@ -20,6 +20,7 @@
 // edge into one move command with the record's target, speed limit, window and law. Reads go
 // through snapshot(): the loop's last snapshot with the writes it has not applied yet, so a read
 // right after an acknowledged write returns the written value.
+#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -140,6 +141,7 @@ class WriteGate {
   std::uint16_t control_word_ = 0;  // as accepted (the loop's follows within a cycle)
   int record_select_ = 0;
   PositionRecords records_;
+  std::chrono::steady_clock::time_point last_record_request_{};  // record_s accepted; paced by record_min_interval_s
   // Accepted commands the loop may not have taken yet (snapshot() applies them); pruned by the
   // snapshot's last_sequence.
   mutable std::deque<runtime::Command> unapplied_;

@@ -25,7 +25,7 @@ enum StatusBit : int {
   kStatusInPosition = 3,      // |target - position| <= the window for the in-position time (RUN)
   kStatusTargetReached = 4,   // the last started move came into position (cleared by the next start)
   kStatusFollowingError = 5,  // |reference - position| beyond following_error_mm now (the fault follows after its time)
-  kStatusWarning = 6,         // following error, off target, I/O errors or the store not saving: look before it faults
+  kStatusWarning = 6,         // following error, off target, I/O errors, the store not saving or its disk low: look before it faults
   kStatusFault = 7,           // a fault is latched (fault_code says which)
   kStatusAck = 8,             // mirrors the control word's start bit once the loop applied it (handshake)
   kStatusHalted = 9,          // the last task was a halt

@@ -8,10 +8,13 @@
 
 #include "core/audit.hpp"
 #include "core/format.hpp"
+#include "core/free_space.hpp"
 #include "core/run_file.hpp"
 #include "core/utc_stamp.hpp"
 
 namespace epa::runtime {
+
+namespace fs = std::filesystem;
 
 Recorder::Recorder(RecorderConfig config, LoopChannels& channels, Log log, Written written)
     : config_(std::move(config)), ch_(channels), log_(std::move(log)), written_(std::move(written)) {}
@@ -40,10 +43,33 @@ std::size_t Recorder::process_pending() {
   RecordRequest r;
   while (ch_.record_requests.try_pop(r)) {
     if (r.reason == RecordRequest::Reason::kMove && !config_.per_move) continue;
+    if (!may_write(r)) continue;
     write(r);
     ++n;
   }
   return n;
+}
+
+bool Recorder::may_write(const RecordRequest& request) {
+  auto skip = [&](const std::string& why) {
+    ++files_skipped_;
+    if (log_) log_("recorder: a run file not written: " + why);
+    return false;
+  };
+  const auto free = core::free_bytes(fs::exists(config_.directory) ? config_.directory : ".");
+  if (free && *free < config_.min_free_bytes)
+    return skip("the disk has " + std::to_string(*free / (1024 * 1024)) + " MiB free, below the " +
+                std::to_string(config_.min_free_bytes / (1024 * 1024)) + " MiB kept for the tuning store");
+  if (request.reason != RecordRequest::Reason::kMove) return true;  // the gate paces record requests; experiments are rare
+  // A token bucket: a burst of a minute's worth, refilled at the rate.
+  const auto now = std::chrono::steady_clock::now();
+  const double per_s = config_.move_files_per_minute / 60.0;
+  if (tokens_at_ == std::chrono::steady_clock::time_point{}) move_tokens_ = config_.move_files_per_minute;
+  else move_tokens_ = std::min(config_.move_files_per_minute, move_tokens_ + std::chrono::duration<double>(now - tokens_at_).count() * per_s);
+  tokens_at_ = now;
+  if (move_tokens_ < 1.0) return skip("more than " + core::format_number(config_.move_files_per_minute) + " moves a minute");
+  move_tokens_ -= 1.0;
+  return true;
 }
 
 std::string Recorder::last_file() const {
@@ -121,6 +147,7 @@ void Recorder::write(const RecordRequest& request) {
   }
   std::error_code ec;
   std::filesystem::create_directories(config_.directory, ec);
+  if (!quota_) quota_.emplace(config_.directory, config_.quota_bytes, log_);  // the files of earlier runs count
   const std::string path = (std::filesystem::path(config_.directory) / name).string();
   if (auto s = core::write_run_file(path, run); !s) {
     if (log_) log_("recorder: " + s.error().message);
@@ -132,6 +159,7 @@ void Recorder::write(const RecordRequest& request) {
   }
   ++files_written_;
   if (log_) log_("recorder: wrote " + path + " (" + std::to_string(run.size()) + " samples)");
+  quota_->add(path);
   if (written_) written_(path, run);
 }
 

@@ -4,12 +4,15 @@
 // runs feed `epa identify` and `epa diagnose` directly. One file per move (if enabled), one per
 // explicit request, and one per excitation experiment (EXCITE), complete or ended early.
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
 #include "core/run.hpp"
+#include "runtime/run_directory_quota.hpp"
 #include "runtime/scan_cycle.hpp"
 
 namespace epa::runtime {
@@ -19,6 +22,13 @@ struct RecorderConfig {
   bool per_move = true;
   double Ts = 0.005;
   std::string source = "appliance";  // run-file metadata: sim backend or which rig
+  // What a client's flood of moves or record requests can put on the disk: the run files stay
+  // within quota_bytes (the oldest deleted), move files are written at most move_files_per_minute
+  // (the rest counted, not written), and nothing is written while the disk has less than
+  // min_free_bytes free, so the tuning store keeps room to save.
+  std::uint64_t quota_bytes = 512ull * 1024 * 1024;
+  double move_files_per_minute = 60;
+  std::uint64_t min_free_bytes = 256ull * 1024 * 1024;
 };
 
 class Recorder {
@@ -38,10 +48,13 @@ class Recorder {
   std::size_t process_pending();
 
   std::uint64_t files_written() const { return files_written_.load(); }
+  // Files not written: move files beyond the rate, anything while the disk was low.
+  std::uint64_t files_skipped() const { return files_skipped_.load(); }
   std::string last_file() const;
 
  private:
   void write(const RecordRequest& request);
+  bool may_write(const RecordRequest& request);  // the rate and the disk's free space
 
   RecorderConfig config_;
   LoopChannels& ch_;
@@ -50,6 +63,10 @@ class Recorder {
   std::atomic<bool> stop_{false};
   std::thread thread_;
   std::atomic<std::uint64_t> files_written_{0};
+  std::atomic<std::uint64_t> files_skipped_{0};
+  std::optional<RunDirectoryQuota> quota_;  // built on the first write: the directory may not exist before
+  double move_tokens_ = 0;                   // the move-file rate's bucket, and when it was last filled
+  std::chrono::steady_clock::time_point tokens_at_{};
   std::uint64_t request_count_ = 0;
   std::uint64_t excitation_count_ = 0;
   mutable std::mutex last_file_mutex_;

@@ -38,6 +38,7 @@ struct RuntimeConfig {
 
   double move_window_s = 5.0;       // online metrics: each move is measured over this window
   double record_buffer_s = 60.0;    // recorder ring: seconds of history kept in memory (see below)
+  double record_min_interval_s = 5.0;  // a record request (record_s) at most this often: one recording at a time
 
   ExcitationSettings excitation;    // the experiment of mode EXCITE, [excite]
 

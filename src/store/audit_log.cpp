@@ -2,6 +2,8 @@
 
 #include "store/statement.hpp"
 
+#include <algorithm>
+
 namespace epa::store {
 
 core::Status AuditLog::append(const core::AuditEntry& e) {
@@ -30,6 +32,14 @@ core::Result<std::vector<AuditRecord>> AuditLog::query(const AuditFilter& f) {
   });
   if (!s) return s.error();
   return out;
+}
+
+core::Result<std::int64_t> AuditLog::drop_oldest(std::int64_t keep_rows) {
+  auto stmt = db_.prepare("DELETE FROM audit_log WHERE id <= (SELECT max(id) FROM audit_log) - ?");
+  if (!stmt) return stmt.error();
+  stmt->bind(1, std::max(keep_rows, core::kAuditMinRows));
+  if (auto s = stmt->run(); !s) return s.error();
+  return db_.changes();
 }
 
 core::Result<std::int64_t> AuditLog::count() {

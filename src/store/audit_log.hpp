@@ -30,6 +30,9 @@ class AuditLog {
   core::Status append(const core::AuditEntry& entry);
   core::Result<std::vector<AuditRecord>> query(const AuditFilter& filter);  // newest first
   core::Result<std::int64_t> count();
+  // Deletes the oldest rows beyond the newest `keep_rows` (at least core::kAuditMinRows); the
+  // number deleted.
+  core::Result<std::int64_t> drop_oldest(std::int64_t keep_rows);
 
  private:
   Database& db_;

@@ -15,6 +15,14 @@ core::Result<std::int64_t> RunTable::insert(const RunRecord& r) {
   return db_.last_insert_id();
 }
 
+core::Result<std::int64_t> RunTable::drop_oldest(std::int64_t keep_rows) {
+  auto stmt = db_.prepare("DELETE FROM runs WHERE id <= (SELECT max(id) FROM runs) - ?");
+  if (!stmt) return stmt.error();
+  stmt->bind(1, keep_rows);
+  if (auto s = stmt->run(); !s) return s.error();
+  return db_.changes();
+}
+
 core::Result<std::vector<RunRecord>> RunTable::recent(std::size_t limit) {
   auto stmt = db_.prepare(
       "SELECT id, path, recorded_ms, controller, tuning_set_id, samples, ts_s, from_mm, to_mm, rise_s, settling_s, ess_mm, "

@@ -1,11 +1,15 @@
 #include "store/schema.hpp"
 
+#include "core/audit.hpp"
+
 #include <array>
 
 #include "store/statement.hpp"
 #include "store/transaction.hpp"
 
 namespace epa::store {
+
+static_assert(core::kAuditMinRows == 1000, "migration 5's trigger keeps the newest 1000 rows");
 
 namespace {
 
@@ -107,6 +111,14 @@ CREATE TABLE fault_history (
   mode INTEGER NOT NULL,             -- the mode it was in before the fault, as the mode register (0 stop, 1 run, 2 manual, 4 excite)
   position_mm REAL, setpoint_mm REAL, valve_v REAL, sensor_v REAL  -- NULL: not known (nothing read yet)
 );
+)sql",
+    // 5: a retention for the audit log ([store] audit_max_rows): the oldest rows may be deleted,
+    // never the newest 1000 (core::kAuditMinRows); rows are still never changed.
+    R"sql(
+DROP TRIGGER audit_log_no_delete;
+CREATE TRIGGER audit_log_keeps_newest BEFORE DELETE ON audit_log
+  WHEN OLD.id > (SELECT max(id) FROM audit_log) - 1000
+  BEGIN SELECT RAISE(ABORT, 'the audit log keeps its newest 1000 rows'); END;
 )sql",
 };
 

@@ -7,7 +7,7 @@
 
 namespace epa::store {
 
-inline constexpr int kSchemaVersion = 4;
+inline constexpr int kSchemaVersion = 5;
 
 core::Result<int> schema_version(Database& db);
 

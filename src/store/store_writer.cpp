@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
+
+#include "core/free_space.hpp"
 
 #include "store/audit_log.hpp"
 #include "store/fault_table.hpp"
@@ -14,6 +17,10 @@
 #include "store/tuning_set_table.hpp"
 
 namespace epa::store {
+
+namespace {
+constexpr std::uint64_t kItemsBetweenRetention = 1000;
+}  // namespace
 
 StoreWriter::StoreWriter(Database db, TuningSet running, std::set<points::PointId> persisted, Log log)
     : db_(std::move(db)), running_(std::move(running)), persisted_(std::move(persisted)), log_(std::move(log)) {}
@@ -77,9 +84,42 @@ TuningSet StoreWriter::running_set() const {
   return running_;
 }
 
+void StoreWriter::set_limits(const StoreLimits& limits) {
+  std::lock_guard lock(mutex_);
+  limits_ = limits;
+}
+
 core::ChangeCounters StoreWriter::counters() const {
   std::lock_guard lock(mutex_);
-  return {accepted_, saved_.load(), health_.ok};
+  return {accepted_, saved_.load(), health_.ok, disk_low_now()};
+}
+
+bool StoreWriter::disk_low_now() const {
+  const std::int64_t now_ms = core::unix_time_ms();
+  if (now_ms - disk_checked_ms_ >= 1000 || now_ms < disk_checked_ms_) {
+    const auto folder = std::filesystem::path(db_.path()).parent_path();
+    const auto free = core::free_bytes(folder.empty() ? "." : folder.string());
+    disk_low_ = free && *free < limits_.min_free_bytes;
+    disk_checked_ms_ = now_ms;
+  }
+  return disk_low_;
+}
+
+void StoreWriter::drop_beyond_retention() {
+  StoreLimits limits;
+  {
+    std::lock_guard lock(mutex_);
+    limits = limits_;
+  }
+  auto audit = AuditLog(db_).drop_oldest(limits.audit_max_rows);
+  auto runs = RunTable(db_).drop_oldest(limits.runs_max_rows);
+  if (!audit || !runs) {
+    if (log_) log_("store: cannot drop rows beyond the retention: " + (!audit ? audit.error() : runs.error()).message);
+    return;
+  }
+  if (*audit > 0 && log_)
+    log_("store: dropped the " + std::to_string(*audit) + " oldest audit rows (retention: the newest " +
+         std::to_string(std::max(limits.audit_max_rows, core::kAuditMinRows)) + ")");
 }
 
 StoreHealth StoreWriter::health() const {
@@ -143,21 +183,31 @@ bool StoreWriter::flush() {
   if (batch.empty()) return true;
   TuningSet running = running_;
   const auto status = write(batch, running);
-  std::lock_guard lock(mutex_);
   if (!status) {
+    std::lock_guard lock(mutex_);
     ++health_.failures;
     if (health_.ok && log_) log_("store: cannot save (will retry): " + status.error().message);
     health_.ok = false;
     health_.last_error = status.error().message;
     return false;
   }
-  if (!health_.ok && log_) log_("store: saving again after " + std::to_string(health_.failures) + " failed attempts");
-  health_.ok = true;
-  running_ = running;
-  std::uint64_t changes = 0;
-  for (const Item& item : batch) changes += std::holds_alternative<std::vector<core::AuditEntry>>(item) ? 1 : 0;
-  pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(batch.size()));
-  saved_.fetch_add(changes);
+  {
+    std::lock_guard lock(mutex_);
+    if (!health_.ok && log_) log_("store: saving again after " + std::to_string(health_.failures) + " failed attempts");
+    health_.ok = true;
+    running_ = running;
+    std::uint64_t changes = 0;
+    for (const Item& item : batch) changes += std::holds_alternative<std::vector<core::AuditEntry>>(item) ? 1 : 0;
+    pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(batch.size()));
+    saved_.fetch_add(changes);
+  }
+  // The retention runs every so many saved items, not per batch: a DELETE per saved write would
+  // double a busy store's work; the bound is exceeded by at most that many rows between runs.
+  rows_since_retention_ += batch.size();
+  if (rows_since_retention_ >= kItemsBetweenRetention) {
+    rows_since_retention_ = 0;
+    drop_beyond_retention();
+  }
   return true;
 }
 

@@ -26,6 +26,14 @@
 
 namespace epa::store {
 
+// What the store may hold: the audit log's and the run history's newest rows (the oldest dropped,
+// logged), and the free space below which it warns (ChangeCounters::disk_low) before it cannot save.
+struct StoreLimits {
+  std::int64_t audit_max_rows = 1'000'000;
+  std::int64_t runs_max_rows = 100'000;
+  std::uint64_t min_free_bytes = 256ull * 1024 * 1024;
+};
+
 struct StoreHealth {
   bool ok = true;               // the last write succeeded
   std::string last_error;       // of the last failed write
@@ -45,6 +53,7 @@ class StoreWriter final : public core::AuditSink {
   StoreWriter(const StoreWriter&) = delete;
   StoreWriter& operator=(const StoreWriter&) = delete;
 
+  void set_limits(const StoreLimits& limits);  // before start()
   void start();
   // Writes what is pending (trying for at most `drain_s`), then joins. Logs what could not be saved.
   void stop(double drain_s = 2.0);
@@ -74,6 +83,7 @@ class StoreWriter final : public core::AuditSink {
   };
   using Item = std::variant<std::vector<core::AuditEntry>, RunRecord, SetSwitch, runtime::FaultRecord>;
   core::Status write(const std::deque<Item>& batch, TuningSet& running);
+  void drop_beyond_retention();  // after a saved batch, now and then
   void loop();
 
   Database db_;
@@ -89,6 +99,11 @@ class StoreWriter final : public core::AuditSink {
   StoreHealth health_;
   bool stop_ = false;
   std::mutex write_mutex_;  // one writer at a time: the thread, or a direct flush()
+  StoreLimits limits_;
+  std::uint64_t rows_since_retention_ = 1000;  // under write_mutex_; the first saved batch runs the retention
+  mutable std::int64_t disk_checked_ms_ = 0;  // disk_low_ is refreshed at most once a second (under mutex_)
+  mutable bool disk_low_ = false;
+  bool disk_low_now() const;  // mutex_ held
   std::thread thread_;
 };
 

@@ -123,6 +123,43 @@ TEST(AuditLog, EntriesAreAppendOnly) {
   EXPECT_EQ(log.query({})->front().entry.new_value, 1.9);
 }
 
+TEST(AuditLog, TheRetentionDropsTheOldestRowsButNeverTheNewestThousand) {
+  Database db = seeded_memory_db();
+  AuditLog log(db);
+  for (int i = 0; i < 1500; ++i) ASSERT_TRUE(log.append({1000 + i, "modbus 127.0.0.1:5000", "setpoint_mm", i * 1.0, i + 1.0}));
+  // A retention below the floor keeps the floor.
+  EXPECT_EQ(*log.drop_oldest(10), 500);
+  EXPECT_EQ(*log.count(), core::kAuditMinRows);
+  EXPECT_EQ(log.query({.limit = 1})->front().entry.new_value, 1500.0);  // the newest is kept
+  // Nothing but the retention may delete: a plain DELETE of the newest rows is refused.
+  auto del = db.exec("DELETE FROM audit_log");
+  ASSERT_FALSE(del);
+  EXPECT_NE(del.error().message.find("newest 1000"), std::string::npos) << del.error().message;
+  EXPECT_EQ(*log.count(), core::kAuditMinRows);
+  for (int i = 0; i < 300; ++i) ASSERT_TRUE(log.append({5000 + i, "web 127.0.0.1", "mode", 0, 1}));
+  EXPECT_EQ(*log.drop_oldest(1200), 100);
+  EXPECT_EQ(*log.count(), 1200);
+}
+
+TEST(RunTable, TheRetentionKeepsTheNewestRows) {
+  Database db = seeded_memory_db();
+  RunTable runs(db);
+  for (int i = 0; i < 30; ++i) {
+    RunRecord r;
+    r.path = "runs/move-" + std::to_string(i) + ".csv";
+    r.recorded_ms = 1000 + i;
+    r.controller = "pp";
+    r.samples = 10;
+    r.Ts = 0.005;
+    ASSERT_TRUE(runs.insert(r));
+  }
+  EXPECT_EQ(*runs.drop_oldest(20), 10);
+  const auto left = *runs.recent(100);
+  ASSERT_EQ(left.size(), 20u);
+  EXPECT_EQ(left.front().path, "runs/move-29.csv");
+  EXPECT_EQ(left.back().path, "runs/move-10.csv");
+}
+
 TEST(AuditLog, FiltersSelectByTimeSourcePointAndLimitNewestFirst) {
   Database db = seeded_memory_db();
   AuditLog log(db);
