@@ -9,7 +9,9 @@
 #include <toml++/toml.h>
 
 #include "core/atomic_file.hpp"
+#include "core/coefficient_cap.hpp"
 #include "core/format.hpp"
+#include "core/printable_name.hpp"
 #include "core/text_file.hpp"
 #include "core/toml_document.hpp"
 #include "core/toml_keys.hpp"
@@ -23,6 +25,7 @@ constexpr const char* kSchema = "epa-model/1";
 // Every number of a model file is bounded: nothing physical in it comes near, and 1e300 or NaN
 // would only overflow later (the model's own validation then checks each value's meaning).
 constexpr double kMaxMagnitude = 1e6;
+constexpr std::size_t kMaxModelSourceChars = 1024;  // a sentence: epa identify writes up to 640 characters
 
 Result<double> number_at(const toml::table& t, const char* table_name, const char* key, const std::string& src) {
   const auto* node = t.get(key);
@@ -38,6 +41,7 @@ Result<double> number_at(const toml::table& t, const char* table_name, const cha
 Result<Polynomial> array_at(const toml::table& t, const char* key, const std::string& src) {
   const auto* arr = t.get_as<toml::array>(key);
   if (!arr) return parse_error(src + ": [arx] " + key + " is missing or not an array of numbers");
+  if (auto s = check_coefficient_count(arr->size(), src + ": [arx] " + key); !s) return s.error();
   std::vector<double> c;
   for (std::size_t i = 0; i < arr->size(); ++i) {
     auto v = arr->get(i)->value<double>();
@@ -106,6 +110,8 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
     f.model.mm_per_volt = *s;
   }
   f.source = root["source"].value_or(std::string());
+  // Free text that `epa design` prints and the store keeps: one printable line (core/printable_name.hpp).
+  if (auto s = check_printable_text(f.source, src + ": source", kMaxModelSourceChars); !s) return s.error();
 
   const auto* arx = root["arx"].as_table();
   if (!arx) return parse_error(src + ": table [arx] is missing");
@@ -148,7 +154,7 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
 }
 
 Result<ModelFile> read_model_file(const std::string& path) {
-  auto text = read_text_file(path, "model file");
+  auto text = read_text_file(path, "model file", kSmallFileCapBytes);
   if (!text) return text.error();
   return parse_model_toml(*text, path);
 }

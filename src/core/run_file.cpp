@@ -8,15 +8,15 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
-#include <filesystem>
-#include <fstream>
 #include <istream>
 #include <ostream>
+#include <streambuf>
 #include <string_view>
 #include <vector>
 
 #include "core/atomic_file.hpp"
 #include "core/format.hpp"
+#include "core/text_file.hpp"
 #include "core/units.hpp"
 
 namespace epa::core {
@@ -114,6 +114,8 @@ Result<Run> parse_run_impl(std::istream& in, const std::string& src, std::option
   std::string raw;
   while (std::getline(in, raw)) {
     std::string_view line = raw;
+    if (raw.size() > kMaxRunLineBytes)
+      return error_at(src, line_no + 1, "line longer than " + std::to_string(kMaxRunLineBytes) + " bytes: not a run file");
     if (++line_no == 1 && line.starts_with(kBom)) line.remove_prefix(kBom.size());
     line = trim(line);  // also drops the '\r' of CRLF files
     if (line.empty()) continue;
@@ -241,7 +243,11 @@ Status check_writable(const Run& run) {
   return ok();
 }
 
-std::string errno_text() { return errno != 0 ? std::string(": ") + std::strerror(errno) : std::string(); }
+// A stream over text already read, without the copy an istringstream makes of up to 160 MiB.
+class TextBuffer : public std::streambuf {
+ public:
+  explicit TextBuffer(std::string& text) { setg(text.data(), text.data(), text.data() + text.size()); }
+};
 
 std::string one_line(std::string text) {
   std::replace_if(text.begin(), text.end(), [](char c) { return c == '\r' || c == '\n'; }, ' ');
@@ -309,11 +315,10 @@ Result<Run> parse_run(std::istream& in, const std::string& source_name, std::opt
 
 Result<Run> read_run_file(const std::string& path, std::optional<double> expected_Ts) {
   try {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) return io_error(path + ": is a folder, expected a run file");
-    errno = 0;
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return io_error("cannot open run file '" + path + "'" + errno_text());
+    auto text = read_text_file(path, "run file", kMaxRunFileBytes);
+    if (!text) return text.error();
+    TextBuffer buffer(*text);
+    std::istream in(&buffer);
     return parse_run(in, path, expected_Ts);
   } catch (const std::exception& e) {
     return io_error("cannot read run file '" + path + "': " + e.what());

@@ -33,6 +33,12 @@ Status write_run_file(const std::string& path, const Run& run);
 // The most samples a run file may hold: 2,000,000 (2.8 h at Ts = 5 ms, about 100 MB read), so
 // `identify` and `diagnose` have bounded memory whatever file they are given.
 inline constexpr std::size_t kMaxRunSamples = 2'000'000;
+// The most bytes a run file may have, 160 MiB: kMaxRunSamples rows of up to 80 bytes (write_run
+// writes about 50). A larger file, or anything that is not a regular file, is refused unread.
+inline constexpr std::size_t kMaxRunFileBytes = std::size_t{160} << 20;
+// The longest line a run file may have: a header or a row is far shorter, and a message that
+// quotes a line stays readable.
+inline constexpr std::size_t kMaxRunLineBytes = 4096;
 
 // Parses epa-run/1. `source_name` is used in messages ("runs/a.csv:14: ..."). If expected_Ts is
 // given, the file's Ts must equal it (relative tolerance 1e-9) and a mismatch is an error naming
@@ -42,7 +48,8 @@ inline constexpr std::size_t kMaxRunSamples = 2'000'000;
 Result<Run> parse_run(std::istream& in, const std::string& source_name,
                       std::optional<double> expected_Ts = std::nullopt);
 
-// parse_run on the file at `path` (used as the source name); io_error when it cannot be read.
+// parse_run on the file at `path` (used as the source name); io_error when it cannot be read, is
+// not a regular file or is larger than kMaxRunFileBytes (core/text_file.hpp).
 Result<Run> read_run_file(const std::string& path, std::optional<double> expected_Ts = std::nullopt);
 
 }  // namespace epa::core
