@@ -60,6 +60,9 @@ function showStatus(s) {
   const fault = $("fault");
   fault.hidden = s.mode !== "fault";
   if (s.mode === "fault") { setText("fault-code", s.fault); setText("fault-text", s.fault_text || ""); }
+  // Warnings the server may report; an older server without the field shows none.
+  $("warn-any-address").hidden = s.any_address_may_command !== true;
+  $("warn-disk-low").hidden = !(s.disk_low === true || (s.store && s.store.disk_low === true));
   setText("position", num(s.position_mm, 1));
   setText("setpoint", num(s.setpoint_mm, 1));
   setText("error", num(s.error_mm, 2));

@@ -146,6 +146,7 @@
 
   function init() {
     document.addEventListener("epa-status", (e) => onStatus(e.detail));
+    $("cmd-form").addEventListener("submit", (e) => e.preventDefault());  // the buttons send; Enter does not post the form
     for (const mode of ["stop", "run", "manual"])
       $(`cmd-${mode}`).addEventListener("click", () => send("/api/mode", { mode }, `mode ${mode}`));
     $("cmd-move").addEventListener("click", () => {

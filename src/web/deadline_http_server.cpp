@@ -1,33 +1,45 @@
 #include "web/deadline_http_server.hpp"
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <poll.h>
 #include <sys/epoll.h>
 #include <sys/eventfd.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
-#include <string>
+#include <deque>
+#include <optional>
+#include <string_view>
+#include <unordered_map>
 
 namespace epa::web {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using std::chrono::milliseconds;
 
-enum class Cut { kNone, kDeadline, kTooLarge };
+constexpr milliseconds kScanPeriod{50};        // how often deadlines are looked at
+constexpr std::size_t kAcceptsPerWake = 256;   // then the connections get their turn
+constexpr std::size_t kReservedDescriptors = 256;  // left to the rest of the process (Modbus, store, logs)
+constexpr auto kTallyPeriod = std::chrono::minutes(1);
 
 // Waits for `events` on `fd` for at most `wait` (not negative); true when they came.
-bool poll_for(int fd, short events, std::chrono::milliseconds wait) {
+bool poll_for(int fd, short events, milliseconds wait) {
   pollfd p{fd, events, 0};
   for (;;) {
-    const int n = ::poll(&p, 1, static_cast<int>(std::max<std::chrono::milliseconds::rep>(0, wait.count())));
+    const int n = ::poll(&p, 1, static_cast<int>(std::max<milliseconds::rep>(0, wait.count())));
     if (n < 0 && errno == EINTR) continue;
     return n > 0;
   }
@@ -35,6 +47,7 @@ bool poll_for(int fd, short events, std::chrono::milliseconds wait) {
 
 std::string address_text(const sockaddr_storage& a, int& port) {
   char text[INET6_ADDRSTRLEN] = {};
+  port = 0;
   if (a.ss_family == AF_INET) {
     const auto& v4 = reinterpret_cast<const sockaddr_in&>(a);
     ::inet_ntop(AF_INET, &v4.sin_addr, text, sizeof text);
@@ -47,250 +60,488 @@ std::string address_text(const sockaddr_storage& a, int& port) {
   return text;
 }
 
-// One connection's socket as httplib's Stream. A request's clock starts with the first byte read
-// after the previous answer; from then on every wait is bounded by what is left of the deadline
-// and its bytes are counted. Once a request is cut, reads fail and httplib's answer to that
-// failure (a 400) is not sent: the caller answers 408 or 431 itself and closes.
-class DeadlineSocketStream final : public httplib::Stream {
+bool iequals(std::string_view a, std::string_view b) {
+  return a.size() == b.size() &&
+         std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) { return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y)); });
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+  return s;
+}
+
+// How much of a request the buffer holds. Only the framing is read here (where the head ends, how
+// long the body is); httplib parses the request once it is whole.
+enum class Framing { kPartial, kWhole, kTooLarge, kTooManyFields, kNul };
+
+Framing framing(std::string_view buf, const RequestLimits& limits, std::size_t max_body_bytes) {
+  const std::size_t head_end = buf.find("\r\n\r\n");
+  if (head_end == std::string_view::npos) return buf.size() > limits.max_request_bytes ? Framing::kTooLarge : Framing::kPartial;
+  const std::size_t body_start = head_end + 4;
+  if (body_start > limits.max_request_bytes) return Framing::kTooLarge;
+  // No field may hold a NUL (RFC 9110 5.5); httplib would read a value only up to it, so a token
+  // followed by NUL and junk would pass as the token alone.
+  if (buf.substr(0, head_end).find('\0') != std::string_view::npos) return Framing::kNul;
+  std::size_t fields = 0;
+  std::optional<std::string_view> length;
+  bool chunked = false;
+  std::size_t line = buf.find("\r\n") + 2;  // past the request line
+  while (line < head_end + 2) {
+    const std::size_t end = buf.find("\r\n", line);
+    const std::string_view field = buf.substr(line, end - line);
+    ++fields;
+    const std::size_t colon = field.find(':');
+    if (colon != std::string_view::npos) {
+      const std::string_view name = field.substr(0, colon), value = trim(field.substr(colon + 1));
+      if (iequals(name, "Content-Length")) length = value;
+      if (iequals(name, "Transfer-Encoding")) chunked = true;
+    }
+    line = end + 2;
+  }
+  if (fields > limits.max_header_fields) return Framing::kTooManyFields;
+  const std::string_view body = buf.substr(body_start);
+  if (chunked) {  // whole once the last chunk (size 0) has come; a body cut short is read under the deadline
+    if (body.rfind("0\r\n\r\n", 0) == 0 || body.find("\r\n0\r\n\r\n") != std::string_view::npos) return Framing::kWhole;
+    return buf.size() > limits.max_request_bytes ? Framing::kTooLarge : Framing::kPartial;
+  }
+  if (!length) return Framing::kWhole;
+  const bool digits = !length->empty() && length->size() <= 18 && length->find_first_not_of("0123456789") == std::string_view::npos;
+  if (!digits) return Framing::kWhole;  // httplib answers it 400
+  const std::size_t declared = std::stoull(std::string(*length));
+  if (declared > max_body_bytes) return Framing::kWhole;  // answered 413 unread
+  if (body.size() >= declared) return Framing::kWhole;
+  return body_start + declared > limits.max_request_bytes ? Framing::kTooLarge : Framing::kPartial;
+}
+
+// An answer the front end gives itself (a refusal), written without waiting, then the caller closes.
+void send_refusal(int fd, int status, std::string_view reason, const std::string& message, const httplib::Headers& headers) {
+  const std::string body = R"({"error":")" + message + "\"}";
+  std::string all = "HTTP/1.1 " + std::to_string(status) + " " + std::string(reason) + "\r\n";
+  for (const auto& [k, v] : headers) all += k + ": " + v + "\r\n";
+  all += "Content-Type: application/json\r\nContent-Length: " + std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body;
+  (void)::send(fd, all.data(), all.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+}
+
+}  // namespace
+
+// An event that may come thousands of times a second (a refused connection): the first is logged at
+// once, the rest counted and logged once a minute ("..., 412 times in the last minute").
+class Tally {
  public:
-  DeadlineSocketStream(int fd, const RequestLimits& limits) : fd_(fd), limits_(limits) {}
+  explicit Tally(std::string what) : what_(std::move(what)) {}
+  void note(Clock::time_point now, const DeadlineHttpServer::Log& log, const std::string& detail) {
+    ++count_, detail_ = detail;
+    if (!reported_ || now - since_ >= kTallyPeriod) report(now, log);
+  }
+  void flush(Clock::time_point now, const DeadlineHttpServer::Log& log) {
+    if (count_ > 0 && now - since_ >= kTallyPeriod) report(now, log);
+  }
+
+ private:
+  void report(Clock::time_point now, const DeadlineHttpServer::Log& log) {
+    if (log) {
+      const bool first = !reported_;
+      log("web: " + what_ + (first ? "" : ", " + std::to_string(count_) + (count_ == 1 ? " time" : " times") + " in the last minute") +
+          " (" + detail_ + ")" + (first ? "; further ones are counted and logged once a minute" : ""));
+    }
+    reported_ = true, count_ = 0, since_ = now;
+  }
+  std::string what_, detail_;
+  std::uint64_t count_ = 0;
+  bool reported_ = false;
+  Clock::time_point since_{};
+};
+
+namespace {
+
+std::size_t descriptor_limit() {
+  rlimit r{};
+  if (::getrlimit(RLIMIT_NOFILE, &r) != 0 || r.rlim_cur == RLIM_INFINITY) return SIZE_MAX;
+  return static_cast<std::size_t>(r.rlim_cur);
+}
+
+}  // namespace
+
+struct DeadlineHttpServer::Connection {
+  int fd = -1;
+  std::string peer;
+  std::string buffer;  // read and not yet answered; starts with the next request's first byte
+  Clock::time_point deadline{};
+  bool in_request = false;  // the next request's first byte has come: `deadline` is its deadline
+  std::size_t requests_left = 0;
+};
+
+namespace {
+
+enum class Cut { kNone, kDeadline, kTooLarge };
+
+// A connection as httplib's Stream, on a worker: the request is read from the bytes the front end
+// buffered (usually all of it), and only a body the front end could not frame (chunked) from the
+// socket, each wait ending at the request's deadline.
+class BufferedStream final : public httplib::Stream {
+ public:
+  BufferedStream(DeadlineHttpServer::Connection& c, const RequestLimits& limits) : c_(c), limits_(limits) {}
 
   Cut cut() const { return cut_; }
-  bool has_buffered() const { return pos_ < end_; }
+  // Forgets the bytes of the request just answered.
+  void consume() {
+    c_.buffer.erase(0, pos_);
+    pos_ = 0;
+  }
 
-  bool is_readable() const override { return pos_ < end_ || poll_for(fd_, POLLIN, limits_.read_timeout); }
-  bool is_writable() const override { return cut_ == Cut::kNone && poll_for(fd_, POLLOUT, limits_.write_timeout); }
+  bool is_readable() const override { return pos_ < c_.buffer.size() || poll_for(c_.fd, POLLIN, left()); }
+  bool is_writable() const override { return cut_ == Cut::kNone && poll_for(c_.fd, POLLOUT, limits_.write_timeout); }
 
   ssize_t read(char* ptr, std::size_t size) override {
     if (cut_ != Cut::kNone) return -1;
-    if (answering_) {  // a new request on this connection: its clock starts with its first byte
-      answering_ = false, request_bytes_ = 0;
-      started_ = pos_ < end_;  // pipelined: that byte is already here
-      if (started_) deadline_ = Clock::now() + limits_.request_deadline;
-    }
-    if (pos_ == end_) {
-      const ssize_t got = fill();
-      if (got <= 0) return got;
-    }
-    const std::size_t n = std::min(size, end_ - pos_);
-    if (request_bytes_ + n > limits_.max_request_bytes) {
-      cut_ = Cut::kTooLarge;
-      return -1;
-    }
-    std::memcpy(ptr, buffer_.data() + pos_, n);
+    if (pos_ == c_.buffer.size() && !fill()) return -1;
+    const std::size_t n = std::min(size, c_.buffer.size() - pos_);
+    std::memcpy(ptr, c_.buffer.data() + pos_, n);
     pos_ += n;
-    request_bytes_ += n;
     return static_cast<ssize_t>(n);
   }
 
   ssize_t write(const char* ptr, std::size_t size) override {
     if (cut_ != Cut::kNone) return -1;
-    answering_ = true;
-    if (!poll_for(fd_, POLLOUT, limits_.write_timeout)) return -1;
     for (;;) {
-      const ssize_t n = ::send(fd_, ptr, size, MSG_NOSIGNAL);
-      if (n < 0 && errno == EINTR) continue;
+      if (!poll_for(c_.fd, POLLOUT, limits_.write_timeout)) return -1;
+      const ssize_t n = ::send(c_.fd, ptr, size, MSG_NOSIGNAL);
+      if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
       return n;
     }
-  }
-
-  // The answer to a cut request, written past httplib (which has given up on it).
-  void answer_cut() const {
-    const bool late = cut_ == Cut::kDeadline;
-    const std::string body = late ? R"({"error":"request not complete within its deadline"})"
-                                  : R"({"error":"request too large"})";
-    const std::string head = std::string(late ? "HTTP/1.1 408 Request Timeout" : "HTTP/1.1 431 Request Header Fields Too Large") +
-                             "\r\nContent-Type: application/json\r\nContent-Length: " + std::to_string(body.size()) +
-                             "\r\nConnection: close\r\n\r\n";
-    const std::string all = head + body;
-    if (poll_for(fd_, POLLOUT, limits_.write_timeout)) (void)::send(fd_, all.data(), all.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
   }
 
   void get_remote_ip_and_port(std::string& ip, int& port) const override { endpoint(::getpeername, ip, port); }
   void get_local_ip_and_port(std::string& ip, int& port) const override { endpoint(::getsockname, ip, port); }
-  socket_t socket() const override { return fd_; }
+  socket_t socket() const override { return c_.fd; }
 
  private:
-  // The address and port getpeername or getsockname gives for the socket.
+  milliseconds left() const {
+    return std::max(milliseconds(0), std::chrono::duration_cast<milliseconds>(c_.deadline - Clock::now()));
+  }
   void endpoint(int (*get)(int, sockaddr*, socklen_t*), std::string& ip, int& port) const {
     sockaddr_storage a{};
     socklen_t len = sizeof a;
     ip.clear(), port = 0;
-    if (get(fd_, reinterpret_cast<sockaddr*>(&a), &len) == 0) ip = address_text(a, port);
+    if (get(c_.fd, reinterpret_cast<sockaddr*>(&a), &len) == 0) ip = address_text(a, port);
   }
-
-  // Reads what the socket has into the empty buffer: >0 bytes, 0 at the peer's end, -1 on a
-  // timeout, a cut or an error.
-  ssize_t fill() {
-    if (started_) {  // every wait inside a request ends at its deadline
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline_ - Clock::now());
-      if (left.count() <= 0 || !poll_for(fd_, POLLIN, left)) {
-        cut_ = Cut::kDeadline;
-        return -1;
-      }
-    } else if (!poll_for(fd_, POLLIN, limits_.read_timeout)) {
-      return -1;
-    }
+  // More of the request from the socket, within its deadline and its size cap.
+  bool fill() {
+    std::array<char, 4096> chunk{};
     for (;;) {
-      const ssize_t n = ::recv(fd_, buffer_.data(), buffer_.size(), 0);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) return n < 0 ? -1 : 0;
-      pos_ = 0, end_ = static_cast<std::size_t>(n);
-      if (!started_) started_ = true, deadline_ = Clock::now() + limits_.request_deadline;
-      return n;
+      if (left().count() <= 0 || !poll_for(c_.fd, POLLIN, left())) return cut_ = Cut::kDeadline, false;
+      const ssize_t n = ::recv(c_.fd, chunk.data(), chunk.size(), 0);
+      if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
+      if (n <= 0) return false;
+      if (c_.buffer.size() + static_cast<std::size_t>(n) > limits_.max_request_bytes) return cut_ = Cut::kTooLarge, false;
+      c_.buffer.append(chunk.data(), static_cast<std::size_t>(n));
+      return true;
     }
   }
 
-  int fd_;
+  DeadlineHttpServer::Connection& c_;
   const RequestLimits& limits_;
-  std::array<char, 4096> buffer_{};
-  std::size_t pos_ = 0, end_ = 0;  // unread bytes: buffer_[pos_, end_)
-  bool started_ = false;           // the current request's first byte has been read
-  bool answering_ = false;         // the current request's answer has begun
-  Clock::time_point deadline_{};
-  std::size_t request_bytes_ = 0;
+  std::size_t pos_ = 0;
   Cut cut_ = Cut::kNone;
 };
 
 }  // namespace
 
-DeadlineHttpServer::DeadlineHttpServer(const RequestLimits& limits) : limits_(limits) {
-  epoll_fd_ = ::epoll_create1(EPOLL_CLOEXEC);
-  wake_fd_ = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
-  if (epoll_fd_ >= 0 && wake_fd_ >= 0) {
-    epoll_event ev{};
-    ev.events = EPOLLIN;
-    ev.data.fd = wake_fd_;
-    ::epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, wake_fd_, &ev);
-    epoll_ok_ = true;
-    parker_ = std::thread([this] { park_loop(); });
-  } else {
-    parking_ = false;  // no epoll: a silent connection keeps its worker (serve)
+// The front end's state: touched by its own thread only, except `returned` and `stopping` (mutex).
+struct DeadlineHttpServer::Front {
+  int epoll_fd = -1, wake_fd = -1, reserve_fd = -1;
+  std::unordered_map<int, std::shared_ptr<Connection>> waiting;  // connections not at a worker
+  std::unordered_map<std::string, std::size_t> per_address;      // every open connection, by peer
+  std::atomic<std::size_t> open{0};
+  std::size_t max_connections = 0;
+  httplib::TaskQueue* queue = nullptr;
+  Clock::time_point next_scan{}, accept_paused_until{};
+  bool accept_paused = false;
+  Tally no_descriptors{"accept refused: out of file descriptors"};
+  Tally over_address_cap{"connections refused: too many from one address"};
+  Tally over_total_cap{"connections refused: the web server's connection limit is reached"};
+
+  std::mutex mutex;
+  std::deque<std::pair<std::shared_ptr<Connection>, bool>> returned;  // from workers: (connection, close it)
+  bool stopping = false, running = false;
+
+  void wake() const {
+    const std::uint64_t one = 1;
+    (void)!::write(wake_fd, &one, sizeof one);
   }
+  bool watch(int fd, int op) const {
+    epoll_event ev{};
+    ev.events = EPOLLIN | EPOLLRDHUP;
+    ev.data.fd = fd;
+    return ::epoll_ctl(epoll_fd, op, fd, &ev) == 0;
+  }
+  void close_connection(const std::shared_ptr<Connection>& c) {
+    ::shutdown(c->fd, SHUT_RDWR);
+    ::close(c->fd);
+    if (auto it = per_address.find(c->peer); it != per_address.end() && --it->second == 0) per_address.erase(it);
+    --open;
+  }
+};
+
+DeadlineHttpServer::DeadlineHttpServer(const RequestLimits& limits, Log log, httplib::Headers answer_headers)
+    : limits_(limits), log_(std::move(log)), answer_headers_(std::move(answer_headers)), front_(std::make_unique<Front>()) {
+  front_->epoll_fd = ::epoll_create1(EPOLL_CLOEXEC);
+  front_->wake_fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+  front_->reserve_fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC);  // given up for an accept when descriptors run out
 }
 
 DeadlineHttpServer::~DeadlineHttpServer() {
-  stop_parking();
-  if (epoll_fd_ >= 0) ::close(epoll_fd_);
-  if (wake_fd_ >= 0) ::close(wake_fd_);
+  stop_serving();
+  for (int fd : {front_->epoll_fd, front_->wake_fd, front_->reserve_fd})
+    if (fd >= 0) ::close(fd);
 }
 
-void DeadlineHttpServer::set_task_queue(httplib::TaskQueue* queue) {
-  std::lock_guard lock(mutex_);
-  queue_ = queue;
+bool DeadlineHttpServer::serving() const {
+  std::lock_guard lock(front_->mutex);
+  return front_->running;
 }
 
-void DeadlineHttpServer::stop_parking() {
-  {
-    std::lock_guard lock(mutex_);
-    if (!parking_ && !parker_.joinable()) return;
-    parking_ = false;
-    queue_ = nullptr;
-  }
-  const std::uint64_t one = 1;
-  if (wake_fd_ >= 0) (void)!::write(wake_fd_, &one, sizeof one);
-  if (parker_.joinable()) parker_.join();
-  std::lock_guard lock(mutex_);
-  for (const auto& [sock, p] : parked_) ::close(sock);
-  parked_.clear();
+std::size_t DeadlineHttpServer::connections() const { return front_->open.load(); }
+
+void DeadlineHttpServer::stop_serving() {
+  std::lock_guard lock(front_->mutex);
+  front_->stopping = true;
+  if (front_->wake_fd >= 0) front_->wake();
 }
 
-void DeadlineHttpServer::park(socket_t sock, std::size_t requests_left, std::chrono::milliseconds wait) {
-  std::unique_lock lock(mutex_);
-  if (!parking_ || !queue_) {
+void DeadlineHttpServer::hand_back(std::shared_ptr<Connection> c, bool close) {
+  std::unique_lock lock(front_->mutex);
+  if (front_->stopping) {  // the front end has closed its own; this one is closed here
     lock.unlock();
-    ::shutdown(sock, SHUT_RDWR);
-    ::close(sock);
+    ::shutdown(c->fd, SHUT_RDWR);
+    ::close(c->fd);
     return;
   }
-  parked_[sock] = {Clock::now() + wait, requests_left};
-  epoll_event ev{};
-  ev.events = EPOLLIN | EPOLLRDHUP | EPOLLONESHOT;
-  ev.data.fd = sock;
-  if (::epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, sock, &ev) != 0) {
-    parked_.erase(sock);
-    lock.unlock();
-    ::close(sock);
-    return;
-  }
-  lock.unlock();
-  const std::uint64_t one = 1;  // the loop's next timeout may be this one's
-  (void)!::write(wake_fd_, &one, sizeof one);
+  front_->returned.emplace_back(std::move(c), close);
+  front_->wake();
 }
 
-void DeadlineHttpServer::park_loop() {
-  std::array<epoll_event, 64> events{};
+void DeadlineHttpServer::answer(std::shared_ptr<Connection> c) {
+  BufferedStream stream(*c, limits_);
   for (;;) {
-    int timeout_ms = 1000;
-    {
-      std::lock_guard lock(mutex_);
-      if (!parking_) return;
-      const auto now = Clock::now();
-      for (auto it = parked_.begin(); it != parked_.end();) {  // waits that ended: closed unanswered
-        if (it->second.until <= now) {
-          ::epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, it->first, nullptr);
-          ::close(it->first);
-          it = parked_.erase(it);
-        } else {
-          const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(it->second.until - now).count() + 1;
-          timeout_ms = static_cast<int>(std::min<long long>(timeout_ms, left));
-          ++it;
-        }
-      }
+    bool connection_closed = false;
+    const bool served = process_request(stream, c->requests_left <= 1, connection_closed, nullptr);
+    --c->requests_left;
+    if (stream.cut() != Cut::kNone) {
+      const bool late = stream.cut() == Cut::kDeadline;
+      send_refusal(c->fd, late ? 408 : 431, late ? "Request Timeout" : "Request Header Fields Too Large",
+                   late ? "request not complete within its deadline" : "request too large", answer_headers_);
+      return hand_back(std::move(c), true);
     }
-    const int n = ::epoll_wait(epoll_fd_, events.data(), static_cast<int>(events.size()), timeout_ms);
-    if (n < 0 && errno != EINTR) return;
-    for (int i = 0; i < n; ++i) {
-      const int fd = events[static_cast<std::size_t>(i)].data.fd;
-      if (fd == wake_fd_) {
-        std::uint64_t count = 0;
-        (void)!::read(wake_fd_, &count, sizeof count);
-        continue;
-      }
-      std::lock_guard lock(mutex_);
-      const auto it = parked_.find(fd);
-      if (it == parked_.end()) continue;
-      const std::size_t left = it->second.requests_left;
-      parked_.erase(it);
-      ::epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, fd, nullptr);
-      if (!parking_ || !queue_) {
-        ::close(fd);
-        continue;
-      }
-      queue_->enqueue([this, fd, left] { serve(fd, left, false); });  // a byte (or the peer's end) came
-    }
+    if (!served || connection_closed || c->requests_left == 0) return hand_back(std::move(c), true);
+    stream.consume();
+    // A pipelined request that is already whole is answered here; any other goes back to wait.
+    if (framing(c->buffer, limits_, payload_max_length_) != Framing::kWhole) return hand_back(std::move(c), false);
+    c->deadline = Clock::now() + limits_.request_deadline;
   }
 }
 
-bool DeadlineHttpServer::process_and_close_socket(socket_t sock) {
-  serve(sock, limits_.keep_alive_max_requests, true);
-  return true;
+// Accepts what the listening socket holds. Out of descriptors, the reserve descriptor is given up to
+// accept and close one connection (so it is refused rather than left hanging, and epoll does not spin),
+// and accepting pauses a moment; it is logged once a minute with a count.
+void DeadlineHttpServer::accept_waiting(int listen_fd) {
+  Front& f = *front_;
+  for (std::size_t i = 0; i < kAcceptsPerWake; ++i) {
+    sockaddr_storage a{};
+    socklen_t len = sizeof a;
+    const int fd = ::accept4(listen_fd, reinterpret_cast<sockaddr*>(&a), &len, SOCK_NONBLOCK | SOCK_CLOEXEC);
+    if (fd < 0) {
+      if (errno == EINTR || errno == ECONNABORTED) continue;
+      if (errno == EMFILE || errno == ENFILE) {
+        f.no_descriptors.note(Clock::now(), log_, "open files limit " + std::to_string(descriptor_limit()) + ": raise LimitNOFILE");
+        if (f.reserve_fd >= 0) {
+          ::close(f.reserve_fd);
+          const int dropped = ::accept4(listen_fd, nullptr, nullptr, SOCK_CLOEXEC);
+          if (dropped >= 0) ::close(dropped);
+          f.reserve_fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+        }
+        ::epoll_ctl(f.epoll_fd, EPOLL_CTL_DEL, listen_fd, nullptr);
+        f.accept_paused = true, f.accept_paused_until = Clock::now() + kScanPeriod;
+      }
+      return;  // EAGAIN: none left
+    }
+    int port = 0;
+    admit(fd, address_text(a, port));
+  }
 }
 
-void DeadlineHttpServer::serve(socket_t sock, std::size_t requests_left, bool first) {
-  DeadlineSocketStream stream(sock, limits_);
-  const auto stopping = [this] { return svr_sock_ == INVALID_SOCKET; };
-  for (std::size_t left = requests_left; left > 0; --left) {
-    if (stopping()) break;
-    const auto wait = first ? limits_.read_timeout : limits_.keep_alive_timeout;
-    if (!stream.has_buffered() && !poll_for(sock, POLLIN, std::chrono::milliseconds(0))) {
-      if (epoll_ok_) {  // silent: wait on the parker rather than on this worker
-        park(sock, left, wait);
-        return;
-      }
-      if (!poll_for(sock, POLLIN, wait)) break;  // no epoll on this system: wait here, as httplib does
-    }
-    first = false;
-    bool connection_closed = false;
-    const bool served = process_request(stream, left == 1, connection_closed, nullptr);
-    if (stream.cut() != Cut::kNone) {
-      stream.answer_cut();
+// A new connection: closed at once past the per-address or the total cap, else it waits for its request.
+void DeadlineHttpServer::admit(int fd, const std::string& peer) {
+  Front& f = *front_;
+  const auto now = Clock::now();
+  std::size_t& from_peer = f.per_address[peer];
+  if (from_peer >= limits_.max_connections_per_address || f.open >= f.max_connections) {
+    const bool address = from_peer >= limits_.max_connections_per_address;
+    if (from_peer == 0) f.per_address.erase(peer);
+    (address ? f.over_address_cap : f.over_total_cap)
+        .note(now, log_, address ? peer + " holds " + std::to_string(limits_.max_connections_per_address) + ", [web] max_connections_per_address"
+                                 : std::to_string(f.max_connections) + " open");
+    send_refusal(fd, 503, "Service Unavailable", address ? "too many connections from " + peer : "too many connections", answer_headers_);
+    ::close(fd);
+    return;
+  }
+  const int yes = 1;  // an answer is written as head and body: Nagle would hold the body for an ACK
+  ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &yes, sizeof yes);
+  auto c = std::make_shared<Connection>();
+  c->fd = fd, c->peer = peer, c->deadline = now + limits_.read_timeout, c->requests_left = limits_.keep_alive_max_requests;
+  if (!f.watch(fd, EPOLL_CTL_ADD)) {
+    ::close(fd);
+    if (from_peer == 0) f.per_address.erase(peer);
+    return;
+  }
+  ++from_peer, ++f.open;
+  f.waiting.emplace(fd, std::move(c));
+}
+
+// Bytes came (or the peer's end): buffered; a request that is whole goes to a worker, one that
+// breaks a cap is refused and its connection closed.
+void DeadlineHttpServer::read_from(int fd) {
+  Front& f = *front_;
+  const auto it = f.waiting.find(fd);
+  if (it == f.waiting.end()) return;
+  const std::shared_ptr<Connection> c = it->second;
+  std::array<char, 16384> chunk{};
+  bool ended = false;
+  while (c->buffer.size() <= limits_.max_request_bytes) {
+    const ssize_t n = ::recv(fd, chunk.data(), chunk.size(), 0);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && errno == EAGAIN) break;
+    if (n <= 0) {
+      ended = true;
       break;
     }
-    if (!served || connection_closed) break;
+    c->buffer.append(chunk.data(), static_cast<std::size_t>(n));
   }
-  ::shutdown(sock, SHUT_RDWR);
-  ::close(sock);
+  if (!c->buffer.empty() && !c->in_request) c->in_request = true, c->deadline = Clock::now() + limits_.request_deadline;
+  const Framing state = c->buffer.empty() ? Framing::kPartial : framing(c->buffer, limits_, payload_max_length_);
+  if (state == Framing::kWhole) return dispatch(c);
+  if (state == Framing::kNul) {
+    send_refusal(fd, 400, "Bad Request", "request head holds a NUL byte", answer_headers_);
+    ended = true;
+  } else if (state == Framing::kTooLarge || state == Framing::kTooManyFields) {
+    send_refusal(fd, 431, "Request Header Fields Too Large",
+                 state == Framing::kTooLarge ? "request too large (at most " + std::to_string(limits_.max_request_bytes) + " bytes)"
+                                             : "request head has more than " + std::to_string(limits_.max_header_fields) + " header fields",
+                 answer_headers_);
+    ended = true;
+  }
+  if (ended) {
+    f.waiting.erase(it);
+    f.close_connection(c);
+  }
+}
+
+void DeadlineHttpServer::dispatch(const std::shared_ptr<Connection>& c) {
+  Front& f = *front_;
+  ::epoll_ctl(f.epoll_fd, EPOLL_CTL_DEL, c->fd, nullptr);
+  f.waiting.erase(c->fd);
+  f.queue->enqueue([this, c] { answer(c); });
+}
+
+// Connections the workers have answered: closed, or waiting again for their next request (which
+// may already be here, pipelined).
+void DeadlineHttpServer::take_back() {
+  Front& f = *front_;
+  std::deque<std::pair<std::shared_ptr<Connection>, bool>> returned;
+  {
+    std::lock_guard lock(f.mutex);
+    returned.swap(f.returned);
+  }
+  const auto now = Clock::now();
+  for (auto& [c, close] : returned) {
+    if (close || !f.watch(c->fd, EPOLL_CTL_ADD)) {
+      f.close_connection(c);
+      continue;
+    }
+    c->in_request = !c->buffer.empty();
+    c->deadline = now + (c->in_request ? limits_.request_deadline : limits_.keep_alive_timeout);
+    f.waiting.emplace(c->fd, c);
+    if (c->in_request) read_from(c->fd);  // frames what is buffered, and reads anything new
+  }
+}
+
+// Waits that ended: a request not whole by its deadline is answered 408, a silent connection closed.
+void DeadlineHttpServer::end_waits(int listen_fd) {
+  Front& f = *front_;
+  const auto now = Clock::now();
+  f.next_scan = now + kScanPeriod;
+  for (auto it = f.waiting.begin(); it != f.waiting.end();) {
+    if (it->second->deadline > now) {
+      ++it;
+      continue;
+    }
+    if (it->second->in_request)
+      send_refusal(it->first, 408, "Request Timeout", "request not complete within its deadline", answer_headers_);
+    f.close_connection(it->second);
+    it = f.waiting.erase(it);
+  }
+  if (f.accept_paused && now >= f.accept_paused_until) f.accept_paused = !f.watch(listen_fd, EPOLL_CTL_ADD);
+  for (Tally* t : {&f.no_descriptors, &f.over_address_cap, &f.over_total_cap}) t->flush(now, log_);
+}
+
+bool DeadlineHttpServer::serve_after_bind() {
+  Front& f = *front_;
+  const int listen_fd = svr_sock_;
+  {
+    std::lock_guard lock(f.mutex);
+    if (f.stopping || listen_fd == INVALID_SOCKET || f.epoll_fd < 0 || f.wake_fd < 0) return false;
+    f.running = true;
+  }
+  std::unique_ptr<httplib::TaskQueue> queue(new_task_queue());
+  f.queue = queue.get();
+  const std::size_t fd_limit = descriptor_limit();
+  f.max_connections = std::min(limits_.max_connections, fd_limit > 2 * kReservedDescriptors ? fd_limit - kReservedDescriptors : fd_limit / 2);
+  ::fcntl(listen_fd, F_SETFL, ::fcntl(listen_fd, F_GETFL) | O_NONBLOCK);
+  f.watch(listen_fd, EPOLL_CTL_ADD);
+  f.watch(f.wake_fd, EPOLL_CTL_ADD);
+
+  // The loop: accept, read what came, dispatch whole requests, take connections back, end waits.
+  std::array<epoll_event, 256> events{};
+  for (;;) {
+    {
+      std::lock_guard lock(f.mutex);
+      if (f.stopping) break;
+    }
+    const auto now = Clock::now();
+    const auto wait = std::chrono::duration_cast<milliseconds>(f.next_scan - now).count();
+    const int n = ::epoll_wait(f.epoll_fd, events.data(), static_cast<int>(events.size()), static_cast<int>(std::clamp<long long>(wait, 0, kScanPeriod.count())));
+    if (n < 0 && errno != EINTR) break;
+    for (int i = 0; i < std::max(n, 0); ++i) {
+      const int fd = events[static_cast<std::size_t>(i)].data.fd;
+      if (fd == listen_fd) {
+        accept_waiting(listen_fd);
+      } else if (fd == f.wake_fd) {
+        std::uint64_t count = 0;
+        (void)!::read(f.wake_fd, &count, sizeof count);
+        take_back();
+      } else {
+        read_from(fd);
+      }
+    }
+    if (Clock::now() >= f.next_scan) end_waits(listen_fd);
+  }
+
+  // Stopping: the listening socket and the waiting connections close; workers finish and close theirs.
+  svr_sock_ = INVALID_SOCKET;
+  ::shutdown(listen_fd, SHUT_RDWR);
+  ::close(listen_fd);
+  for (auto& [fd, c] : f.waiting) f.close_connection(c);
+  f.waiting.clear();
+  queue->shutdown();
+  {
+    std::lock_guard lock(f.mutex);
+    for (auto& [c, close] : f.returned) ::close(c->fd);
+    f.returned.clear();
+    f.running = false;
+  }
+  f.queue = nullptr;
+  return true;
 }
 
 }  // namespace epa::web

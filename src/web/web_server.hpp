@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/audit.hpp"
 #include "core/result.hpp"
@@ -19,7 +20,7 @@
 namespace epa::web {
 
 struct WebConfig {
-  std::string address = "0.0.0.0";  // IPv4 address to listen on
+  std::string address = "0.0.0.0";  // IPv4 or IPv6 address to listen on ("::": IPv6 and IPv4)
   int port = 8080;                   // 0: any free port (see port())
   std::string token;                 // "": commands refused (403); else "Authorization: Bearer <token>"
   std::string static_dir = "../web"; // index.html, app.js, style.css
@@ -27,6 +28,10 @@ struct WebConfig {
   int worker_threads = 512;          // connections served at once (a worker each, started on demand)
   std::size_t max_body_bytes = 4096;
   int request_deadline_ms = 2000;    // a request's head and body arrive within this of its first byte, or 408
+  int max_connections_per_address = 32;  // more from one client address are closed at once (503)
+  // Names (or addresses) besides this machine's own addresses, "localhost" and its host name that a
+  // request's Host may carry; any other is refused 421 (a DNS-rebinding page carries its own name).
+  std::vector<std::string> host_names;
   std::function<void(const std::string&)> log;  // token lock-outs; may be empty
 };
 
@@ -50,6 +55,8 @@ class WebServer {
   WebServer& operator=(const WebServer&) = delete;
 
   int port() const;
+  // What the listener is bound to (getsockname): "127.0.0.1:8080", "[::1]:8080".
+  const std::string& bound_address() const;
   void stop();
 
  private:

@@ -25,6 +25,7 @@
 #include <thread>
 #include <utility>
 #include <filesystem>
+#include <fstream>
 
 #include "../support/temp_path.hpp"
 #include "web/commission_port.hpp"
@@ -95,6 +96,8 @@ class WebServerTest : public ::testing::Test {
     config.token = token;
     config.static_dir = std::string(EPA_SOURCE_DIR) + "/web";
     config.request_deadline_ms = request_deadline_ms_;
+    config.host_names = host_names_;
+    if (!static_dir_.empty()) config.static_dir = static_dir_;
     auto limits = epa::points::WriteLimits::from_config(limits_, "test.toml");
     ASSERT_TRUE(limits.has_value()) << limits.error().message;
     gate_ = std::make_unique<epa::points::WriteGate>(std::move(*limits), limits_,
@@ -129,6 +132,8 @@ class WebServerTest : public ::testing::Test {
   }
 
   int request_deadline_ms_ = 2000;
+  std::vector<std::string> host_names_;
+  std::string static_dir_;  // "": the source tree's web/
   epa::runtime::LoopChannels channels_{16};
   epa::runtime::RuntimeConfig limits_;  // setpoint range [0, 500] mm
   epa::runtime::Snapshot snap_;
@@ -732,13 +737,13 @@ TEST_F(WebServerTest, ASecondServerOnTheSamePortIsRefused) {
 
 TEST_F(WebServerTest, OversizedHeadsAndDeclaredBodiesAreRefusedAtOnce) {
   start("a-token-of-sixteen-chars");
-  std::string many = "GET /api/status HTTP/1.1\r\nHost: x\r\n";
+  std::string many = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n";
   for (int i = 0; i < 100; ++i) many += "X-Filler-" + std::to_string(i) + ": y\r\n";
   EXPECT_EQ(raw_exchange(server_->port(), many + "\r\n").first, "HTTP/1.1 431 Request Header Fields Too Large");
-  std::string big = "GET /api/status HTTP/1.1\r\nHost: x\r\n";  // 40 fields of 300 bytes: 12 KB
+  std::string big = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n";  // 40 fields of 300 bytes: 12 KB
   for (int i = 0; i < 40; ++i) big += "X-Big-" + std::to_string(i) + ": " + std::string(300, 'a') + "\r\n";
   EXPECT_EQ(raw_exchange(server_->port(), big + "\r\n").first, "HTTP/1.1 431 Request Header Fields Too Large");
-  const auto [answer, took] = raw_exchange(server_->port(), "POST /api/setpoint HTTP/1.1\r\nHost: x\r\nContent-Length: 1000000000000\r\n"
+  const auto [answer, took] = raw_exchange(server_->port(), "POST /api/setpoint HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 1000000000000\r\n"
                                                             "Content-Type: application/json\r\n\r\n{");
   EXPECT_EQ(answer, "HTTP/1.1 413 Payload Too Large");
   EXPECT_LT(took, std::chrono::milliseconds(1000));  // not after holding a worker for the read timeout
@@ -801,6 +806,10 @@ TEST_F(WebServerTest, FiftyIdleConnectionsDoNotStopANormalRequest) {
     addr.sin_family = AF_INET;
     addr.sin_port = htons(static_cast<std::uint16_t>(server_->port()));
     addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    sockaddr_in from{};  // 127.0.0.2-6: ten each, under the per-address cap
+    from.sin_family = AF_INET;
+    from.sin_addr.s_addr = htonl(INADDR_LOOPBACK + 1 + static_cast<std::uint32_t>(i % 5));
+    ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&from), sizeof from), 0);
     ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
     if (i % 2) {
       ASSERT_GT(::send(fd, "GET /api/sta", 12, 0), 0);  // half of them stop mid-request
@@ -835,8 +844,8 @@ TEST_F(WebServerTest, PipelinedRequestsOnOneConnectionAreEachAnswered) {
   start();
   const int fd = connect_to(server_->port());
   ASSERT_GE(fd, 0);
-  const std::string get = "GET /api/status HTTP/1.1\r\nHost: x\r\n\r\n";
-  const std::string last = "GET /api/points HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n";
+  const std::string get = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
+  const std::string last = "GET /api/points HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
   const std::string three = get + get + last;  // in one segment: the second and third wait in the buffer
   ASSERT_EQ(::send(fd, three.data(), three.size(), MSG_NOSIGNAL), static_cast<ssize_t>(three.size()));
   const std::string answers = read_to_close(fd);
@@ -850,7 +859,7 @@ TEST_F(WebServerTest, ARequestNotCompleteWithinItsDeadlineIs408AndClosed) {
   start();
   const int fd = connect_to(server_->port());
   ASSERT_GE(fd, 0);
-  const std::string head = "GET /api/status HTTP/1.1\r\nHost: x\r\nX-Slow: aaaaaaaaaaaaaaaaaaaa\r\n\r\n";
+  const std::string head = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: aaaaaaaaaaaaaaaaaaaa\r\n\r\n";
   const auto t0 = std::chrono::steady_clock::now();
   std::size_t sent = 0;
   for (; sent < head.size(); ++sent) {  // a byte every 50 ms: each one in time for a per-read timeout
@@ -873,11 +882,187 @@ TEST_F(WebServerTest, ARequestFarBeyondTheHeadCapIsCutUnreadWith431) {
   start();
   const int fd = connect_to(server_->port());
   ASSERT_GE(fd, 0);
-  std::string huge = "GET /api/status HTTP/1.1\r\nHost: x\r\nX-Huge: " + std::string(200 * 1024, 'a') + "\r\n\r\n";
+  std::string huge = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Huge: " + std::string(200 * 1024, 'a') + "\r\n\r\n";
   (void)::send(fd, huge.data(), huge.size(), MSG_NOSIGNAL);  // the server may close before it has all
   const std::string answer = read_to_close(fd);
   ::close(fd);
   EXPECT_EQ(answer.substr(0, answer.find("\r\n")), "HTTP/1.1 431 Request Header Fields Too Large");
+}
+
+// The whole answer to `request` sent on a new connection from `from` (an address of 127/8).
+std::string raw_answer(int port, const std::string& request, const char* from = "127.0.0.1") {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  if (fd < 0) return "";
+  sockaddr_in src{}, dst{};
+  src.sin_family = dst.sin_family = AF_INET;
+  ::inet_pton(AF_INET, from, &src.sin_addr);
+  dst.sin_port = htons(static_cast<std::uint16_t>(port));
+  dst.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  timeval tv{5, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&src), sizeof src) != 0 ||
+      ::connect(fd, reinterpret_cast<sockaddr*>(&dst), sizeof dst) != 0) {
+    ::close(fd);
+    return "";
+  }
+  (void)::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
+  std::string all = read_to_close(fd);
+  ::close(fd);
+  return all;
+}
+
+std::string status_line(const std::string& answer) { return answer.substr(0, answer.find("\r\n")); }
+
+bool has_header(const std::string& answer, const std::string& line) {
+  return answer.substr(0, answer.find("\r\n\r\n") + 2).find("\r\n" + line + "\r\n") != std::string::npos;
+}
+
+// Every answer, the page's, the API's, an error and a refusal the server gives before httplib parses,
+// says: not in a frame, no type sniffing, no referrer, and a content policy with no inline script.
+TEST_F(WebServerTest, EveryAnswerCarriesTheSecurityHeaders) {
+  start();
+  const std::string connection_close = "Connection: close\r\n\r\n";
+  std::string too_many = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n";
+  for (int i = 0; i < 80; ++i) too_many += "X-" + std::to_string(i) + ": y\r\n";
+  for (const std::string& request :
+       {"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n" + connection_close, "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n" + connection_close,
+        "GET /nothing-here HTTP/1.1\r\nHost: 127.0.0.1\r\n" + connection_close,
+        "GET /api/status HTTP/1.1\r\nHost: evil.example\r\n" + connection_close, too_many + "\r\n"}) {
+    const std::string answer = raw_answer(server_->port(), request);
+    ASSERT_FALSE(answer.empty()) << request;
+    EXPECT_TRUE(has_header(answer, "X-Frame-Options: DENY")) << answer;
+    EXPECT_TRUE(has_header(answer, "X-Content-Type-Options: nosniff")) << answer;
+    EXPECT_TRUE(has_header(answer, "Referrer-Policy: no-referrer")) << answer;
+    EXPECT_NE(answer.find("Content-Security-Policy: default-src 'self'; script-src 'self';"), std::string::npos) << answer;
+    EXPECT_EQ(answer.find("unsafe-inline"), std::string::npos) << answer;
+  }
+}
+
+// The page has no inline script or handler the content policy would block.
+TEST_F(WebServerTest, ThePageHasNoInlineScript) {
+  start();
+  auto res = client_->Get("/");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->body.find("<script>"), std::string::npos);
+  for (const char* handler : {" onsubmit=", " onclick=", " onload=", " onchange=", " oninput=", " style="})
+    EXPECT_EQ(res->body.find(handler), std::string::npos) << handler;
+}
+
+// DNS rebinding: a page whose name resolves to the appliance sends its own name as Host.
+TEST_F(WebServerTest, AHostThatIsNotThisMachineIsRefused421) {
+  host_names_ = {"PLC-7.plant.example."};
+  start();
+  const auto status_for = [this](const std::string& host) {
+    return status_line(raw_answer(server_->port(), "GET /api/status HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n"));
+  };
+  const std::string port = std::to_string(server_->port());
+  for (const std::string& host : std::vector<std::string>{"127.0.0.1", "127.0.0.1:" + port, "127.9.9.9", "localhost", "LOCALHOST:" + port, "[::1]:" + port,
+                                  "plc-7.plant.example", "plc-7.plant.example:" + port})
+    EXPECT_EQ(status_for(host), "HTTP/1.1 200 OK") << host;
+  for (const std::string& host : std::vector<std::string>{"evil.example", "evil.example:" + port, "plc-7", "8.8.8.8", "127.0.0.1.evil.example"})
+    EXPECT_EQ(status_for(host), "HTTP/1.1 421 Misdirected Request") << host;
+  const std::string refused =
+      raw_answer(server_->port(), "GET /api/status HTTP/1.1\r\nHost: evil.example\r\nConnection: close\r\n\r\n");
+  EXPECT_NE(refused.find("host_names"), std::string::npos) << refused;
+  EXPECT_EQ(refused.find("\"mode\""), std::string::npos) << refused;
+}
+
+// The README's rule: more than 64 header fields are refused, 64 are not (Host counts as one).
+TEST_F(WebServerTest, SixtyFourHeaderFieldsAreServedAndSixtyFiveRefused) {
+  start();
+  const auto head_with = [](int fields) {
+    std::string h = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n";
+    for (int i = 2; i < fields; ++i) h += "X-F" + std::to_string(i) + ": y\r\n";
+    return h + "\r\n";
+  };
+  EXPECT_EQ(status_line(raw_answer(server_->port(), head_with(63))), "HTTP/1.1 200 OK");
+  EXPECT_EQ(status_line(raw_answer(server_->port(), head_with(64))), "HTTP/1.1 200 OK");
+  const std::string refused = raw_answer(server_->port(), head_with(65));
+  EXPECT_EQ(status_line(refused), "HTTP/1.1 431 Request Header Fields Too Large");
+  EXPECT_NE(refused.find("more than 64 header fields"), std::string::npos) << refused;
+}
+
+// The right token followed by a NUL and junk is not the token.
+TEST_F(WebServerTest, TheTokenFollowedByNulAndJunkIsRefused) {
+  start("a-token-of-sixteen-chars");
+  const std::string body = R"({"setpoint_mm": 150})";
+  const auto post_with = [&](const std::string& authorization) {
+    return raw_answer(server_->port(), "POST /api/setpoint HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: " + authorization +
+                                           "\r\nContent-Type: application/json\r\nContent-Length: " + std::to_string(body.size()) +
+                                           "\r\nConnection: close\r\n\r\n" + body);
+  };
+  EXPECT_EQ(status_line(post_with(std::string("Bearer a-token-of-sixteen-chars\0junk", 37))), "HTTP/1.1 400 Bad Request");
+  EXPECT_EQ(status_line(post_with(std::string("Bearer a-token-of-sixteen-chars\0", 32))), "HTTP/1.1 400 Bad Request");
+  EXPECT_TRUE(queued().empty());
+  EXPECT_EQ(status_line(post_with("Bearer a-token-of-sixteen-chars")), "HTTP/1.1 200 OK");
+}
+
+// One address holds at most 32 connections (the default): the 33rd is closed at once with 503,
+// while another address is served as before.
+TEST_F(WebServerTest, AnAddressPastItsConnectionCapIsRefusedAtOnce) {
+  start();
+  std::vector<int> held;
+  for (int i = 0; i < 32; ++i) {
+    const int fd = connect_to(server_->port());
+    ASSERT_GE(fd, 0);
+    held.push_back(fd);
+  }
+  std::this_thread::sleep_for(100ms);  // accepted
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string refused = raw_answer(server_->port(), "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n");
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, 500ms);
+  EXPECT_EQ(status_line(refused), "HTTP/1.1 503 Service Unavailable");
+  EXPECT_NE(refused.find("too many connections from 127.0.0.1"), std::string::npos) << refused;
+  EXPECT_EQ(status_line(raw_answer(server_->port(), "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n",
+                                   "127.0.0.2")),
+            "HTTP/1.1 200 OK");
+  for (int fd : held) ::close(fd);
+}
+
+// The page's files are read once, below static_dir, with no symlink followed and no hard link
+// served: a link to the configuration placed there, before start or after, is never served.
+TEST_F(WebServerTest, StaticFilesRefuseSymlinksAndHardLinksAndIgnoreLaterSwaps) {
+  const epa::test::TempDir dir("static");
+  const auto web = std::filesystem::path(EPA_SOURCE_DIR) / "web";
+  for (const char* f : {"index.html", "app.js", "commands.js", "style.css"}) std::filesystem::copy_file(web / f, dir.path / f);
+  const auto secret = dir.path.parent_path() / (dir.path.filename().string() + "-secret.toml");
+  { std::ofstream(secret) << "token = \"the-secret-token-value\"\n"; }
+  std::filesystem::create_symlink(secret, dir.path / "leak.js");
+  const auto hard_target = dir.path / "hard-target.txt";  // not a page extension: never served itself
+  { std::ofstream(hard_target) << "token = \"the-secret-token-value\"\n"; }
+  std::filesystem::create_hard_link(hard_target, dir.path / "hard.js");
+  static_dir_ = dir.path.string();
+  start();
+  for (const char* path : {"/leak.js", "/hard.js", "/hard-target.txt", "/../web/app.js", "/%2e%2e/web/app.js", "/sub/app.js"}) {
+    auto res = client_->Get(path);
+    ASSERT_TRUE(res) << path;
+    EXPECT_EQ(res->status, 404) << path;
+    EXPECT_EQ(res->body.find("the-secret-token-value"), std::string::npos) << path;
+  }
+  // Swapped for a symlink to the secret while serving: the page's own file is still what is served.
+  std::filesystem::remove(dir.path / "app.js");
+  std::filesystem::create_symlink(secret, dir.path / "app.js");
+  for (int i = 0; i < 20; ++i) {
+    auto res = client_->Get("/app.js");
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 200);
+    EXPECT_EQ(res->body.find("the-secret-token-value"), std::string::npos);
+  }
+  std::filesystem::remove(secret);
+}
+
+TEST_F(WebServerTest, APageFileThatIsASymlinkStopsTheStartNamingIt) {
+  const epa::test::TempDir dir("static");
+  const auto web = std::filesystem::path(EPA_SOURCE_DIR) / "web";
+  for (const char* f : {"index.html", "style.css"}) std::filesystem::copy_file(web / f, dir.path / f);
+  std::filesystem::create_symlink(web / "app.js", dir.path / "app.js");
+  epa::web::WebConfig config;
+  config.address = "127.0.0.1";
+  config.port = 0;
+  config.static_dir = dir.path.string();
+  auto server = epa::web::WebServer::start(config, channels_, nullptr, nullptr);
+  ASSERT_FALSE(server.has_value());
+  EXPECT_NE(server.error().message.find("app.js (a symbolic link"), std::string::npos) << server.error().message;
 }
 
 }  // namespace
