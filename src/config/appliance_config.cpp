@@ -1,6 +1,9 @@
 #include "config/appliance_config.hpp"
 
+#include "core/audit.hpp"
 #include "core/format.hpp"
+#include "core/ip_address.hpp"
+#include "core/secret_strength.hpp"
 #include "core/toml_at_line.hpp"
 #include "core/toml_document.hpp"
 #include "core/toml_keys.hpp"
@@ -19,19 +22,21 @@ namespace epa::config {
 
 namespace {
 
-// The values a numeric key may take: [lo, hi], or (lo, hi] when lo is open; in `unit`.
+// The values a numeric key may take: [lo, hi] in `unit`, and 0 as well when `zero_is_off`. The lower
+// bounds are physical, not just "above zero": a tiny value that passes is as harmful as a wrong one
+// (sensor_gain = 1e-300 blinds the sensor, idle_timeout_s = 1e-300 drops every client).
 struct Range {
   double lo, hi;
-  bool lo_open = false;
   const char* unit = "";
-  bool contains(double v) const { return (lo_open ? v > lo : v >= lo) && v <= hi; }
+  bool zero_is_off = false;
+  bool contains(double v) const { return (zero_is_off && v == 0.0) || (v >= lo && v <= hi); }
   std::string text() const {
-    return std::string(lo_open ? "(" : "[") + core::format_number(lo) + ", " + core::format_number(hi) + "]" +
+    return std::string(zero_is_off ? "0 (off) or " : "") + "between " + core::format_number(lo) + " and " + core::format_number(hi) +
            (*unit ? std::string(" ") + unit : std::string());
   }
 };
-Range closed(double lo, double hi, const char* unit) { return {lo, hi, false, unit}; }
-Range above(double lo, double hi, const char* unit) { return {lo, hi, true, unit}; }
+Range closed(double lo, double hi, const char* unit) { return {lo, hi, unit, false}; }
+Range zero_or(double lo, double hi, const char* unit) { return {lo, hi, unit, true}; }
 
 constexpr double kDay_s = 86400.0;
 
@@ -48,8 +53,8 @@ class TableReader {
     const toml::node* n = find(key);
     if (!n) return;
     const auto v = n->value<double>();
-    if (!v || !std::isfinite(*v)) return fail(*n, key, "must be a number within " + range.text());
-    if (!range.contains(*v)) return fail(*n, key, core::format_number(*v) + " is outside " + range.text());
+    if (!v || !std::isfinite(*v)) return fail(*n, key, "must be a number " + range.text());
+    if (!range.contains(*v)) return fail(*n, key, "= " + core::format_number(*v) + ": must be " + range.text());
     out = *v;
   }
   template <typename Int>
@@ -143,6 +148,28 @@ class TableReader {
 };
 
 
+// [modbus] and [web] address: what the listener binds, so exactly an IP address (the log then says
+// what was bound, and a typo such as 999.1.1.1 cannot turn into another address).
+core::Result<std::string> listen_address(std::string_view v) {
+  if (auto a = core::parse_ip_address(v, 0); !a) return a.error();
+  return std::string(v);
+}
+
+// [hal.modbus_io] host: libmodbus' TCP client takes IPv4 only.
+core::Result<std::string> module_host(std::string_view v) {
+  if (!core::is_ipv4_address(v))
+    return core::invalid_argument("'" + std::string(v) + "' is not an IPv4 address such as 192.168.0.10 (four numbers 0-255, no host names)");
+  return std::string(v);
+}
+
+// [web] token: "" (commands off) or a secret that is not guessed (core/secret_strength.hpp).
+core::Result<std::string> web_token(std::string_view v) {
+  if (v.empty()) return std::string();
+  if (const std::string why = core::token_weakness(v); !why.empty())
+    return core::invalid_argument(why + " (or \"\" for no commands): a weak token is guessed; " + core::kTokenAdvice);
+  return std::string(v);
+}
+
 core::Result<HalBackend> parse_backend(std::string_view s) {
   if (s == "sim") return HalBackend::kSim;
   if (s == "modbus-io") return HalBackend::kModbusIo;
@@ -178,7 +205,7 @@ void read_analog_point(TableReader& parent, const char* key, hal::AnalogPoint& p
   t.choice<hal::AnalogEncoding>("encoding", p.encoding, parse_encoding);
   t.choice<core::WordOrder>("word_order", p.word_order, core::parse_word_order);
   double full_scale_v = p.volts_per_count * hal::kInt16FullScaleCounts;
-  t.number("full_scale_v", full_scale_v, above(0, 100, "V"));
+  t.number("full_scale_v", full_scale_v, closed(0.1, 100, "V"));
   p.volts_per_count = full_scale_v / hal::kInt16FullScaleCounts;
   t.number("offset_v", p.offset_v, closed(-100, 100, "V"));
   t.refuse_unknown_keys();
@@ -206,6 +233,16 @@ const char* to_string(HalBackend b) {
   return "?";
 }
 
+bool any_address_may_command(const ApplianceConfig& c) {
+  return c.modbus_enabled && !c.modbus.policy.read_only && c.modbus.policy.write_clients.empty();
+}
+
+std::string any_address_notice(const ApplianceConfig& c) {
+  if (!any_address_may_command(c)) return "";
+  return "any address may command motion over Modbus: set [modbus] write_clients to restrict it "
+         "(README, \"Who may command the axis\")";
+}
+
 core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, const std::string& file) {
   auto document = core::parse_toml(text, file);
   if (!document) return document.error();
@@ -228,7 +265,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   ctl.text("model", c.model_path);
   ctl.text("design", c.design_path);
   ctl.number("lc_mm", c.lc_mm, closed(0, 100, "mm"));
-  ctl.number("valve_limit_v", c.valve_limit_v, above(0, 10, "V"));
+  ctl.number("valve_limit_v", c.valve_limit_v, closed(0.1, 10, "V"));
   ctl.refuse_unknown_keys();
 
   TableReader lim(top.subtable("limits"), "limits", file, error);
@@ -238,19 +275,19 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   lim.number("soft_max_mm", r.soft_max_mm, closed(-10000, 10000, "mm"));
   lim.number("setpoint_min_mm", r.setpoint_min_mm, closed(-10000, 10000, "mm"));
   lim.number("setpoint_max_mm", r.setpoint_max_mm, closed(-10000, 10000, "mm"));
-  lim.number("manual_valve_limit_v", r.manual_valve_limit_v, above(0, 10, "V"));
+  lim.number("manual_valve_limit_v", r.manual_valve_limit_v, closed(0.1, 10, "V"));
   lim.number("safe_valve_v", r.safe_valve_v, closed(-10, 10, "V"));
-  lim.number("following_error_mm", r.following_error_mm, above(0, 10000, "mm"));
-  lim.number("following_error_time_s", r.following_error_time_s, closed(0, 3600, "s (0: off)"));
+  lim.number("following_error_mm", r.following_error_mm, closed(0.5, 10000, "mm"));
+  lim.number("following_error_time_s", r.following_error_time_s, zero_or(0.01, 3600, "s"));
   lim.integer("max_consecutive_io_errors", r.max_consecutive_io_errors, 1, 1000000);
-  lim.number("heartbeat_timeout_s", r.heartbeat_timeout_s, closed(0, 3600, "s (0: off)"));
-  lim.number("sensor_frozen_time_s", r.sensor_frozen_time_s, closed(0, 3600, "s (0: off)"));
-  lim.number("sensor_frozen_drive_v", r.sensor_frozen_drive_v, above(0, 10, "V"));
+  lim.number("heartbeat_timeout_s", r.heartbeat_timeout_s, zero_or(0.05, 3600, "s"));
+  lim.number("sensor_frozen_time_s", r.sensor_frozen_time_s, zero_or(0.05, 3600, "s"));
+  lim.number("sensor_frozen_drive_v", r.sensor_frozen_drive_v, closed(0.1, 10, "V"));
   lim.refuse_unknown_keys();
 
   TableReader cal(top.subtable("calibration"), "calibration", file, error);
   cal.number("sensor_offset_v", r.sensor_offset_v, closed(-100, 100, "V"));
-  cal.number("sensor_gain", r.sensor_gain, above(0, 1000, ""));
+  cal.number("sensor_gain", r.sensor_gain, closed(0.1, 10, "(model volts per sensor volt)"));
   cal.refuse_unknown_keys();
 
   TableReader start(top.subtable("startup"), "startup", file, error);
@@ -265,47 +302,53 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   TableReader rec(top.subtable("recorder"), "recorder", file, error);
   rec.text("directory", c.record_directory);
   rec.boolean("per_move", c.record_per_move);
-  rec.number("buffer_s", r.record_buffer_s, above(0, 600, "s"));
-  rec.number("move_window_s", r.move_window_s, above(0, 600, "s"));
+  rec.number("buffer_s", r.record_buffer_s, closed(1, 600, "s"));
+  rec.number("move_window_s", r.move_window_s, closed(0.1, 600, "s"));
+  rec.number("min_interval_s", r.record_min_interval_s, closed(0.1, 3600, "s"));
+  rec.number("quota_mb", c.record_quota_mb, closed(1, 1e7, "MiB"));
+  rec.number("move_files_per_minute", c.record_move_files_per_minute, closed(1, 12000, "files a minute"));
   rec.refuse_unknown_keys();
 
   TableReader mo(top.subtable("motion"), "motion", file, error);
-  mo.number("in_position_window_mm", r.in_position_window_mm, above(0, 100, "mm"));
+  mo.number("in_position_window_mm", r.in_position_window_mm, closed(0.01, 100, "mm"));
   mo.number("in_position_time_s", r.in_position_time_s, closed(0, 60, "s"));
-  mo.number("standstill_time_s", r.standstill_time_s, above(0, 60, "s"));
-  mo.number("halt_decel_mm_s2", r.halt_decel_mm_s2, above(0, 1e6, "mm/s^2"));
-  mo.number("jog_speed_mm_s", r.jog_speed_mm_s, above(0, 10000, "mm/s"));
-  mo.number("jog_accel_mm_s2", r.jog_accel_mm_s2, above(0, 1e6, "mm/s^2"));
-  mo.number("jog_keepalive_s", r.jog_keepalive_s, closed(0, 3600, "s (0: off)"));
+  mo.number("standstill_time_s", r.standstill_time_s, closed(0.05, 60, "s"));
+  mo.number("halt_decel_mm_s2", r.halt_decel_mm_s2, closed(100, 1e6, "mm/s^2"));
+  mo.number("jog_speed_mm_s", r.jog_speed_mm_s, closed(0.1, 10000, "mm/s"));
+  mo.number("jog_accel_mm_s2", r.jog_accel_mm_s2, closed(100, 1e6, "mm/s^2"));
+  mo.number("jog_keepalive_s", r.jog_keepalive_s, zero_or(0.05, 3600, "s"));
   mo.boolean("enable_holds_position", r.enable_holds_position);
   mo.refuse_unknown_keys();
 
   TableReader ex(top.subtable("excite"), "excite", file, error);
   ex.integer("seed", r.excitation.seed, 0, 4294967295);
-  ex.number("amplitude_min_v", r.excitation.amplitude_min_v, above(0, 10, "V"));
-  ex.number("amplitude_max_v", r.excitation.amplitude_max_v, above(0, 10, "V"));
+  ex.number("amplitude_min_v", r.excitation.amplitude_min_v, closed(0.05, 10, "V"));
+  ex.number("amplitude_max_v", r.excitation.amplitude_max_v, closed(0.05, 10, "V"));
   ex.number("duration_s", r.excitation.duration_s, closed(1, 600, "s"));
-  ex.number("guard_mm", r.excitation.guard_mm, above(0, 10000, "mm"));
+  ex.number("guard_mm", r.excitation.guard_mm, closed(1, 10000, "mm"));
   ex.boolean("sweep", r.excitation.sweep);
   ex.refuse_unknown_keys();
 
   TableReader st(top.subtable("store"), "store", file, error);
   st.text("path", c.store_path);
+  st.number("min_free_mb", c.store_min_free_mb, closed(1, 1e7, "MiB"));
+  st.integer("audit_max_rows", c.audit_max_rows, core::kAuditMinRows, std::int64_t{1'000'000'000});
   st.refuse_unknown_keys();
 
   TableReader log(top.subtable("log"), "log", file, error);
-  log.number("status_interval_s", c.status_interval_s, closed(0, kDay_s, "s (0: off)"));
+  log.number("status_interval_s", c.status_interval_s, zero_or(1, kDay_s, "s"));
   log.refuse_unknown_keys();
 
   TableReader mbs(top.subtable("modbus"), "modbus", file, error);
   mbs.boolean("enabled", c.modbus_enabled);
-  mbs.text("address", c.modbus.address);
+  mbs.choice<std::string>("address", c.modbus.address, listen_address);
   mbs.integer("port", c.modbus.port, 0, 65535);
   mbs.integer("unit_id", c.modbus.unit_id, 0, 247);
   mbs.integer_list("alias_unit_ids", c.modbus.alias_unit_ids, 0, 255);
   mbs.integer("max_clients", c.modbus.max_clients, 1, 1000);
-  mbs.number("idle_timeout_s", c.modbus.idle_timeout_s, above(0, kDay_s, "s"));
-  mbs.number("frame_timeout_s", c.modbus.frame_timeout_s, above(0, 60, "s"));
+  mbs.integer("max_clients_per_address", c.modbus.max_clients_per_address, 1, 1000);
+  mbs.number("idle_timeout_s", c.modbus.idle_timeout_s, closed(1, kDay_s, "s"));
+  mbs.number("frame_timeout_s", c.modbus.frame_timeout_s, closed(0.1, 60, "s"));
   mbs.text("register_map", c.register_map_path);
   mbs.boolean("read_only", c.modbus.policy.read_only);
   mbs.choice<std::optional<std::uint64_t>>("unlock_key", c.modbus.policy.unlock_key,
@@ -315,20 +358,18 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
                                               if (!key) return key.error();
                                               return std::optional<std::uint64_t>{*key};
                                             });
-  mbs.number("unlock_timeout_s", c.modbus.policy.unlock_timeout_s, above(0, kDay_s, "s"));
+  mbs.number("unlock_timeout_s", c.modbus.policy.unlock_timeout_s, closed(1, kDay_s, "s"));
   mbs.text_list("write_clients", c.modbus.policy.write_clients);
   mbs.refuse_unknown_keys();
 
   TableReader web(top.subtable("web"), "web", file, error);
   web.boolean("enabled", c.web_enabled);
-  web.text("address", c.web.address);
+  web.choice<std::string>("address", c.web.address, listen_address);
   web.integer("port", c.web.port, 0, 65535);
-  web.choice<std::string>("token", c.web.token, [](std::string_view v) -> core::Result<std::string> {
-    if (!v.empty() && v.size() < 16)
-      return core::invalid_argument("must be at least 16 characters (or \"\" for no commands): a short token is guessed");
-    return std::string(v);
-  });
+  web.choice<std::string>("token", c.web.token, web_token);
   web.text("static_dir", c.web.static_dir);
+  web.integer("max_connections_per_address", c.web.max_connections_per_address, 1, 4096);
+  web.text_list("host_names", c.web.host_names);
   web.refuse_unknown_keys();
 
   TableReader hal_table(top.subtable("hal"), "hal", file, error);
@@ -349,7 +390,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   sim.text_list("effects", c.sim_effects);
   sim.refuse_unknown_keys();
   TableReader mb(hal_table.subtable("modbus_io"), "hal.modbus_io", file, error);
-  mb.text("host", c.modbus_io.host);
+  mb.choice<std::string>("host", c.modbus_io.host, module_host);
   mb.integer("port", c.modbus_io.port, 1, 65535);
   mb.integer("unit_id", c.modbus_io.unit_id, 0, 247);
   mb.integer("response_timeout_ms", c.modbus_io.response_timeout_ms, 1, 1000);
@@ -370,6 +411,11 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
     if (c.sim_plant != "hammerstein") return core::invalid_argument(file + ": [hal.sim] effects apply to the hammerstein plant only");
     if (auto e = plant::parse_effect_specs(c.sim_effects); !e) return core::invalid_argument(file + ": [hal.sim] effects: " + e.error().message);
   }
+  for (std::string& client : c.modbus.policy.write_clients) {
+    auto ip = core::parse_ip_address(client, 0);
+    if (!ip) return core::invalid_argument(file + ": [modbus] write_clients: " + ip.error().message);
+    client = core::ip_text(ip->storage);  // the form a peer's address is compared in: ::0:1 is ::1
+  }
   if (auto s = runtime::validate(r); !s) return core::invalid_argument(file + ": " + s.error().message);
   if (c.backend == HalBackend::kModbusIo)
     if (auto s = hal::validate(c.modbus_io); !s) return core::invalid_argument(file + ": [hal.modbus_io] " + s.error().message);
@@ -379,7 +425,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
 }
 
 core::Result<ApplianceConfig> read_appliance_config(const std::string& path) {
-  auto text = core::read_text_file(path, "configuration file");
+  auto text = core::read_text_file(path, "configuration file", core::kSmallFileCapBytes);
   if (!text) return text.error();
   auto c = parse_appliance_config(*text, path);
   if (!c) return c;

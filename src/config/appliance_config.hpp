@@ -33,6 +33,10 @@ struct ApplianceConfig {
   std::string store_path = "epa.db";  // the tuning store (SQLite), relative to the working directory
   std::string record_directory = "runs";
   bool record_per_move = true;
+  double record_quota_mb = 512;            // [recorder] quota_mb: the run files' total, the oldest deleted beyond it
+  double record_move_files_per_minute = 60;  // [recorder] move_files_per_minute: more moves are not written
+  double store_min_free_mb = 256;          // [store] min_free_mb: below it, no run files and a warning
+  std::int64_t audit_max_rows = 1'000'000;  // [store] audit_max_rows: the audit log's newest rows kept
   double status_interval_s = 10.0;
 
   bool modbus_enabled = true;
@@ -57,5 +61,11 @@ struct ApplianceConfig {
 core::Result<ApplianceConfig> parse_appliance_config(const std::string& toml_text, const std::string& source_name);
 core::Result<ApplianceConfig> read_appliance_config(const std::string& path);
 const char* to_string(HalBackend backend);
+// True when any address may command motion: the Modbus server runs, writable, with no
+// [modbus] write_clients. (HTTP commands always need the [web] token.) Said at start and in
+// /api/status (any_address_may_command).
+bool any_address_may_command(const ApplianceConfig& c);
+// The start-up warning when any_address_may_command, else "".
+std::string any_address_notice(const ApplianceConfig& c);
 
 }  // namespace epa::config

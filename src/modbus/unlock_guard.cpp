@@ -2,6 +2,8 @@
 
 #include <set>
 
+#include "core/secret_strength.hpp"
+
 namespace epa::modbus {
 
 core::Result<std::uint64_t> parse_unlock_key(std::string_view text) {
@@ -33,25 +35,26 @@ core::Result<std::uint64_t> parse_unlock_key(std::string_view text) {
     down += value(i) == value(i - 1) - 1;
   }
   if (up >= 8 || down >= 8) return refuse("is mostly a run of consecutive digits: too easy to guess");
+  if (const std::string why = core::hex_words_weakness(digits); !why.empty()) return refuse(why);
   return key;
 }
 
-UnlockGuard::Attempt UnlockGuard::attempt(const std::string& address, std::uint64_t key, std::int64_t now_ns) {
+UnlockGuard::Attempt UnlockGuard::attempt(const core::Guesser& who, std::uint64_t key, std::int64_t now_ns) {
   if (!key_) {
     ++failures_;
     return {Verdict::kNoKey};
   }
-  if (backoff_.locked_until(address, now_ns) != 0) {
+  if (backoff_.refused_until(who, now_ns) != 0) {
     ++failures_;
     return {Verdict::kLockedOut};
   }
   if (key == *key_) {
-    backoff_.right(address);
+    backoff_.right(who);
     return {Verdict::kUnlocked};
   }
   ++failures_;
-  const auto lockout = backoff_.wrong(address, now_ns);
-  return {Verdict::kWrongKey, lockout.started, lockout.backoff_ns};
+  const auto lockout = backoff_.wrong(who, now_ns);
+  return {Verdict::kWrongKey, lockout.started, lockout.address_started, lockout.backoff_ns};
 }
 
 }  // namespace epa::modbus

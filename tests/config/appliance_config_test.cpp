@@ -3,7 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <iostream>
+#include <random>
 #include <regex>
+
+#include "core/secret_strength.hpp"
+#include "modbus/unlock_guard.hpp"
 
 namespace epa::config {
 namespace {
@@ -182,6 +187,132 @@ TEST(ApplianceConfig, EveryNumericKeyIsBoundedAndARefusalNamesFileLineAndKey) {
     }
   }
   EXPECT_GE(keys, 40);
+}
+
+// A listen address is an IP address, exactly: a typo is refused naming the key and the value
+// (999.1.1.1 once bound 255.255.255.255), and IPv6 is taken (the listener binds it).
+TEST(ApplianceConfig, ListenAddressesAreIpv4OrIpv6AndATypoIsRefused) {
+  for (const char* key : {"modbus", "web"}) {
+    for (const char* bad : {"999.1.1.1", "1.2.3", "1.2.3.4.5", "01.2.3.4", " 127.0.0.1", "127.0.0.1 ", "localhost", "0x7f.0.0.1", "::g",
+                            "fe80::1%eth0", ""}) {
+      const auto e = error_of(std::string("[") + key + "]\naddress = \"" + bad + "\"\n");
+      EXPECT_NE(e.find(std::string("test.toml:2: ") + key + ".address '" + bad + "' is not an IP address"), std::string::npos) << e;
+    }
+    for (const char* good : {"0.0.0.0", "127.0.0.1", "255.255.255.255", "::", "::1", "fe80::1", "2001:db8::5"}) {
+      auto c = parse_appliance_config(std::string("[") + key + "]\naddress = \"" + good + "\"\n", "test.toml");
+      ASSERT_TRUE(c.has_value()) << good << ": " << c.error().message;
+      EXPECT_EQ(std::string(key) == "modbus" ? c->modbus.address : c->web.address, good);
+    }
+  }
+  // The I/O module's host is a client address for libmodbus' IPv4-only TCP client.
+  EXPECT_NE(error_of("[hal.modbus_io]\nhost = \"300.1.1.1\"\n").find("hal.modbus_io.host '300.1.1.1' is not an IPv4 address"),
+            std::string::npos);
+  EXPECT_NE(error_of("[hal.modbus_io]\nhost = \"::1\"\n").find("hal.modbus_io.host"), std::string::npos);
+}
+
+TEST(ApplianceConfig, WriteClientsAreIpAddressesInTheFormPeersAreComparedIn) {
+  auto c = parse_appliance_config("[modbus]\nwrite_clients = [\"10.0.0.5\", \"0:0:0:0:0:0:0:1\", \"::ffff:10.0.0.6\"]\n", "t.toml");
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  EXPECT_EQ(c->modbus.policy.write_clients, (std::vector<std::string>{"10.0.0.5", "::1", "10.0.0.6"}));
+  const auto e = error_of("[modbus]\nwrite_clients = [\"10.0.0.300\"]\n");
+  EXPECT_NE(e.find("[modbus] write_clients: '10.0.0.300' is not an IP address"), std::string::npos) << e;
+}
+
+// A tiny value that passed "above zero" was as harmful as a wrong one: sensor_gain = 1e-300 blinded
+// the sensor (the piston drove into the end stop), idle_timeout_s = 1e-300 dropped every client.
+// Each such key has a physical lower bound, and the message says the range.
+TEST(ApplianceConfig, ATinyValueWhereItHarmsIsRefusedSayingTheRange) {
+  EXPECT_EQ(error_of("[modbus]\nidle_timeout_s = 1e-300\n"), "test.toml:2: modbus.idle_timeout_s = 1e-300: must be between 1 and 86400 s");
+  EXPECT_EQ(error_of("[calibration]\nsensor_gain = 1e-300\n"),
+            "test.toml:2: calibration.sensor_gain = 1e-300: must be between 0.1 and 10 (model volts per sensor volt)");
+  EXPECT_EQ(error_of("[limits]\nheartbeat_timeout_s = 1e-300\n"),
+            "test.toml:2: limits.heartbeat_timeout_s = 1e-300: must be 0 (off) or between 0.05 and 3600 s");
+  const std::vector<std::pair<std::string, std::string>> harmful = {
+      {"controller", "valve_limit_v"},        {"limits", "manual_valve_limit_v"},  {"limits", "following_error_mm"},
+      {"limits", "following_error_time_s"},   {"limits", "sensor_frozen_time_s"},  {"limits", "sensor_frozen_drive_v"},
+      {"recorder", "buffer_s"},               {"recorder", "move_window_s"},       {"motion", "in_position_window_mm"},
+      {"motion", "standstill_time_s"},        {"motion", "halt_decel_mm_s2"},      {"motion", "jog_speed_mm_s"},
+      {"motion", "jog_accel_mm_s2"},          {"motion", "jog_keepalive_s"},       {"excite", "amplitude_min_v"},
+      {"excite", "guard_mm"},                 {"log", "status_interval_s"},        {"modbus", "frame_timeout_s"},
+      {"modbus", "unlock_timeout_s"}};
+  for (const auto& [table, key] : harmful) {
+    const auto e = error_of("[" + table + "]\n" + key + " = 1e-300\n");
+    EXPECT_NE(e.find(table + "." + key + " = 1e-300: must be "), std::string::npos) << e;
+    EXPECT_NE(e.find("between"), std::string::npos) << e;
+  }
+  EXPECT_NE(error_of("[hal.modbus_io]\nsensor = { full_scale_v = 1e-300 }\n").find("full_scale_v = 1e-300: must be between 0.1"),
+            std::string::npos);
+  // 0 still switches off what has an "off".
+  auto off = parse_appliance_config("[limits]\nheartbeat_timeout_s = 0\nfollowing_error_time_s = 0\n[log]\nstatus_interval_s = 0\n", "t.toml");
+  ASSERT_TRUE(off.has_value()) << off.error().message;
+}
+
+TEST(ApplianceConfig, AWeakTokenIsRefusedSayingHowToMakeAGoodOne) {
+  for (const char* weak : {"1", "aaaaaaaaaaaaaaaa", "password12345678", "                ", "P4ssw0rd-Qz81x7!", "Adm1n-9Zq!x7Lk2v",
+                           "abcabcabcabcabca", "Xy7!Xy7!Xy7!Xy7!", "abcdefghijklmnopqrstuvwxyz", "xkqpwmzrtvbnhjlf", "My-Epa-9Zq!x7Lk2v",
+                           "Zq81x-records-token", "Qz81xAAAAAAq7!kp"}) {
+    const auto e = error_of(std::string("[web]\ntoken = \"") + weak + "\"\n");
+    EXPECT_NE(e.find("test.toml:2: web.token "), std::string::npos) << weak << ": " << e;
+    EXPECT_NE(e.find("head -c 18 /dev/urandom | base64"), std::string::npos) << weak << ": " << e;
+    if (std::string(weak).size() >= 16) {
+      EXPECT_EQ(e.find(weak), std::string::npos) << "the message repeats the secret: " << e;
+    }
+  }
+  EXPECT_NE(error_of("[web]\ntoken = \"1\"\n").find("at least 16 characters"), std::string::npos);
+  EXPECT_NE(error_of("[web]\ntoken = \"password12345678\"\n").find("common word 'password'"), std::string::npos);
+  for (const char* strong : {"q7Kx2vR9mZp4Lw8n", "Df4-cZmm1ss-Qz81x", "3f9c1a7e5b2d8064c9e1f7a3b5d20c86e4a19f73", "Gx0/3J5qkVbN8tR+Wm2eLd7Y"}) {
+    auto c = parse_appliance_config(std::string("[web]\ntoken = \"") + strong + "\"\n", "t.toml");
+    ASSERT_TRUE(c.has_value()) << strong << ": " << c.error().message;
+    EXPECT_EQ(c->web.token, strong);
+  }
+  EXPECT_TRUE(parse_appliance_config("[web]\ntoken = \"\"\n", "t.toml").has_value());  // no commands
+}
+
+TEST(ApplianceConfig, AnUnlockKeyOfHexWordsIsRefused) {
+  for (const char* weak : {"deadbeefcafebabe", "c0ffee00f00d1234", "5e3ad00dfeedface"}) {
+    const auto e = error_of(std::string("[modbus]\nunlock_key = \"") + weak + "\"\n");
+    EXPECT_NE(e.find("modbus.unlock_key is mostly well-known hex words"), std::string::npos) << weak << ": " << e;
+    EXPECT_NE(e.find("/dev/urandom"), std::string::npos) << e;
+  }
+  auto c = parse_appliance_config("[modbus]\nunlock_key = \"5e3a9c17d24b086f\"\n", "t.toml");
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+}
+
+// The rules refuse what is guessed first, not what a generator gives: random secrets of the shapes
+// the messages advise pass (nearly) always. Counted over a fixed pseudo-random sample.
+TEST(ApplianceConfig, RandomSecretsPassTheStrengthRules) {
+  std::mt19937_64 random(43);
+  const std::string base64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/", hex = "0123456789abcdef";
+  auto draw = [&](const std::string& alphabet, std::size_t n) {
+    std::string s;
+    for (std::size_t i = 0; i < n; ++i) s += alphabet[random() % alphabet.size()];
+    return s;
+  };
+  int refused_base64 = 0, refused_hex = 0, refused_keys = 0;
+  constexpr int kDraws = 5000;
+  for (int i = 0; i < kDraws; ++i) {
+    refused_base64 += !core::token_weakness(draw(base64, 24)).empty();  // head -c 18 /dev/urandom | base64
+    refused_hex += !core::token_weakness(draw(hex, 40)).empty();        // secrets.token_hex(20)
+    refused_keys += !modbus::parse_unlock_key(draw(hex, 16)).has_value();  // od -An -tx8 -N8 /dev/urandom
+  }
+  EXPECT_LE(refused_base64, kDraws / 200) << "of " << kDraws;
+  EXPECT_LE(refused_hex, kDraws / 200) << "of " << kDraws;
+  EXPECT_LE(refused_keys, kDraws / 100) << "of " << kDraws;
+  std::cout << "refused of " << kDraws << " random: base64 tokens " << refused_base64 << ", hex tokens " << refused_hex << ", keys "
+            << refused_keys << "\n";
+}
+
+TEST(ApplianceConfig, AnyAddressMayCommandUnlessWriteClientsOrReadOnlyRestrictIt) {
+  auto shipped = read_appliance_config(kShipped);
+  ASSERT_TRUE(shipped.has_value()) << shipped.error().message;
+  EXPECT_TRUE(any_address_may_command(*shipped));
+  EXPECT_NE(any_address_notice(*shipped).find("set [modbus] write_clients"), std::string::npos);
+  auto listed = parse_appliance_config("[modbus]\nwrite_clients = [\"10.0.0.5\"]\n", "t.toml");
+  ASSERT_TRUE(listed.has_value());
+  EXPECT_FALSE(any_address_may_command(*listed));
+  EXPECT_EQ(any_address_notice(*listed), "");
+  EXPECT_FALSE(any_address_may_command(*parse_appliance_config("[modbus]\nread_only = true\n", "t.toml")));
+  EXPECT_FALSE(any_address_may_command(*parse_appliance_config("[modbus]\nenabled = false\n", "t.toml")));
 }
 
 }  // namespace
