@@ -21,7 +21,7 @@ core::Result<std::string> appliance_token(const std::string& token, const std::s
     if (token.empty()) return core::invalid_argument("no token: set EPA_TOKEN, or give --token-file FILE (or --token, which shows in ps), with the appliance's [web] token");
     return token;
   }
-  auto text = core::read_text_file(token_file, "token file");
+  auto text = core::read_text_file(token_file, "token file", 64 * 1024);  // a token is one line
   if (!text) return text.error();
   std::string first = text->substr(0, text->find('\n'));
   if (!first.empty() && first.back() == '\r') first.pop_back();

@@ -49,7 +49,7 @@ int run_commission(const CommissionOptions& o, std::ostream& out, std::ostream& 
   auto fail = [&err](const std::string& m) { return err << "epa commission: " << m << "\n", 1; };
   std::string spec;
   if (!o.spec_path.empty()) {
-    auto text = core::read_text_file(o.spec_path, "commission spec");
+    auto text = core::read_text_file(o.spec_path, "commission spec", core::kSmallFileCapBytes);
     if (!text) return fail(text.error().message);
     // Read here first, so that a file that is no spec is named as the file; the appliance checks
     // the values against its own limits.

@@ -9,8 +9,10 @@
 #include "app/output_file.hpp"
 #include "app/store_save.hpp"
 #include "app/tuning_source.hpp"
+#include "control/branch_stability.hpp"
 #include "control/diophantine.hpp"
 #include "control/pole_placement_design.hpp"
+#include "core/coefficient_cap.hpp"
 #include "core/format.hpp"
 #include "core/paper_reference.hpp"
 #include "plant/stick_slip_model.hpp"
@@ -66,6 +68,7 @@ core::Result<Polynomial> parse_T(const std::vector<std::string>& words) {
     if (used != w.size() || !std::isfinite(v)) return core::invalid_argument("--T: '" + w + "' is not a number (give 'paper' or coefficients)");
     c.push_back(v);
   }
+  if (auto s = core::check_coefficient_count(c.size(), "--T"); !s) return core::invalid_argument(s.error().message);
   return Polynomial(std::move(c));
 }
 
@@ -172,10 +175,7 @@ int run_design(const DesignOptions& o, std::ostream& out, std::ostream& err) {
   // A branch whose loop is unstable: where the dead zone's slopes apply the design does not hold
   // the axis (a spec of 5 % overshoot in 0.5 s, the README's example until 2026-11-29, diverged in
   // simulation). Said last and in the exit code, and never stored as a tuning set.
-  std::string unstable;
-  for (const auto& b : branches)
-    if (b.jury.verdict == control::Stability::kUnstable)  // marginal (a root on the circle) is reported above
-      unstable += (unstable.empty() ? "" : ", ") + b.name + " (max |root| " + core::format_number(b.max_root_abs) + ")";
+  const std::string unstable = control::unstable_branches(branches);  // marginal (a root on the circle) is reported above
 
   if (!o.json_path.empty()) {
     nlohmann::json j = {{"schema", "epa-design/1"}, {"F", F.coefficients()}, {"G", G.coefficients()},

@@ -5,7 +5,9 @@
 #include <nlohmann/json.hpp>
 
 #include "app/output_file.hpp"
+#include "control/branch_stability.hpp"
 #include "core/format.hpp"
+#include "core/printable_name.hpp"
 #include "core/text_file.hpp"
 #include "core/utc_stamp.hpp"
 #include "store/audit_log.hpp"
@@ -110,6 +112,20 @@ std::vector<std::pair<std::string, std::string>> fields(const store::TuningSet& 
   return out;
 }
 
+// The branches of A F + gain B G that are unstable, on the file's model with its dead zone and,
+// when the set's own dead zone differs (what NG-IDZ and FF-IDZ invert), with that one too.
+std::string unstable_branches_of(const store::TuningFile& file) {
+  const core::HammersteinModel& model = file.model.model;
+  std::string unstable = control::unstable_branches(control::analyse_branches(model, file.set.F, file.set.G));
+  const auto& dz = file.set.dead_zone;
+  if (dz.m_l == model.dead_zone.m_l && dz.m_r == model.dead_zone.m_r) return unstable;
+  core::HammersteinModel with_set_dead_zone = model;
+  with_set_dead_zone.dead_zone = dz;
+  const std::string also = control::unstable_branches(control::analyse_branches(with_set_dead_zone, file.set.F, file.set.G));
+  if (also.empty()) return unstable;
+  return unstable + (unstable.empty() ? "" : "; ") + also + " with the set's dead zone";
+}
+
 std::string number_or_dash(const std::optional<double>& v) { return v ? core::format_number(*v) : "-"; }
 
 int list(store::Database& db, std::ostream& out) {
@@ -184,11 +200,19 @@ int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::os
     }
 
     if (cmd->got_subcommand("import")) {
-      auto text = core::read_text_file(o.file, "tuning file");
+      auto text = core::read_text_file(o.file, "tuning file", core::kSmallFileCapBytes);
       if (!text) return fail(text.error().message);
       auto file = store::parse_tuning_toml(*text, o.file);
       if (!file) return fail(file.error().message);
       if (!o.name.empty()) file->set.name = o.name;
+      if (auto st = core::check_printable_name(file->set.name, "--name"); !st) return fail(st.error().message);
+      // The set runs on the axis once active: it passes the same Jury test as `epa design --save`.
+      if (const auto unstable = unstable_branches_of(*file); !unstable.empty()) {
+        err << "epa tuning: import refused: tuning set '" << file->set.name << "' of " << o.file
+            << " is UNSTABLE: the closed loop is unstable on " << unstable
+            << "; a controller with this set does not hold the axis there (epa design shows each branch's Jury table)\n";
+        return 3;
+      }
       auto tx = store::Transaction::begin(*db);
       if (!tx) return fail(tx.error().message);
       file->model.created_ms = core::unix_time_ms();

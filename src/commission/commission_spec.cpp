@@ -7,6 +7,7 @@
 #include <set>
 
 #include "core/format.hpp"
+#include "core/strict_json.hpp"
 
 namespace epa::commission {
 
@@ -89,14 +90,11 @@ core::Status check_runnable(const CommissionSpec& spec, const ApplianceBounds& b
 }
 
 core::Result<CommissionSpec> parse_commission_spec(const std::string& text) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {  // its what() says where: "... at line 1, column 22: ..."
-    const std::string what = e.what();
-    const auto at = what.find("parse error");
-    return core::parse_error("commission spec: not valid JSON: " + (at == std::string::npos ? what : what.substr(at)));
-  }
+  // Strict (core/strict_json.hpp): valid UTF-8, each key once, bounded depth; the library's own
+  // text, which can quote the invalid bytes, never reaches an answer.
+  auto parsed = core::parse_strict_json(text, "commission spec");
+  if (!parsed) return parsed.error();
+  const nlohmann::json& j = *parsed;
   if (!j.is_object()) return core::parse_error("commission spec: a JSON object is expected, not " + std::string(j.type_name()));
   static const std::set<std::string> known = {"excitation_runs", "excitation_s", "seed", "amplitude_max_v", "controller",
                                               "overshoot_pct", "settling_s", "observer_pole", "moves_mm", "move_hold_s",

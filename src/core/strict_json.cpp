@@ -55,6 +55,8 @@ Result<nlohmann::json> parse_strict_json(std::string_view text, const std::strin
     return parse_error(r.message);
   } catch (const json::parse_error& e) {  // our words and position: the library's text may quote what broke it
     return parse_error(what + ": not valid JSON: parse error at " + line_and_column(text, e.byte > 0 ? e.byte - 1 : 0));
+  } catch (const json::out_of_range&) {  // 1e999
+    return parse_error(what + ": a number is beyond the range of a double");
   } catch (const json::exception&) {
     return parse_error(what + ": not valid JSON");
   }

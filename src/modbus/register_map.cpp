@@ -81,7 +81,7 @@ std::string_view to_string(DataType t) {
 bool is_bit_table(Table t) { return t == Table::kCoil || t == Table::kDiscreteInput; }
 
 core::Result<RegisterMap> RegisterMap::load(const std::string& path) {
-  auto text = core::read_text_file(path, "register map");
+  auto text = core::read_text_file(path, "register map", core::kSmallFileCapBytes);
   if (!text) return text.error();
   return parse(*text, path);
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/tiny_number.hpp"
 #include "modbus/exception_codes.hpp"
 
 namespace epa::modbus {
@@ -165,8 +166,8 @@ std::uint8_t RequestHandler::collect_register_writes(int address, int quantity, 
     for (int i = 0; i < e.width(); ++i) words[i] = static_cast<std::uint16_t>(be16(bytes + 2 * (a - address + i)));
     const double value = decode_value(e, words);
     // A subnormal float is what a client with the wrong word order writes (100.0 as CDAB reads
-    // 2.4e-41): within most ranges, and a setpoint of 0 mm. Nobody means one: refused, 03.
-    if (e.type == DataType::kFloat32 && std::fpclassify(static_cast<float>(value)) == FP_SUBNORMAL) return kIllegalValue;
+    // 2.4e-41): within most ranges, and a setpoint of 0 mm. Nobody means one: refused, 03 (HTTP alike).
+    if (e.type == DataType::kFloat32 && core::is_tiny_number(value)) return kIllegalValue;
     out.push_back({&e, value, e.type == DataType::kKey64 ? key_value(words) : 0});
     a += e.width();
   }

@@ -139,7 +139,7 @@ core::Result<PneumaticParams> parse_pneumatic_toml(const std::string& text, cons
 }
 
 core::Result<PneumaticParams> read_pneumatic_file(const std::string& path) {
-  auto text = core::read_text_file(path, "pneumatic plant file");
+  auto text = core::read_text_file(path, "pneumatic plant file", core::kSmallFileCapBytes);
   if (!text) return text.error();
   return parse_pneumatic_toml(*text, path);
 }

@@ -1,5 +1,6 @@
 #include "store/model_table.hpp"
 
+#include "core/printable_name.hpp"
 #include "store/polynomial_json.hpp"
 #include "store/statement.hpp"
 
@@ -33,6 +34,8 @@ core::Result<ModelRecord> read_row(const Statement& s) {
 
 core::Result<std::int64_t> ModelTable::insert(const ModelRecord& r) {
   if (r.name.empty()) return core::invalid_argument("a model needs a name");
+  // A model's name may be a file's stem (epa design --save): one printable line, as long as a file name.
+  if (auto s = core::check_printable_name(r.name, "model name", 255); !s) return s.error();
   if (auto s = r.model.validate(); !s) return core::invalid_argument("model '" + r.name + "': " + s.error().message);
   auto stmt = db_.prepare(
       "INSERT INTO models (name, created_ms, source, a_json, b_json, m_r, m_l, b_r, b_l, ts_s, mm_per_volt, fit_json) "

@@ -5,8 +5,10 @@
 #include <string_view>
 #include <toml++/toml.h>
 
+#include "core/coefficient_cap.hpp"
 #include "core/format.hpp"
 #include "core/model_file.hpp"
+#include "core/printable_name.hpp"
 #include "core/toml_document.hpp"
 #include "core/toml_keys.hpp"
 #include "core/toml_number.hpp"
@@ -19,6 +21,10 @@ namespace {
 constexpr double kMaxMagnitude = 1e6;
 
 constexpr const char* kSchema = "epa-tuning/1";
+// Free text bounds: a source is a sentence (epa identify writes up to 640 characters), design and
+// fit a one-line JSON object of a few figures and at most 64 coefficients per polynomial.
+constexpr std::size_t kMaxSourceChars = 1024;
+constexpr std::size_t kMaxJsonTextChars = 16384;
 
 std::string quoted(const std::string& s) {
   std::ostringstream out;
@@ -40,6 +46,7 @@ core::Result<double> number(const toml::table& t, const char* key, const std::st
 core::Result<core::Polynomial> polynomial(const toml::table& t, const char* key, const std::string& where) {
   const auto* arr = t.get_as<toml::array>(key);
   if (!arr) return core::parse_error(where + " " + key + " is missing or not an array of numbers");
+  if (auto s = core::check_coefficient_count(arr->size(), where + " " + key); !s) return s.error();
   std::vector<double> c;
   for (std::size_t i = 0; i < arr->size(); ++i) {
     auto v = arr->get(i)->value<double>();
@@ -49,6 +56,16 @@ core::Result<core::Polynomial> polynomial(const toml::table& t, const char* key,
     c.push_back(*v);
   }
   return core::Polynomial(std::move(c));
+}
+
+// The free text of a file reaches the log, the store and `epa tuning list`: one printable line
+// each (core/printable_name.hpp), so a name cannot forge a line there. `table` prefixes the keys.
+core::Status free_text_fits(const std::string& src, const std::string& name, const std::string& source,
+                            const std::string& json_text, const std::string& table) {
+  const std::string where = src + ": " + table;
+  if (auto s = core::check_printable_name(name, where + "name"); !s) return s;
+  if (auto s = core::check_printable_text(source, where + "source", kMaxSourceChars); !s) return s;
+  return core::check_printable_text(json_text, where + (table.empty() ? "design" : "fit"), kMaxJsonTextChars);
 }
 
 }  // namespace
@@ -90,6 +107,7 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
   if (t.name.empty()) return core::parse_error(src + ": name is missing");
   t.source = root["source"].value_or(std::string());
   t.design_json = root["design"].value_or(std::string("{}"));
+  if (auto s = free_text_fits(src, t.name, t.source, t.design_json, ""); !s) return s.error();
   auto kind = control::parse_controller_kind(root["controller"].value_or(std::string()));
   if (!kind) return core::parse_error(src + ": controller: " + kind.error().message);
   t.controller = *kind;
@@ -136,6 +154,7 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
   f.model.name = (*model)["name"].value_or(std::string());
   if (f.model.name.empty()) return core::parse_error(src + ": [model] name is missing");
   f.model.fit_json = (*model)["fit"].value_or(std::string("{}"));
+  if (auto s = free_text_fits(src, f.model.name, "", f.model.fit_json, "[model] "); !s) return s.error();
   // The rest of [model] is an epa-model/1 document: read it with the model file's own reader.
   toml::table model_doc = *model;
   model_doc.erase("name");

@@ -2,6 +2,7 @@
 
 #include <charconv>
 
+#include "core/printable_name.hpp"
 #include "store/polynomial_json.hpp"
 #include "store/statement.hpp"
 
@@ -66,6 +67,8 @@ core::Result<std::vector<TuningSet>> read_all(Statement& stmt) {
 
 core::Result<std::int64_t> TuningSetTable::insert(const TuningSet& t) {
   if (t.name.empty()) return core::invalid_argument("a tuning set needs a name");
+  // Every way in (import, design --save, commissioning) passes here: a name reaches the log and `tuning list`.
+  if (auto s = core::check_printable_name(t.name, "tuning set name"); !s) return s.error();
   auto stmt = db_.prepare(
       "INSERT INTO tuning_sets (name, modified_ms, source, model_id, controller, f_json, g_json, h_json, design_json, "
       "m_r, m_l, b_r, b_l, lc_mm, valve_limit_v, trajectory_json, created_ms) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");

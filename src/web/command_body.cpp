@@ -1,9 +1,13 @@
 #include "web/command_body.hpp"
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <utility>
 
 #include "control/controller_kind.hpp"
+#include "core/format.hpp"
+#include "core/strict_json.hpp"
+#include "core/tiny_number.hpp"
 #include "points/point_catalog.hpp"
 #include "points/record_controller.hpp"
 #include "runtime/mode.hpp"
@@ -22,7 +26,13 @@ CommandBody malformed(std::string message) { return {std::move(message), {}}; }
 // One point's value from JSON: a number, a boolean (1/0), or for mode and controller their name.
 std::optional<double> value_of(P id, const json& v, std::string& error) {
   const std::string point(points::name(id));
-  if (v.is_number()) return v.get<double>();
+  if (v.is_number()) {
+    // Refused as Modbus refuses them (core/tiny_number.hpp): no interface takes a value the other refuses.
+    const double number = v.get<double>();
+    if (std::isfinite(number) && !core::is_tiny_number(number)) return number;
+    error = point + " " + core::format_number(number) + " is not a usable number (non-zero values below 1.2e-38 and non-finite ones are refused)";
+    return std::nullopt;
+  }
   if (v.is_boolean()) return v.get<bool>() ? 1.0 : 0.0;
   if (v.is_string() && id == P::kMode) {
     auto m = runtime::parse_mode(v.get<std::string>());
@@ -81,8 +91,10 @@ CommandBody record_body(const json& j) {
 CommandBody parse_command_body(CommandEndpoint endpoint, const std::string& body) {
   json j = json::object();
   if (!body.empty()) {
-    j = json::parse(body, nullptr, /*allow_exceptions=*/false);
-    if (j.is_discarded()) return malformed("the request body is not valid JSON");
+    // Strict: valid UTF-8, each key once, bounded depth (core/strict_json.hpp), in words of ours.
+    auto parsed = core::parse_strict_json(body, "the request body");
+    if (!parsed) return malformed(parsed.error().message);
+    j = std::move(*parsed);
   }
   if (!j.is_object()) return malformed("the request body must be a JSON object");
 
