@@ -7,8 +7,13 @@
 
 namespace epa::app {
 
-CommissionService::CommissionService(AxisFactory make_axis, commission::Identify identify, commission::ApplianceBounds bounds, Log log)
-    : make_axis_(std::move(make_axis)), identify_(std::move(identify)), bounds_(std::move(bounds)), log_(std::move(log)) {}
+CommissionService::CommissionService(AxisFactory make_axis, commission::Identify identify, commission::ApplianceBounds bounds, Log log,
+                                     core::AuditSink* audit)
+    : make_axis_(std::move(make_axis)), identify_(std::move(identify)), bounds_(std::move(bounds)), log_(std::move(log)), audit_(audit) {}
+
+void CommissionService::audit(const std::string& source, double command) const {
+  if (audit_) audit_->record({{core::unix_time_ms(), source, "commission_command", 0.0, command}});
+}
 
 CommissionService::~CommissionService() {
   {
@@ -30,6 +35,7 @@ points::CommissionStartResult CommissionService::start(const std::string& spec_j
   sequence_ = std::make_unique<commission::CommissionSequence>(*axis_, identify_, log_);
   running_ = true;
   if (log_) log_("commission: started by " + source + " with spec " + commission::format_commission_spec(*spec));
+  audit(source, 1.0);
   thread_ = std::thread([this, s = *spec] {
     const auto outcome = sequence_->run(s);
     auto json = commission::format_commission_json(outcome);
@@ -47,6 +53,7 @@ bool CommissionService::abort(const std::string& source) {
   std::lock_guard lock(mutex_);
   if (!running_) return false;
   if (log_) log_("commission: abort requested by " + source);
+  audit(source, 2.0);  // under the one who aborts: what the run does next stays under its starter
   sequence_->abort();
   return true;
 }

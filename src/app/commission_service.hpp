@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "commission/axis.hpp"
+#include "core/audit.hpp"
 #include "commission/commission_sequence.hpp"
 #include "commission/commission_spec.hpp"
 #include "web/commission_port.hpp"
@@ -23,7 +24,10 @@ class CommissionService final : public web::CommissionPort {
   using AxisFactory = std::function<std::unique_ptr<commission::Axis>(const std::string& source)>;
 
   // `bounds`: what this appliance can run; a spec beyond them is refused before the axis is touched.
-  CommissionService(AxisFactory make_axis, commission::Identify identify, commission::ApplianceBounds bounds, Log log);
+  // `audit`: where a start and an abort are audited, each under the source that asked for it,
+  // whichever interface it came through.
+  CommissionService(AxisFactory make_axis, commission::Identify identify, commission::ApplianceBounds bounds, Log log,
+                    core::AuditSink* audit = nullptr);
   ~CommissionService() override;  // aborts a run under way and waits for it (the valve safe)
   CommissionService(const CommissionService&) = delete;
   CommissionService& operator=(const CommissionService&) = delete;
@@ -43,6 +47,8 @@ class CommissionService final : public web::CommissionPort {
   commission::Identify identify_;
   commission::ApplianceBounds bounds_;
   Log log_;
+  core::AuditSink* audit_;
+  void audit(const std::string& source, double command) const;  // commission_command: 1 start, 2 abort
   mutable std::mutex mutex_;
   std::unique_ptr<commission::Axis> axis_;
   std::unique_ptr<commission::CommissionSequence> sequence_;

@@ -25,6 +25,7 @@
 #include "core/audit.hpp"
 #include "core/format.hpp"
 #include "core/version.hpp"
+#include "core/log_throttle.hpp"
 #include "hal/realtime.hpp"
 #include "runtime/clock.hpp"
 #include "runtime/recorder.hpp"
@@ -58,6 +59,12 @@ namespace {
 constexpr std::size_t kThreadStackBytes = 512 * 1024;
 
 // Applies the command-line overrides on top of the file, re-validating what they touch.
+// Lines of one repeatable kind (audit, move, refused) logged a minute: enough to follow a person
+// at work, far below what a flooding client would make the log hold.
+constexpr int kLinesPerMinute = 30;
+
+std::uint64_t mib(double megabytes) { return static_cast<std::uint64_t>(megabytes * 1024 * 1024); }
+
 core::Status apply_overrides(const ServeOptions& o, config::ApplianceConfig& c) {
   if (!o.hal.empty()) {
     if (o.hal == "sim") c.backend = config::HalBackend::kSim;
@@ -183,7 +190,8 @@ core::Result<std::unique_ptr<web::WebServer>> start_web(const config::ApplianceC
   auto store_stats = [&store] {
     const auto counters = store.counters();
     const auto health = store.health();
-    return web::StoreStats{true, health.ok, counters.accepted, counters.saved, health.last_error, store.running_set().name};
+    return web::StoreStats{true, health.ok, counters.accepted, counters.saved, health.last_error, store.running_set().name,
+                           counters.disk_low};
   };
   web::WebConfig web_config = c.web;
   web_config.log = [](const std::string& line) { spdlog::warn("{}", line); };
@@ -196,16 +204,26 @@ core::Result<std::unique_ptr<web::WebServer>> start_web(const config::ApplianceC
 
 // What the operator should read in the log between two snapshots: mode changes, moves. (Faults
 // come from the loop's events: take_fault_events.)
-void log_changes(const runtime::Snapshot& previous, const runtime::Snapshot& s) {
+// A line of a kind a client can repeat at request speed (moves, refusals, audit entries), through
+// the throttle: the held-back ones are counted in the next summary.
+void log_throttled(core::LogThrottle& throttle, const char* kind, spdlog::level::level_enum level, const std::string& line) {
+  std::string summary;
+  const bool admitted = throttle.admit(kind, summary);
+  if (!summary.empty()) spdlog::log(level, "{}", summary);
+  if (admitted) spdlog::log(level, "{}", line);
+}
+
+void log_changes(const runtime::Snapshot& previous, const runtime::Snapshot& s, core::LogThrottle& throttle) {
   if (s.mode != previous.mode) spdlog::info("mode {} -> {}", runtime::to_string(previous.mode), runtime::to_string(s.mode));
   if (s.fault_events_dropped != previous.fault_events_dropped)
     spdlog::warn("{} fault(s) latched with the fault event ring full: counted in faults, missing from the fault history",
                  s.fault_events_dropped - previous.fault_events_dropped);
   if (s.moves != previous.moves)
-    spdlog::info("move {} {:.1f} -> {:.1f} mm ({}, {}): rise {:.3f} s, settling {:.3f} s, e_ss {:.2f} mm, overshoot {:.1f} %",
-                 s.last_move.number, s.last_move.from_mm, s.last_move.to_mm, control::to_string(s.last_move.controller),
-                 core::to_string(static_cast<core::MoveEnd>(s.last_move.end)), s.last_move.rise_s, s.last_move.settling_s,
-                 s.last_move.ess_mm, s.last_move.overshoot_pct);
+    log_throttled(throttle, "move", spdlog::level::info,
+                  fmt::format("move {} {:.1f} -> {:.1f} mm ({}, {}): rise {:.3f} s, settling {:.3f} s, e_ss {:.2f} mm, overshoot {:.1f} %",
+                              s.last_move.number, s.last_move.from_mm, s.last_move.to_mm, control::to_string(s.last_move.controller),
+                              core::to_string(static_cast<core::MoveEnd>(s.last_move.end)), s.last_move.rise_s,
+                              s.last_move.settling_s, s.last_move.ess_mm, s.last_move.overshoot_pct));
 }
 
 // Each fault the loop latched, from its event, never from the snapshot (a reset in the next cycle
@@ -237,7 +255,7 @@ void take_fault_events(runtime::LoopChannels& channels, store::StoreWriter& stor
 // so a stuck loop gets the unit restarted.
 enum class StopCause { kSignal, kDuration };
 StopCause supervise(const config::ApplianceConfig& c, double duration_s, runtime::LoopChannels& channels, points::WriteGate& gate,
-                    store::StoreWriter& store_writer, const sigset_t& signals) {
+                    store::StoreWriter& store_writer, const sigset_t& signals, core::LogThrottle& throttle) {
   std::uint64_t watchdog_usec = 0;
   const bool watchdog = sd_watchdog_enabled(0, &watchdog_usec) > 0;
   const auto started = std::chrono::steady_clock::now();
@@ -254,8 +272,9 @@ StopCause supervise(const config::ApplianceConfig& c, double duration_s, runtime
     const auto now = std::chrono::steady_clock::now();
     const runtime::Snapshot s = channels.snapshot.read();
     take_fault_events(channels, store_writer);
-    log_changes(previous, s);
-    gate.take_refusals([](const std::string& line) { spdlog::warn("{}", line); });
+    log_changes(previous, s, throttle);
+    gate.take_refusals([&throttle](const std::string& line) { log_throttled(throttle, "refused", spdlog::level::warn, line); });
+    for (const std::string& summary : throttle.due_summaries()) spdlog::info("{}", summary);
     previous = s;
     if (c.status_interval_s > 0 && now - last_status >= std::chrono::duration<double>(c.status_interval_s)) {
       spdlog::info("status: {}", describe_snapshot(s));
@@ -314,6 +333,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   store::StoreWriter& store_writer = *control->store.writer;
   auto daq = make_daq(c, control->plant_model.model);
   if (!daq) return fail(daq.error());
+  store_writer.set_limits({.audit_max_rows = c.audit_max_rows, .min_free_bytes = mib(c.store_min_free_mb)});
   spdlog::info("epa {} serve starting: config {}, DAQ {}", core::kVersion, o.config_path, (*daq)->describe());
   if (auto s = (*daq)->open(); !s) {
     spdlog::error("DAQ: {}", s.error().message);
@@ -350,7 +370,8 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
     loop.run(loop_thread.stop);
   });
   for (int i = 0; i < 200 && channels.snapshot.read().cycle == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  LogAuditSink log_audit(&store_writer);
+  core::LogThrottle log_throttle(kLinesPerMinute, 60.0);
+  LogAuditSink log_audit(log_throttle, &store_writer);
   web::RecentAudit audit(&log_audit);  // the last entries for the status page, the log, the store
   points::WriteGate gate(std::move(*limits), c.runtime, control->tuning_base, channels, &audit, control->store.records);  // every interface's writes
   // Commissioning (issue 19): its axis is this loop, through the gate, the recorder and the store.
@@ -369,7 +390,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
       .excitation_max_source = limits_now.range(points::PointId::kExciteDuration).max.source,
       .amplitude_max_v = limits_now.range(points::PointId::kExciteAmplitudeMax).max.value};
   auto commissioning = std::make_unique<CommissionService>(make_axis, identify_for_commissioning(c.runtime.mm_per_volt), bounds,
-                                                           [](const std::string& line) { spdlog::info("{}", line); });
+                                                           [](const std::string& line) { spdlog::info("{}", line); }, &audit);
   gate.attach_commission(commissioning.get());
   // The web server starts first, so the Modbus identity names the port it bound (VendorUrl; with
   // `port = 0` only the bind knows it), and stops first (declared after the Modbus server): its
@@ -390,8 +411,12 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
     modbus_for_web = modbus_server.get();
   }
   runtime::Recorder recorder({.directory = c.record_directory, .per_move = c.record_per_move, .Ts = c.runtime.period_s,
-                              .source = std::string("appliance/") + to_string(c.backend)},
-                             channels, [](const std::string& line) { spdlog::info("{}", line); },
+                              .source = std::string("appliance/") + to_string(c.backend),
+                              .quota_bytes = mib(c.record_quota_mb),
+                              .move_files_per_minute = c.record_move_files_per_minute,
+                              .min_free_bytes = mib(c.store_min_free_mb)},
+                             channels,
+                             [&log_throttle](const std::string& line) { log_throttled(log_throttle, "recorder", spdlog::level::info, line); },
                              [&store_writer, &recorded](const std::string& path, const core::Run& run) {
                                store_writer.record_run(to_run_record(path, run));
                                recorded.put(path, run);
@@ -400,7 +425,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
 
   sd_notify(0, "READY=1");
   spdlog::info("running");
-  const StopCause cause = supervise(c, o.duration_s, channels, gate, store_writer, signals);
+  const StopCause cause = supervise(c, o.duration_s, channels, gate, store_writer, signals, log_throttle);
 
   sd_notify(0, "STOPPING=1");
   if (web_server) web_server->stop();        // no more commands from either interface;

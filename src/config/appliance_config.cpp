@@ -305,7 +305,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   rec.number("buffer_s", r.record_buffer_s, closed(1, 600, "s"));
   rec.number("move_window_s", r.move_window_s, closed(0.1, 600, "s"));
   rec.number("min_interval_s", r.record_min_interval_s, closed(0.1, 3600, "s"));
-  rec.number("quota_mb", c.record_quota_mb, closed(1, 1e7, "MiB"));
+  rec.number("quota_mb", c.record_quota_mb, closed(0.01, 1e7, "MiB"));  // tiny: only the newest file kept
   rec.number("move_files_per_minute", c.record_move_files_per_minute, closed(1, 12000, "files a minute"));
   rec.refuse_unknown_keys();
 

@@ -38,6 +38,7 @@ points::InterfaceStatus RequestHandler::status(const Session& session, std::int6
   const core::ChangeCounters changes = gate_.counters();
   points::InterfaceStatus s{static_cast<std::uint32_t>(changes.accepted), static_cast<std::uint32_t>(changes.saved), changes.saving,
                             requests_, clients_, now_ns >= session.unlocked_until_ns, unlock_.failures(), gate_.commission_view()};
+  s.disk_low = changes.disk_low;
   s.records = gate_.records();
   s.record_select = gate_.record_select();
   s.fault_history_count = channels_.fault_history.copy_newest(s.recent_faults);

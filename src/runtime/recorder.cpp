@@ -101,8 +101,8 @@ void Recorder::write(const RecordRequest& request) {
   run.set_meta("controller", request.open_loop ? "open-loop" : std::string(control::to_string(request.controller)));
   run.set_meta("source", config_.source);
   const auto first = ch_.samples.copy_out(request.first, request.end, run);
-  if (run.size() == 0) {
-    if (log_) log_("recorder: no samples left to write (the ring was overwritten)");
+  if (run.size() == 0) {  // a move cut short in the cycle it began has none; else the loop lapped them
+    if (log_ && request.end > request.first) log_("recorder: no samples left to write (the ring was overwritten)");
     return;
   }
   if (request.open_loop) {  // no reference and no controller output: only what the valve got and the piston did

@@ -117,9 +117,15 @@ void StoreWriter::drop_beyond_retention() {
     if (log_) log_("store: cannot drop rows beyond the retention: " + (!audit ? audit.error() : runs.error()).message);
     return;
   }
-  if (*audit > 0 && log_)
-    log_("store: dropped the " + std::to_string(*audit) + " oldest audit rows (retention: the newest " +
+  // Said once a minute at most: under a write flood the retention runs every second.
+  dropped_audit_rows_ += static_cast<std::uint64_t>(*audit);
+  const std::int64_t now_ms = core::unix_time_ms();
+  if (dropped_audit_rows_ > 0 && log_ && (now_ms - dropped_logged_ms_ >= 60'000 || now_ms < dropped_logged_ms_)) {
+    log_("store: dropped the " + std::to_string(dropped_audit_rows_) + " oldest audit rows since the last report (retention: the newest " +
          std::to_string(std::max(limits.audit_max_rows, core::kAuditMinRows)) + ")");
+    dropped_audit_rows_ = 0;
+    dropped_logged_ms_ = now_ms;
+  }
 }
 
 StoreHealth StoreWriter::health() const {

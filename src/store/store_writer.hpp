@@ -101,6 +101,8 @@ class StoreWriter final : public core::AuditSink {
   std::mutex write_mutex_;  // one writer at a time: the thread, or a direct flush()
   StoreLimits limits_;
   std::uint64_t rows_since_retention_ = 1000;  // under write_mutex_; the first saved batch runs the retention
+  std::uint64_t dropped_audit_rows_ = 0;       // not reported yet (under write_mutex_)
+  std::int64_t dropped_logged_ms_ = 0;
   mutable std::int64_t disk_checked_ms_ = 0;  // disk_low_ is refreshed at most once a second (under mutex_)
   mutable bool disk_low_ = false;
   bool disk_low_now() const;  // mutex_ held

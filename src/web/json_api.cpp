@@ -51,7 +51,7 @@ json status_bits(std::uint16_t word) {
 
 std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled, const StoreStats& store) {
   const bool faulted = s.mode == runtime::Mode::kFault;
-  const std::uint16_t word = points::status_word(s, store.ok);
+  const std::uint16_t word = points::status_word(s, store.ok && !store.disk_low);
   json j = {
       {"version", std::string(core::kVersion)},
       {"cycle", s.cycle},
@@ -93,7 +93,8 @@ std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, b
       {"store",
        {{"enabled", store.enabled}, {"ok", store.ok}, {"accepted", store.accepted}, {"saved", store.saved},
         {"last_error", store.last_error.empty() ? json(nullptr) : json(store.last_error)},
-        {"tuning_set", store.enabled ? json(store.tuning_set) : json(nullptr)}}},
+        {"tuning_set", store.enabled ? json(store.tuning_set) : json(nullptr)},
+        {"disk_low", store.disk_low}}},
       {k(P::kStatusWord), word},
       {"status_bits", status_bits(word)},
       {k(P::kControlWord), s.axis.control_word},

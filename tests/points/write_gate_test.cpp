@@ -171,9 +171,9 @@ TEST(WriteGate, CommissionCommandIsUnlockProtectedWrittenAloneAndGoesToTheServic
   EXPECT_EQ(gate.submit({&start, 1}, kOperator).refusal, Refusal::kConflict);  // one run at a time
   ASSERT_TRUE(gate.submit({&abort, 1}, kOperator).accepted());
   EXPECT_EQ(gate.submit({&abort, 1}, kOperator).refusal, Refusal::kConflict);  // nothing to abort
-  ASSERT_EQ(sink.entries.size(), 2u);
-  EXPECT_EQ(sink.entries[0].point, "commission_command");
-  EXPECT_DOUBLE_EQ(sink.entries[1].new_value, 2.0);
+  // The service audits a start and an abort, each under its own source, for every interface
+  // (app/commission_service.cpp); the gate adds no second entry.
+  EXPECT_TRUE(sink.entries.empty());
 }
 
 TEST(WriteGate, AGroupIsTakenWholeOrNotAtAll) {
