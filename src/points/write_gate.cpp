@@ -402,8 +402,7 @@ GateResult WriteGate::commission(std::span<const PointWrite> writes, const Reque
   } else if (!commission_->abort(who.source)) {
     return refuse(Refusal::kConflict, "commission_command: no commissioning run is under way");
   }
-  if (audit_) audit_->record({{core::unix_time_ms(), who.source, std::string(name(PointId::kCommissionCommand)), 0.0, value}});
-  return {};
+  return {};  // audited by the service, under who.source, as a start or abort from any interface
 }
 
 GateResult WriteGate::replace_tuning(const control::ControllerConfig& replacement, const Requester& who, const core::AuditEntry& entry) {
