@@ -171,9 +171,10 @@ core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const config::A
   const auto& p = c.modbus.policy;
   std::string aliases;
   for (const int id : c.modbus.alias_unit_ids) aliases += (aliases.empty() ? ", also " : " and ") + std::to_string(id);
-  spdlog::info("modbus: listening on {}:{} (unit {}{}, map {}, {} points, {})", c.modbus.address, (*server)->port(),
+  spdlog::info("modbus: listening on {} (unit {}{}, map {}, {} points, {})", (*server)->bound_address(),
                c.modbus.unit_id, aliases, c.register_map_path, map.entries().size(),
                p.read_only ? "read-only" : p.unlock_key ? "tuning locked until unlocked" : "tuning locked (no unlock key)");
+  if (const std::string notice = config::any_address_notice(c); !notice.empty()) spdlog::warn("{}", notice);
   return server;
 }
 
@@ -183,9 +184,9 @@ core::Result<std::unique_ptr<web::WebServer>> start_web(const config::ApplianceC
                                                         points::WriteGate& gate, web::RecentAudit& audit,
                                                         const std::atomic<const modbus::ModbusServer*>& modbus,
                                                         const store::StoreWriter& store, web::CommissionPort* commission) {
-  auto modbus_stats = [&modbus] {
+  auto modbus_stats = [&modbus, any_address = config::any_address_may_command(c)] {
     const modbus::ModbusServer* mb = modbus.load();
-    return mb ? web::ModbusStats{true, mb->clients(), mb->requests(), mb->exceptions()} : web::ModbusStats{};
+    return mb ? web::ModbusStats{true, mb->clients(), mb->requests(), mb->exceptions(), any_address} : web::ModbusStats{};
   };
   auto store_stats = [&store] {
     const auto counters = store.counters();
@@ -197,7 +198,7 @@ core::Result<std::unique_ptr<web::WebServer>> start_web(const config::ApplianceC
   web_config.log = [](const std::string& line) { spdlog::warn("{}", line); };
   auto server = web::WebServer::start(web_config, channels, &gate, &audit, modbus_stats, store_stats, commission);
   if (!server) return server.error();
-  spdlog::info("web: listening on {}:{} (static files {}, commands {})", c.web.address, (*server)->port(), c.web.static_dir,
+  spdlog::info("web: listening on {} (static files {}, commands {})", (*server)->bound_address(), c.web.static_dir,
                c.web.token.empty() ? "disabled: no token configured" : "enabled with the token");
   return server;
 }

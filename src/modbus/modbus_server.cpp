@@ -13,6 +13,7 @@
 #include <cstring>
 #include <vector>
 
+#include "core/ip_address.hpp"
 #include "core/listen_backlog.hpp"
 #include "runtime/clock.hpp"
 
@@ -76,19 +77,24 @@ struct ModbusServer::Impl {
 core::Result<std::unique_ptr<ModbusServer>> ModbusServer::start(const ServerConfig& c, const RegisterMap& map,
                                                                 points::WriteGate& gate, runtime::LoopChannels& ch, Log log) {
   const std::string where = c.address + ":" + std::to_string(c.port);
+  // Our own listener (IPv4 or IPv6, exactly the address given); libmodbus' context only builds
+  // the answers, so its own address (it takes IPv4 only) is never used.
+  auto address = core::parse_ip_address(c.address, c.port);
+  if (!address) return core::invalid_argument("modbus: address " + address.error().message);
   auto impl = std::make_unique<Impl>(c, map, gate, ch, std::move(log));
-  impl->ctx = modbus_new_tcp(c.address.c_str(), c.port);
-  if (!impl->ctx) return core::invalid_argument("modbus: cannot listen on " + where + ": " + modbus_strerror(errno));
+  impl->ctx = modbus_new_tcp(nullptr, c.port);
+  if (!impl->ctx) return core::io_error("modbus: cannot create the answering context: " + std::string(modbus_strerror(errno)));
   impl->image = new_register_image(map);  // bit tables padded to 16: the reserved bits read 0
   if (!impl->image) return core::io_error("modbus: cannot allocate the register image");
-  impl->listener = modbus_tcp_listen(impl->ctx, core::kListenBacklog);
-  if (impl->listener < 0) return core::io_error("modbus: cannot listen on " + where + ": " + modbus_strerror(errno));
-  fcntl(impl->listener, F_SETFL, O_NONBLOCK);
-  sockaddr_in addr{};
-  socklen_t len = sizeof addr;
-  getsockname(impl->listener, reinterpret_cast<sockaddr*>(&addr), &len);
+  auto listener = core::open_listener(*address, core::kListenBacklog, where);
+  if (!listener) return core::io_error("modbus: " + listener.error().message);
+  impl->listener = *listener;
+  sockaddr_storage bound{};
+  socklen_t len = sizeof bound;
+  getsockname(impl->listener, reinterpret_cast<sockaddr*>(&bound), &len);
   std::unique_ptr<ModbusServer> server(new ModbusServer(std::move(impl)));
-  server->port_ = ntohs(addr.sin_port);
+  server->port_ = core::port_of(bound);
+  server->bound_ = core::endpoint_text(bound);
   server->thread_ = std::thread([s = server.get()] { s->serve(); });
   return server;
 }
@@ -124,21 +130,19 @@ void ModbusServer::serve() {
 
     if (fds[0].revents & POLLIN) {
       for (;;) {
-        sockaddr_in peer{};
+        sockaddr_storage peer{};  // IPv4 or IPv6; "::" hands IPv4 peers over as mapped addresses (ip_text unmaps them)
         socklen_t len = sizeof peer;
         const int fd = accept4(m.listener, reinterpret_cast<sockaddr*>(&peer), &len, SOCK_NONBLOCK | SOCK_CLOEXEC);
         if (fd < 0) break;
-        char ip[INET_ADDRSTRLEN] = "?";
-        inet_ntop(AF_INET, &peer.sin_addr, ip, sizeof ip);
+        const std::string ip = core::ip_text(peer);
         if (static_cast<int>(m.clients.size()) >= m.config.max_clients)
           drop(eviction_candidate(m.clients), "evicted: max_clients reached and it was idle the longest");
         const int one = 1;
         setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-        sockaddr_in local{};
+        sockaddr_storage local{};
         socklen_t local_len = sizeof local;
-        char local_ip[INET_ADDRSTRLEN] = "";
-        if (getsockname(fd, reinterpret_cast<sockaddr*>(&local), &local_len) == 0) inet_ntop(AF_INET, &local.sin_addr, local_ip, sizeof local_ip);
-        Session session{ip, std::string(ip) + ":" + std::to_string(ntohs(peer.sin_port)), 0, local_ip};
+        const std::string local_ip = getsockname(fd, reinterpret_cast<sockaddr*>(&local), &local_len) == 0 ? core::url_host(local) : "";
+        Session session{ip, core::endpoint_text(peer), 0, local_ip};
         m.clients.push_back({fd, std::move(session), {}, now, -1, false, 0});
       }
     }

@@ -19,7 +19,7 @@
 namespace epa::modbus {
 
 struct ServerConfig {
-  std::string address = "0.0.0.0";  // IPv4 address to listen on
+  std::string address = "0.0.0.0";  // IPv4 or IPv6 address to listen on ("::": IPv6 and IPv4)
   int port = 502;                    // 0: any free port (see port())
   int unit_id = 1;
   std::vector<int> alias_unit_ids = kDefaultAliasUnitIds;  // also answered as this device; others get 0B
@@ -42,6 +42,8 @@ class ModbusServer {
   ModbusServer& operator=(const ModbusServer&) = delete;
 
   int port() const { return port_; }
+  // What the listener is bound to (getsockname): "127.0.0.1:502", "[::1]:502".
+  const std::string& bound_address() const { return bound_; }
   int clients() const { return clients_.load(); }
   std::uint64_t requests() const { return requests_.load(); }
   std::uint64_t exceptions() const { return exceptions_.load(); }
@@ -54,6 +56,7 @@ class ModbusServer {
 
   std::unique_ptr<Impl> impl_;
   int port_ = 0;
+  std::string bound_;
   std::atomic<bool> stop_{false};
   std::atomic<int> clients_{0};
   std::atomic<std::uint64_t> requests_{0}, exceptions_{0};

@@ -99,6 +99,7 @@ std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, b
       {"status_bits", status_bits(word)},
       {k(P::kControlWord), s.axis.control_word},
       {"commands_enabled", commands_enabled},
+      {"any_address_may_command", modbus.any_address_may_command},
   };
   return j.dump();
 }

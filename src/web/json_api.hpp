@@ -20,6 +20,7 @@ struct ModbusStats {
   bool enabled = false;
   int clients = 0;
   std::uint64_t requests = 0, exceptions = 0;
+  bool any_address_may_command = false;  // writable with no [modbus] write_clients: anyone on the network may move the axis
 };
 
 // What the tuning store reports (enabled = false when the appliance runs without one).

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "core/address_backoff.hpp"
+#include "core/ip_address.hpp"
 #include "core/listen_backlog.hpp"
 #include "runtime/clock.hpp"
 #include "web/command_body.hpp"
@@ -90,6 +91,7 @@ struct WebServer::Impl {
   TrendBuffer trend;
   std::string chart_js;
   int port = 0;
+  std::string bound;  // getsockname of the listener: "127.0.0.1:8080", "[::1]:8080"
   std::atomic<std::uint64_t> requests{0};
   std::atomic<bool> listen_returned{false};
 
@@ -370,6 +372,8 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
   });
   impl->routes();
 
+  // Exactly an IP address: httplib would resolve a name, and bind what the resolver says.
+  if (auto a = core::parse_ip_address(config.address, config.port); !a) return core::invalid_argument("web: address " + a.error().message);
   if (config.port == 0) {
     impl->port = s.bind_to_any_port(config.address);
     if (impl->port <= 0) return core::io_error("web: cannot bind to " + config.address + " (any port)");
@@ -381,6 +385,7 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
   }
   if (*listening_socket == INVALID_SOCKET || ::listen(*listening_socket, core::kListenBacklog) != 0)
     return core::io_error("web: cannot enlarge the listen queue of " + config.address + ":" + std::to_string(impl->port));
+  impl->bound = core::bound_endpoint(*listening_socket);
   Impl* p = impl.get();
   p->sampler = std::thread([p] { p->sample_until_stopped(); });
   p->listener = std::thread([p] {
@@ -394,6 +399,7 @@ WebServer::WebServer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 WebServer::~WebServer() { stop(); }
 
 int WebServer::port() const { return impl_->port; }
+const std::string& WebServer::bound_address() const { return impl_->bound; }
 
 void WebServer::stop() {
   {

@@ -24,7 +24,7 @@ set -uo pipefail
 source "$(dirname "$0")/../support/appliance.sh" command-panel
 test_arguments 3 "<epa binary> <source dir> <artifacts dir>" "$@"
 artifacts=$3
-token="panel-test-token-0123456789"
+token="X8DGaf4hnkECJ9wmbmrjCJ8M"
 need chromium
 need curl
 mkdir -p "$artifacts"

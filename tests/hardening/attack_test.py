@@ -374,7 +374,7 @@ def main():
     reg_map = os.path.join(src, "registers", "epa.csv")
 
     app = Appliance(epa, reg_map, "", modbus_extra="max_clients = 16\n", web_static_dir=os.path.join(src, "web"),
-                    web_extra='token = "a-token-for-the-attack-suite"\n')
+                    web_extra='token = "90t7oIsgbHRGOIHHO5qHvUCU"\n')
     try:
         brute_force(app)
         unlock_scope(app)

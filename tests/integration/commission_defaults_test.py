@@ -26,7 +26,7 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from epa_appliance import Appliance, Checks, wait_until  # noqa: E402
 
-TOKEN = "Df4-commission-defaults-Qz81x"
+TOKEN = "r1f5_De3kRiAVQhRiD5mSRW4"
 SANITIZER_RUN = os.environ.get("EPA_SANITIZER_RUN") == "1"
 MODE_ADDRESS = 2  # holding `mode` of registers/epa.csv
 RUN, STOP = 1, 0

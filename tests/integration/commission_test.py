@@ -43,7 +43,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from epa_appliance import Appliance, free_port, stop_process  # noqa: E402
 from stall_monitor import SKIP_RETURN_CODE, StallMonitor  # noqa: E402
 
-TOKEN = "commissioning-test-token-0123"
+TOKEN = "0nckvUtg9V7xrBbM-fiPztEj"
 SANITIZER_RUN = os.environ.get("EPA_SANITIZER_RUN") == "1"
 FAILURES = []
 

@@ -16,7 +16,7 @@ import urllib.request
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from epa_appliance import HOST, Appliance, free_port  # noqa: E402
 
-TOKEN = "records-cli-test-token-42"
+TOKEN = "agqppIImfJRYkrwE1pvb3Ccz"
 failures = []
 
 
@@ -83,7 +83,7 @@ def main():
         r = records("set", "5", "--target-mm", "10", token_env=TOKEN)
         check(r.returncode == 0 and table()["records"][4]["target_mm"] == 10.0,
               f"the token from EPA_TOKEN: record 5 set (exit {r.returncode}, {r.stderr.strip()!r})")
-        r = records("set", "5", "--target-mm", "20", "--token", "not-the-token")
+        r = records("set", "5", "--target-mm", "20", "--token", "Wq3kZ8vN1xR5tY7pL2mB9cJd")  # strong, but not the one
         check(r.returncode == 1 and "HTTP 401" in r.stderr and "wrong token" in r.stderr and table()["records"][4]["target_mm"] == 10.0,
               f"a wrong token: the appliance's 401 passed through, nothing changed: {r.stderr.strip()!r}")
         r = records("set", "5", "--token", TOKEN)

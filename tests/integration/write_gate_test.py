@@ -26,7 +26,7 @@ import urllib.request
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from epa_appliance import UNIT, Appliance, Checks, f32_value, f32_words, pymodbus, unlock  # noqa: E402
 
-TOKEN = "a-token-for-the-write-gate-test"
+TOKEN = "mteO0wA4Az6ZNXI75tnO0ToT"
 ILLEGAL_VALUE = 0x03
 
 

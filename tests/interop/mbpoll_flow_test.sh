@@ -63,7 +63,7 @@ A_FCOUNT=$(addr fault_history_count input uint32) || exit 1
 A_F0=$(addr fault_0_code input uint16) || exit 1
 pass "(1) map: $(($(wc -l <"$tmp/map.csv") - 1)) points from epa registers --csv; status_word input $A_STATUS, control_word holding $A_CW"
 
-token="mbpoll-flow-token-0123456789"
+token="IZrXZnw2VNsOO9NPydTejzee"
 web_static_dir="$src/web" web_token=$token
 start_appliance "$src/registers/epa.csv" "[limits]
 soft_max_mm = 300.0
