@@ -15,6 +15,7 @@
 
 #include "app/cli_checks.hpp"
 #include "app/daq_factory.hpp"
+#include "app/file_limit.hpp"
 #include "app/appliance_axis.hpp"
 #include "app/commission_identify.hpp"
 #include "app/commission_service.hpp"
@@ -336,6 +337,7 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   if (!daq) return fail(daq.error());
   store_writer.set_limits({.audit_max_rows = c.audit_max_rows, .min_free_bytes = mib(c.store_min_free_mb)});
   spdlog::info("epa {} serve starting: config {}, DAQ {}", core::kVersion, o.config_path, (*daq)->describe());
+  spdlog::info("{}", raise_file_limit());  // before any listener: connections are descriptors
   if (auto s = (*daq)->open(); !s) {
     spdlog::error("DAQ: {}", s.error().message);
     return 1;

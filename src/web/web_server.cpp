@@ -20,8 +20,10 @@
 #include "web/commission_port.hpp"
 #include "web/deadline_http_server.hpp"
 #include "web/elastic_task_queue.hpp"
+#include "web/host_check.hpp"
 #include "web/prometheus.hpp"
 #include "web/recent_audit.hpp"
+#include "web/static_files.hpp"
 #include "web/trend_buffer.hpp"
 
 namespace epa::web {
@@ -52,27 +54,21 @@ void send_error(httplib::Response& res, int status, const std::string& message) 
 constexpr std::size_t kMaxHeaderFields = 64;
 constexpr std::size_t kMaxHeadBytes = 8192;
 constexpr std::size_t kMaxRequestBytes = 64 * 1024;  // beyond it a request is cut unread (431), not parsed
-constexpr std::size_t kMaxStaticFileBytes = 4 << 20;
 constexpr std::size_t kIdleWorkers = 4;  // kept when nothing happens; more start per connection
 
-std::string content_type(const std::filesystem::path& file) {
-  const std::string ext = file.extension().string();
-  if (ext == ".html") return "text/html; charset=utf-8";
-  if (ext == ".js") return "text/javascript; charset=utf-8";
-  if (ext == ".css") return "text/css; charset=utf-8";
-  if (ext == ".svg") return "image/svg+xml";
-  if (ext == ".png") return "image/png";
-  if (ext == ".json") return "application/json";
-  if (ext == ".ico") return "image/x-icon";
-  return "application/octet-stream";
-}
+// On every answer. The page loads only its own files (no inline script or style), so the policy
+// allows nothing else; no other site may frame it (clickjacking the command panel) or learn its URL.
+constexpr const char* kPageCsp =
+    "default-src 'self'; script-src 'self'; style-src 'self'; img-src 'self' data:; connect-src 'self'; "
+    "object-src 'none'; base-uri 'none'; form-action 'self'; frame-ancestors 'none'";
+// The commissioning report is one self-contained HTML file with its own <style> and no script.
+constexpr const char* kReportCsp = "default-src 'none'; style-src 'unsafe-inline'; img-src data:; frame-ancestors 'none'";
 
-// Whether `file` (canonical) lies inside `root` (canonical).
-bool within(const std::filesystem::path& file, const std::filesystem::path& root) {
-  auto f = file.begin();
-  for (auto r = root.begin(); r != root.end(); ++r, ++f)
-    if (f == file.end() || *f != *r) return false;
-  return true;
+httplib::Headers security_headers() {
+  return {{"X-Frame-Options", "DENY"},
+          {"X-Content-Type-Options", "nosniff"},
+          {"Referrer-Policy", "no-referrer"},
+          {"Content-Security-Policy", kPageCsp}};
 }
 
 }  // namespace
@@ -100,7 +96,8 @@ struct WebServer::Impl {
   bool stopping = false;
   std::thread listener, sampler;
 
-  std::filesystem::path static_root;  // canonical static_dir
+  StaticFiles static_files;  // read once at start (static_files.hpp says why)
+  HostCheck hosts;
   std::mutex token_mutex;
   core::AddressBackoff token_guesses;  // by client address, under token_mutex
   runtime::MonotonicClock clock;
@@ -114,12 +111,15 @@ struct WebServer::Impl {
         modbus_stats(std::move(m)),
         store_stats(std::move(st)),
         commission(cp),
-        server(request_limits(c)) {}
+        server(request_limits(c), c.log, security_headers()),
+        hosts(c.host_names) {}
 
   static RequestLimits request_limits(const WebConfig& c) {
     RequestLimits limits;
     limits.request_deadline = std::chrono::milliseconds(c.request_deadline_ms);
     limits.max_request_bytes = kMaxRequestBytes;
+    limits.max_header_fields = kMaxHeaderFields;
+    limits.max_connections_per_address = static_cast<std::size_t>(c.max_connections_per_address);
     return limits;
   }
 
@@ -170,19 +170,11 @@ struct WebServer::Impl {
     return false;
   }
 
-  // The page's files: only regular files inside static_dir, after every symlink and ".." is
-  // resolved, so nothing outside it is ever served.
+  // The page's files, from memory (static_files.hpp).
   void serve_static(const httplib::Request& req, httplib::Response& res) {
-    std::string rel = req.path == "/" ? "index.html" : req.path.substr(1);
-    std::error_code ec;
-    const auto file = std::filesystem::weakly_canonical(static_root / rel, ec);
-    if (ec || !within(file, static_root) || !std::filesystem::is_regular_file(file, ec) ||
-        std::filesystem::file_size(file, ec) > kMaxStaticFileBytes)
-      return send_error(res, 404, "no such resource");
-    std::ifstream in(file, std::ios::binary);
-    std::stringstream body;
-    body << in.rdbuf();
-    res.set_content(body.str(), content_type(file));
+    const StaticFile* file = static_files.find(req.path);
+    if (!file) return send_error(res, 404, "no such resource");
+    res.set_content(file->body, file->content_type);
   }
 
   // A command: the token, then the body read into point writes, then the write gate decides (and
@@ -217,6 +209,8 @@ struct WebServer::Impl {
       if (!commission) return none(res);
       const auto html = commission->report_html();
       if (!html) return send_error(res, 404, "no commissioning run has ended yet");
+      res.headers.erase("Content-Security-Policy");
+      res.set_header("Content-Security-Policy", kReportCsp);
       res.set_content(*html, "text/html; charset=utf-8");
     });
     s.Post("/api/commission", [this, none](const httplib::Request& req, httplib::Response& res) {
@@ -241,10 +235,17 @@ struct WebServer::Impl {
     s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
       requests.fetch_add(1, std::memory_order_relaxed);
       res.set_header("Cache-Control", "no-store");
-      // Caps on the head, and a declared body over the cap refused before any of it is read.
+      if (!hosts.allowed(req.get_header_value("Host"), req.local_addr)) {
+        res.set_header("Connection", "close");
+        send_error(res, 421, "this appliance does not answer to the name '" + req.get_header_value("Host") +
+                                 "': open it by its address, or list the name in [web] host_names");
+        return httplib::Server::HandlerResponse::Handled;
+      }
+      // A cap on the head's bytes (its fields are counted as they arrive: deadline_http_server.cpp),
+      // and a declared body over the cap refused before any of it is read.
       std::size_t head_bytes = req.method.size() + req.target.size();
       for (const auto& [k, v] : req.headers) head_bytes += k.size() + v.size() + 4;
-      if (req.headers.size() > kMaxHeaderFields || head_bytes > kMaxHeadBytes) {
+      if (head_bytes > kMaxHeadBytes) {
         res.set_header("Connection", "close");
         send_error(res, 431, "request head too large (at most " + std::to_string(kMaxHeaderFields) + " fields, " +
                                  std::to_string(kMaxHeadBytes) + " bytes)");
@@ -336,15 +337,14 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
                                                    CommissionPort* commission) {
   if (config.worker_threads < 1) return core::invalid_argument("web: worker_threads must be >= 1");
   auto impl = std::make_unique<Impl>(config, channels, gate, audit, std::move(modbus_stats), std::move(store_stats), commission);
-  if (!std::filesystem::is_directory(config.static_dir))
-    return core::io_error("web: static_dir '" + config.static_dir + "' is not a folder (it holds index.html, app.js, style.css)");
-  impl->static_root = std::filesystem::canonical(config.static_dir);
-  for (const char* page_file : {"index.html", "app.js", "style.css"}) {
-    std::error_code ec;
-    const auto f = std::filesystem::weakly_canonical(impl->static_root / page_file, ec);
-    if (ec || !within(f, impl->static_root) || !std::filesystem::is_regular_file(f))
-      return core::io_error("web: static_dir '" + config.static_dir + "' does not hold the page's " + page_file +
-                            " (it must be the folder of web/: index.html, app.js, style.css)");
+  if (config.max_connections_per_address < 1) return core::invalid_argument("web: max_connections_per_address must be >= 1");
+  auto files = StaticFiles::load(config.static_dir, {"index.html", "app.js", "style.css"});
+  if (!files) return files.error();
+  impl->static_files = std::move(*files);
+  if (config.log && !impl->static_files.skipped.empty()) {
+    std::string names;
+    for (const auto& s : impl->static_files.skipped) names += (names.empty() ? "" : ", ") + s;
+    config.log("web: static_dir '" + config.static_dir + "': not served: " + names);
   }
   {
     std::ifstream in(config.chart_js, std::ios::binary);
@@ -353,11 +353,10 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
   }
   auto& s = impl->server;
   const int threads = config.worker_threads;
-  s.new_task_queue = [threads, &s] {
-    auto* queue = new ElasticTaskQueue(kIdleWorkers, static_cast<std::size_t>(threads), std::chrono::seconds(5));
-    s.set_task_queue(queue);  // where parked connections go back to when they speak
-    return queue;
+  s.new_task_queue = [threads] {
+    return new ElasticTaskQueue(kIdleWorkers, static_cast<std::size_t>(threads), std::chrono::seconds(5));
   };
+  s.set_default_headers(security_headers());
   s.set_payload_max_length(config.max_body_bytes);  // timeouts and keep-alive: RequestLimits
   // Debian's libcpp-httplib is built with a listen queue of 5; the hook that sets the listening
   // socket's options is where its descriptor can be seen, to listen again with the larger queue.
@@ -389,7 +388,7 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
   Impl* p = impl.get();
   p->sampler = std::thread([p] { p->sample_until_stopped(); });
   p->listener = std::thread([p] {
-    p->server.listen_after_bind();
+    p->server.serve_after_bind();
     p->listen_returned = true;
   });
   return std::unique_ptr<WebServer>(new WebServer(std::move(impl)));
@@ -408,10 +407,7 @@ void WebServer::stop() {
   }
   impl_->stop_cv.notify_all();
   if (impl_->listener.joinable()) {
-    // listen_after_bind may not have reached its loop yet, and a stop() before that is lost.
-    while (!impl_->server.is_running() && !impl_->listen_returned.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    impl_->server.stop_parking();  // while httplib's task queue still exists
-    impl_->server.stop();
+    impl_->server.stop_serving();  // also when it has not begun: then it returns at once
     impl_->listener.join();
   }
   if (impl_->sampler.joinable()) impl_->sampler.join();

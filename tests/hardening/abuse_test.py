@@ -107,13 +107,13 @@ def flood_http(port, seconds, counter):
 def http_worker(port, seconds, counter, seed):
     end = time.monotonic() + seconds
     requests = [
-        b"GET /api/status HTTP/1.1\r\nHost: x\r\n\r\n",
-        b"GET /api/trend HTTP/1.1\r\nHost: x\r\n\r\n",
-        b"POST /api/setpoint HTTP/1.1\r\nHost: x\r\nContent-Length: 20\r\n\r\n{\"setpoint_mm\":120}",
-        b"GET /../../etc/passwd HTTP/1.1\r\nHost: x\r\n\r\n",
+        b"GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n",
+        b"GET /api/trend HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n",
+        b"POST /api/setpoint HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 20\r\n\r\n{\"setpoint_mm\":120}",
+        b"GET /../../etc/passwd HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n",
         b"GARBAGE\r\n\r\n",
-        b"POST /api/mode HTTP/1.1\r\nHost: x\r\nContent-Length: 100000\r\n\r\n" + b"x" * 8192,
-        b"GET /nothing-here HTTP/1.1\r\nHost: x\r\n\r\n",
+        b"POST /api/mode HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 100000\r\n\r\n" + b"x" * 8192,
+        b"GET /nothing-here HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n",
     ]
     rng = random.Random(seed)
     while time.monotonic() < end:

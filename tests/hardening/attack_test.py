@@ -196,13 +196,16 @@ def poll_while_held(app, idle, slow, seconds):
     return served, total
 
 
-def connect_burst(port, connects=300):
+def connect_burst(port, connects=300, sources=None):
     """Fires `connects` connects at once without a byte sent (a reconnect storm, a flood) and
-    leaves them open; the sockets, to be closed by the caller."""
+    leaves them open; the sockets, to be closed by the caller. `sources`: the addresses they come
+    from, in turn (HTTP caps the connections of one address)."""
     burst = []
-    for _ in range(connects):
+    for i in range(connects):
         s = socket.socket()
         s.setblocking(False)
+        if sources:
+            s.bind((sources[i % len(sources)], 0))
         s.connect_ex((HOST, port))
         burst.append(s)
     return burst
@@ -228,9 +231,9 @@ def modbus_poll_after_burst(port):
 def http_poll_after_burst(port):
     """The status line and seconds of /api/status right after a burst of 600 silent connects (HTTP:
     more than the 512 workers, so each silent connection must not hold one)."""
-    burst = connect_burst(port, 600)
+    burst = connect_burst(port, 600, [f"127.0.0.{10 + i}" for i in range(40)])  # 15 an address: under its cap of 32
     try:
-        return http_raw(port, b"GET /api/status HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n", timeout=3.0)
+        return http_raw(port, b"GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n", timeout=3.0)
     except OSError as e:
         return f"no connection: {e}", 3.0
     finally:
@@ -266,12 +269,12 @@ def status_line(s, until_closed=False):
 
 def slow_http(app, connections, seconds):
     stop = threading.Event()
-    head = b"GET /api/status HTTP/1.1\r\nHost: x\r\nX-Slow: " + b"a" * 100 + b"\r\n\r\n"
+    head = b"GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: " + b"a" * 100 + b"\r\n\r\n"
 
-    def dribble():
+    def dribble(source):
         while not stop.is_set():
             try:
-                with socket.create_connection((HOST, app.web_port), timeout=2) as s:
+                with socket.create_connection((HOST, app.web_port), timeout=2, source_address=(source, 0)) as s:
                     for i in range(len(head)):
                         if stop.wait(1.0):
                             return
@@ -279,7 +282,8 @@ def slow_http(app, connections, seconds):
             except OSError:
                 stop.wait(0.1)
 
-    threads = [threading.Thread(target=dribble, daemon=True) for _ in range(connections)]
+    # From 20 addresses other than the poller's, each under the HTTP per-address cap of 32.
+    threads = [threading.Thread(target=dribble, args=(f"127.0.0.{10 + i % 20}",), daemon=True) for i in range(connections)]
     for t in threads:
         t.start()
     time.sleep(2.0)
@@ -289,7 +293,7 @@ def slow_http(app, connections, seconds):
     while time.monotonic() < deadline:
         total += 1
         try:
-            line, took = http_raw(app.web_port, b"GET /api/status HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n", timeout=2.0)
+            line, took = http_raw(app.web_port, b"GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n", timeout=2.0)
         except OSError as e:
             line, took = f"no connection: {e}", 2.0
         slowest_s = max(slowest_s, took)
@@ -307,7 +311,7 @@ def slow_http(app, connections, seconds):
 def dribbled_head(port):
     """Sends a request head a byte every 0.3 s until the server answers or closes: its status line
     and the seconds from the first byte to the end of the connection."""
-    head = b"GET /api/status HTTP/1.1\r\nHost: x\r\nX-Slow: " + b"a" * 200 + b"\r\n\r\n"
+    head = b"GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: " + b"a" * 200 + b"\r\n\r\n"
     with socket.create_connection((HOST, port), timeout=10) as s:
         t0 = time.monotonic()
         for i in range(len(head)):  # 75 s at most: the deadline must end it long before
@@ -333,18 +337,18 @@ def http_rows(app, hold_s):
     line, took = dribbled_head(app.web_port)
     check(line.startswith("HTTP/1.1 408") and 1.5 <= took <= 3.5,
           f"a head dribbled a byte every 0.3 s: 408 and closed 2 s after its first byte: {line!r} after {took:.1f} s")
-    lines = b"GET /api/status HTTP/1.1\r\nHost: x\r\n" + b"".join(b"X-%d: y\r\n" % i for i in range(2000)) + b"\r\n"
+    lines = b"GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n" + b"".join(b"X-%d: y\r\n" % i for i in range(2000)) + b"\r\n"
     line, _ = http_raw(app.web_port, lines)
     check(line.startswith("HTTP/1.1 4"), f"2,000 header lines refused: {line}")
-    megabyte = b"GET /api/status HTTP/1.1\r\nHost: x\r\n" + b"".join(b"X-%d: %s\r\n" % (i, b"a" * 1000) for i in range(1000)) + b"\r\n"
+    megabyte = b"GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n" + b"".join(b"X-%d: %s\r\n" % (i, b"a" * 1000) for i in range(1000)) + b"\r\n"
     line, _ = http_raw(app.web_port, megabyte)
     check(line.startswith("HTTP/1.1 4"), f"1 MB of headers refused: {line}")
-    line, took = http_raw(app.web_port, b"POST /api/setpoint HTTP/1.1\r\nHost: x\r\nContent-Length: 1000000000000\r\n\r\n{")
+    line, took = http_raw(app.web_port, b"POST /api/setpoint HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 1000000000000\r\n\r\n{")
     check(line.startswith("HTTP/1.1 413") and took < 1.0, f"Content-Length 10^12: {line} after {took:.2f} s")
     codes = []
     for i in range(8):
         body = b'{"setpoint_mm": 10}'
-        req = (b"POST /api/setpoint HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer guess-%d-xxxxxxxxxxxx\r\n"
+        req = (b"POST /api/setpoint HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: Bearer guess-%d-xxxxxxxxxxxx\r\n"
                b"Content-Type: application/json\r\nContent-Length: %d\r\nConnection: close\r\n\r\n%s" % (i, len(body), body))
         codes.append(http_raw(app.web_port, req)[0][9:12])
     check(codes[:5] == ["401"] * 5 and set(codes[5:]) == {"429"}, f"token guessing: 401 five times, then 429: {codes}")
