@@ -186,15 +186,18 @@ std::uint8_t RequestHandler::collect_coil_writes(int address, int quantity, cons
 }
 
 std::uint8_t RequestHandler::take_key(const Write& key, const Session& session, std::int64_t now_ns) {
-  const UnlockGuard::Attempt a = unlock_.attempt(session.address, key.key, now_ns);
+  const UnlockGuard::Attempt a = unlock_.attempt({session.address, session.peer, session.opened_ns}, key.key, now_ns);
   if (a.verdict == UnlockGuard::Verdict::kUnlocked) return 0;
   if (a.verdict == UnlockGuard::Verdict::kNoKey) return kIllegalValue;  // none configured: nothing to guess
   // A wrong key is logged and audited each time (at most kFreeAttempts before a back-off), the
   // start of a back-off too; attempts during one are refused unseen and only counted.
   if (a.verdict == UnlockGuard::Verdict::kLockedOut) return kCannotApply;
   std::string what = "wrong unlock key";
-  if (a.lockout_started)
-    what += "; unlock writes from " + session.address + " refused for " + std::to_string(a.backoff_ns / 1'000'000'000) + " s";
+  if (a.lockout_started && !a.address_lockout)
+    what += "; unlock writes on this connection refused for " + std::to_string(a.backoff_ns / 1'000'000'000) + " s";
+  if (a.address_lockout)
+    what += "; unlock writes from " + session.address + " refused for " + std::to_string(a.backoff_ns / 1'000'000'000) +
+            " s, except from a connection open 2 s that sent no wrong key";
   if (log_) log_("modbus: " + session.peer + ": " + what + " (" + std::to_string(unlock_.failures()) + " refused attempts since start)");
   // The audit trail says who and what, each in its column: an event on `unlock`, nothing changed
   // (the why is in the log line above).

@@ -12,7 +12,8 @@
 // write that covers only part of a 32-bit value, a wrong unlock key, tuning values that do not
 // validate together, or a bad device identification read code; 04 the write cannot be applied
 // (server read-only, client not allowed to write, tuning locked, wrong mode, fault latched, an
-// unlock from an address in its back-off); 06 the command queue is full (busy); 0B a request
+// unlock refused unseen: from a connection in its back-off, or while its address is in back-off
+// from a connection that sent a wrong key or is not yet open 2 s); 06 the command queue is full (busy); 0B a request
 // for a unit id that is not this device's (unit_id, and by default 0 and 0xFF).
 //
 // Bit tables (coils, discrete inputs) read in blocks of 16, as clients poll them: every address
@@ -49,6 +50,7 @@ struct Session {
   std::string peer;                    // "ip:port", for the log and the audit trail
   std::int64_t unlocked_until_ns = 0;  // the unlock is this connection's, until then or until it closes
   std::string local_address;           // this appliance's address the client reached (FC43's VendorUrl)
+  std::int64_t opened_ns = 0;          // when the connection was accepted (the unlock back-off hears old ones)
 };
 
 // What goes back for one request.
@@ -78,6 +80,8 @@ class RequestHandler {
   // What the interface points read for `session` (`locked` is that connection's).
   points::InterfaceStatus status(const Session& session, std::int64_t now_ns) const;
   void set_clients(int n) { clients_ = n; }
+  // The connection is closed: its own count of wrong keys goes (its address's stays).
+  void connection_closed(const Session& session) { unlock_.closed(session.peer); }
   const RegisterMap& map() const { return map_; }
 
  private:

@@ -99,7 +99,7 @@ struct WebServer::Impl {
   StaticFiles static_files;  // read once at start (static_files.hpp says why)
   HostCheck hosts;
   std::mutex token_mutex;
-  core::AddressBackoff token_guesses;  // by client address, under token_mutex
+  core::AddressBackoff token_guesses;  // by connection and by client address, under token_mutex
   runtime::MonotonicClock clock;
 
   Impl(const WebConfig& c, runtime::LoopChannels& ch, points::WriteGate* g, RecentAudit* a, ModbusStatsFn m, StoreStatsFn st,
@@ -138,8 +138,11 @@ struct WebServer::Impl {
   }
 
   // The token rule: none configured -> commands are off (403); else the bearer token must match
-  // (401), and an address that sent 5 wrong tokens is refused unseen (429) for a back-off
-  // (core::AddressBackoff), so a token cannot be guessed at request speed.
+  // (401); a connection that sent 5 wrong tokens is refused unseen (429) for a back-off, and an
+  // address that sent 5 is heard only on connections that sent no wrong token and sent their first
+  // command 2 s before (core::AddressBackoff), so a token cannot be guessed at request speed and a
+  // guesser on an operator's address does not lock the operator out. httplib does not tell when a
+  // connection was opened: "ip:port" is the connection, its first command starts its clock.
   bool authorised(const httplib::Request& req, httplib::Response& res) {
     if (config.token.empty()) {
       send_error(res, 403, "commands are disabled: configure [web] token to enable them");
@@ -147,7 +150,8 @@ struct WebServer::Impl {
     }
     const std::int64_t now_ns = clock.now_ns();
     std::unique_lock lock(token_mutex);
-    if (const std::int64_t until_ns = token_guesses.locked_until(req.remote_addr, now_ns); until_ns != 0) {
+    const core::Guesser who{req.remote_addr, req.remote_addr + ":" + std::to_string(req.remote_port), -1};
+    if (const std::int64_t until_ns = token_guesses.refused_until(who, now_ns); until_ns != 0) {
       const auto wait_s = std::to_string((until_ns - now_ns) / 1'000'000'000 + 1);
       res.set_header("Retry-After", wait_s);
       send_error(res, 429, "too many wrong tokens from " + req.remote_addr + ": try again in " + wait_s + " s");
@@ -156,15 +160,17 @@ struct WebServer::Impl {
     const std::string header = req.get_header_value("Authorization");
     const std::string prefix = "Bearer ";
     if (header.compare(0, prefix.size(), prefix) == 0 && constant_time_equal(header.substr(prefix.size()), config.token)) {
-      token_guesses.right(req.remote_addr);
+      token_guesses.right(who);
       return true;
     }
-    const auto lockout = token_guesses.wrong(req.remote_addr, now_ns);
+    const auto lockout = token_guesses.wrong(who, now_ns);
     lock.unlock();
     if (lockout.started && config.log)
-      config.log("web: " + std::to_string(lockout.wrong_in_row) + " wrong tokens from " + req.remote_addr + ":" +
-                 std::to_string(req.remote_port) + ": its commands are refused for " +
-                 std::to_string(lockout.backoff_ns / 1'000'000'000) + " s");
+      config.log("web: wrong tokens from " + who.connection + ": " +
+                 (lockout.address_started ? "commands from " + req.remote_addr + " are refused for " +
+                                                std::to_string(lockout.backoff_ns / 1'000'000'000) +
+                                                " s, except on a connection that sent no wrong token and its first command 2 s before"
+                                          : "its commands are refused for " + std::to_string(lockout.backoff_ns / 1'000'000'000) + " s"));
     res.set_header("WWW-Authenticate", "Bearer");
     send_error(res, 401, "missing or wrong token: send 'Authorization: Bearer <token>'");
     return false;
