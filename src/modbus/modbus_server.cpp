@@ -10,11 +10,14 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <algorithm>
 #include <cstring>
 #include <vector>
 
 #include "core/ip_address.hpp"
 #include "core/listen_backlog.hpp"
+#include "modbus/slot_log.hpp"
+#include "modbus/slot_policy.hpp"
 #include "runtime/clock.hpp"
 
 namespace epa::modbus {
@@ -33,19 +36,23 @@ struct ClientConnection {
   std::int64_t idle_since_ns = 0;        // connected, or last request answered: bytes alone do not count
   std::int64_t frame_started_ns = -1;    // the first byte of the frame still incomplete; -1: none
   bool served = false;                   // has completed a request
+  std::int64_t connected_ns = 0;
+  std::int64_t last_valid_ns = -1;       // its last request answered without an exception (slot_policy)
   short revents = 0;                     // of this round's poll
 };
 
 namespace {
-// Which client makes room for a new one: those that never completed a request first (a crowd of
-// fresh idle sockets cannot push out a working HMI), then the one idle the longest.
-std::size_t eviction_candidate(const std::vector<ClientConnection>& clients) {
-  std::size_t pick = 0;
-  for (std::size_t i = 1; i < clients.size(); ++i) {
-    const ClientConnection &a = clients[i], &b = clients[pick];
-    if (a.served != b.served ? !a.served : a.idle_since_ns < b.idle_since_ns) pick = i;
+// The clients as the slot policy sees them: a client proves itself by its unlock or its address on
+// write_clients (the history of valid requests the policy reads from the times).
+std::vector<SlotHolder> slot_holders(const std::vector<ClientConnection>& clients, const WritePolicy& policy, std::int64_t now_ns) {
+  std::vector<SlotHolder> out;
+  out.reserve(clients.size());
+  for (const ClientConnection& c : clients) {
+    const auto& allowed = policy.write_clients;
+    const bool writer = !allowed.empty() && std::find(allowed.begin(), allowed.end(), c.session.address) != allowed.end();
+    out.push_back({c.session.address, c.connected_ns, c.last_valid_ns, c.served, writer || now_ns < c.session.unlocked_until_ns});
   }
-  return pick;
+  return out;
 }
 }  // namespace
 
@@ -58,6 +65,7 @@ struct ModbusServer::Impl {
   std::vector<ClientConnection> clients;
   runtime::MonotonicClock clock;
   Log log;
+  SlotLog slot_log;
 
   Impl(const ServerConfig& c, const RegisterMap& map, points::WriteGate& gate, runtime::LoopChannels& ch, Log l)
       : config(c), handler(map, c.policy, unit_ids(c), c.status_page_url, gate, ch, l), log(std::move(l)) {}
@@ -115,9 +123,20 @@ void ModbusServer::serve() {
   const auto idle_ns = static_cast<std::int64_t>(m.config.idle_timeout_s * 1e9);
   const auto frame_ns = static_cast<std::int64_t>(m.config.frame_timeout_s * 1e9);
   auto drop = [&](std::size_t i, const char* why) {
-    if (m.log) m.log("modbus: client " + m.clients[i].session.peer + " disconnected (" + why + ")");
+    const std::int64_t now_ns = m.clock.now_ns();
+    if (m.log && why && m.slot_log.disconnect_line(now_ns))
+      m.log("modbus: client " + m.clients[i].session.peer + " disconnected (" + why + ")");
+    m.handler.connection_closed(m.clients[i].session);
     ::close(m.clients[i].fd);
     m.clients.erase(m.clients.begin() + static_cast<std::ptrdiff_t>(i));
+  };
+  // Room for a newcomer from `ip` (slot_policy.hpp): false when it is refused. An eviction or a
+  // refusal is counted for the summary line, not logged one by one.
+  auto make_room = [&](const std::string& ip, std::int64_t now_ns) {
+    const Admission a = admit(slot_holders(m.clients, m.config.policy, now_ns), ip, now_ns, {m.config.max_clients, m.config.max_clients_per_address});
+    if (a.kind == Admission::Kind::kRefuse) m.slot_log.refused(now_ns);
+    if (a.kind == Admission::Kind::kEvict) m.slot_log.evicted(now_ns), drop(a.victim, nullptr);
+    return a.kind != Admission::Kind::kRefuse;
   };
 
   while (!stop_.load()) {
@@ -135,15 +154,19 @@ void ModbusServer::serve() {
         const int fd = accept4(m.listener, reinterpret_cast<sockaddr*>(&peer), &len, SOCK_NONBLOCK | SOCK_CLOEXEC);
         if (fd < 0) break;
         const std::string ip = core::ip_text(peer);
-        if (static_cast<int>(m.clients.size()) >= m.config.max_clients)
-          drop(eviction_candidate(m.clients), "evicted: max_clients reached and it was idle the longest");
+        if (!make_room(ip, now)) {
+          ::close(fd);
+          continue;
+        }
         const int one = 1;
         setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
         sockaddr_storage local{};
         socklen_t local_len = sizeof local;
         const std::string local_ip = getsockname(fd, reinterpret_cast<sockaddr*>(&local), &local_len) == 0 ? core::url_host(local) : "";
         Session session{ip, core::endpoint_text(peer), 0, local_ip};
-        m.clients.push_back({fd, std::move(session), {}, now, -1, false, 0});
+        session.opened_ns = now;
+        m.clients.push_back({.fd = fd, .session = std::move(session), .buffer = {}, .idle_since_ns = now, .frame_started_ns = -1,
+                             .served = false, .connected_ns = now, .last_valid_ns = -1, .revents = 0});
       }
     }
 
@@ -194,12 +217,19 @@ void ModbusServer::serve() {
         cl.buffer.erase(cl.buffer.begin(), cl.buffer.begin() + static_cast<std::ptrdiff_t>(total));
         cl.idle_since_ns = now;
         cl.served = true;
+        if (!reply.exception) cl.last_valid_ns = now;
         cl.frame_started_ns = cl.buffer.empty() ? -1 : now;  // a pipelined frame's clock starts now
       }
       if (dropped) continue;
     }
     clients_ = static_cast<int>(m.clients.size());
+    evicted_ = m.slot_log.evicted_total();
+    refused_ = m.slot_log.refused_total();
+    if (const std::string line = m.slot_log.due(now, m.config.max_clients, m.config.max_clients_per_address); m.log && !line.empty())
+      m.log(line);
   }
+  const std::string line = m.slot_log.due(m.clock.now_ns(), m.config.max_clients, m.config.max_clients_per_address, true);
+  if (m.log && !line.empty()) m.log(line);  // the count since the last summary, on the way out
   modbus_set_socket(m.ctx, -1);
 }
 

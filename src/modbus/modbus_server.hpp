@@ -5,8 +5,8 @@
 // PDU the RequestHandler builds itself (device identification), and the RequestHandler for what
 // the answer says. A crowd of dead or slow connections cannot starve it:
 // a frame must be complete within frame_timeout_s of its first byte, a client without a request
-// for idle_timeout_s is closed, and at max_clients a new client evicts a connection that never
-// completed a request, else the one idle the longest.
+// for idle_timeout_s is closed, and the connection slots are shared fairly (slot_policy.hpp):
+// per-address caps, and clients that proved themselves are never evicted for a newcomer.
 #include <atomic>
 #include <functional>
 #include <memory>
@@ -24,6 +24,7 @@ struct ServerConfig {
   int unit_id = 1;
   std::vector<int> alias_unit_ids = kDefaultAliasUnitIds;  // also answered as this device; others get 0B
   int max_clients = 16;
+  int max_clients_per_address = 4;   // one address holds at most this many of them
   double idle_timeout_s = 60.0;      // a client without a complete request this long is disconnected
   double frame_timeout_s = 1.0;      // a frame not complete this long after its first byte: disconnected
   WritePolicy policy;
@@ -47,6 +48,8 @@ class ModbusServer {
   int clients() const { return clients_.load(); }
   std::uint64_t requests() const { return requests_.load(); }
   std::uint64_t exceptions() const { return exceptions_.load(); }
+  std::uint64_t evicted() const { return evicted_.load(); }  // connections closed to make room for a newcomer
+  std::uint64_t refused() const { return refused_.load(); }  // newcomers closed at once: no slot for them
   void stop();
 
  private:
@@ -59,7 +62,7 @@ class ModbusServer {
   std::string bound_;
   std::atomic<bool> stop_{false};
   std::atomic<int> clients_{0};
-  std::atomic<std::uint64_t> requests_{0}, exceptions_{0};
+  std::atomic<std::uint64_t> requests_{0}, exceptions_{0}, evicted_{0}, refused_{0};
   std::thread thread_;
 };
 

@@ -249,17 +249,88 @@ TEST_F(Server, DeviceIdentificationIsAnsweredBehindTheRequestsMbapHeader) {
   EXPECT_EQ(server_->exceptions(), 1u);
 }
 
-TEST_F(Server, ANewClientOverTheCapEvictsTheOneIdleTheLongest) {
+// Fair slots (slot_policy.hpp): at max_clients a newcomer evicts the youngest client that has not
+// proved itself, so a reconnecting crowd churns among its newest and the established clients stay.
+TEST_F(Server, ANewClientOverTheCapEvictsTheYoungestClientNotTheEstablishedOnes) {
   modbus_t* a = client();
   modbus_t* b = client();
-  modbus_t* c = client();
   std::uint16_t r[2];
-  for (auto* ctx : {a, b, c}) ASSERT_EQ(modbus_read_input_registers(ctx, 0, 2, r), 2);  // a is now idle the longest
-  for (auto* ctx : {b, c}) ASSERT_EQ(modbus_read_input_registers(ctx, 0, 2, r), 2);
+  for (auto* ctx : {a, b}) ASSERT_EQ(modbus_read_input_registers(ctx, 0, 2, r), 2);
+  std::this_thread::sleep_for(20ms);  // c is accepted after a and b, on a later tick
+  modbus_t* c = client();
+  ASSERT_EQ(modbus_read_input_registers(c, 0, 2, r), 2);  // c is now the youngest, though a is idle the longest
   modbus_t* d = client();
   EXPECT_EQ(modbus_read_input_registers(d, 0, 2, r), 2);  // served, not refused
+  EXPECT_EQ(modbus_read_input_registers(a, 0, 2, r), 2);
   EXPECT_EQ(modbus_read_input_registers(b, 0, 2, r), 2);
-  EXPECT_EQ(modbus_read_input_registers(a, 0, 2, r), -1);  // a made room
+  EXPECT_EQ(modbus_read_input_registers(c, 0, 2, r), -1);  // c made room
+  EXPECT_EQ(server_->clients(), 3);
+  EXPECT_EQ(server_->evicted(), 1u);
+}
+
+// An unlocked connection has proved itself: never evicted for a newcomer; with every slot held by
+// such clients a newcomer is refused (closed at once).
+TEST_F(Server, AnUnlockedClientIsNeverEvictedAndANewcomerIsRefusedWhenAllAreProved) {
+  const std::uint16_t key[4] = {0x5e3a, 0x9c17, 0xd24b, 0x086f};
+  std::vector<modbus_t*> unlocked;
+  for (int i = 0; i < 3; ++i) {
+    unlocked.push_back(client());
+    ASSERT_EQ(modbus_write_registers(unlocked.back(), 9, 4, key), 4) << modbus_strerror(errno);
+  }
+  modbus_t* late = modbus_new_tcp("127.0.0.1", server_->port());
+  modbus_set_response_timeout(late, 1, 0);
+  clients_.push_back(late);
+  std::uint16_t r[2];
+  if (modbus_connect(late) == 0) {
+    EXPECT_EQ(modbus_read_input_registers(late, 0, 2, r), -1);  // closed at once
+  }
+  for (auto* ctx : unlocked) EXPECT_EQ(modbus_read_input_registers(ctx, 0, 2, r), 2);
+  EXPECT_EQ(server_->refused(), 1u);
+  EXPECT_EQ(server_->evicted(), 0u);
+}
+
+// One address holds at most max_clients_per_address slots: above it a newcomer takes the place of
+// its own address's youngest, never another address's client.
+TEST_F(Server, ANewcomerAboveItsAddressCapReplacesItsOwnAddressesClient) {
+  server_->stop();
+  ServerConfig c;
+  c.max_clients = 4;
+  c.max_clients_per_address = 2;
+  start(c);  // on 127.0.0.1; clients bound to 127.0.0.2 reach it too (all of 127/8 is loopback)
+  auto from = [&](const char* source) {
+    const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in local{};
+    local.sin_family = AF_INET;
+    inet_pton(AF_INET, source, &local.sin_addr);
+    EXPECT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&local), sizeof local), 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<std::uint16_t>(server_->port()));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    EXPECT_EQ(connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+    raw_.push_back(fd);
+    return fd;
+  };
+  const std::uint8_t read[] = {0x00, 0x01, 0x00, 0x00, 0x00, 0x06, 0x01, 0x04, 0x00, 0x00, 0x00, 0x02};
+  auto served = [&](int fd) {
+    timeval tv{1, 0};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    std::uint8_t answer[64];
+    return send(fd, read, sizeof read, MSG_NOSIGNAL) == sizeof read && recv(fd, answer, sizeof answer, 0) > 0;
+  };
+  const int other = from("127.0.0.2");
+  ASSERT_TRUE(served(other));
+  const int first = from("127.0.0.1");
+  ASSERT_TRUE(served(first));
+  std::this_thread::sleep_for(20ms);
+  const int second = from("127.0.0.1");
+  ASSERT_TRUE(served(second));
+  std::this_thread::sleep_for(20ms);
+  const int third = from("127.0.0.1");  // the address's third: the server has room, the address not
+  EXPECT_TRUE(served(third));
+  EXPECT_FALSE(served(second));  // its own address's youngest made room
+  EXPECT_TRUE(served(first));
+  EXPECT_TRUE(served(other));    // another address's client is never taken for it
   EXPECT_EQ(server_->clients(), 3);
 }
 

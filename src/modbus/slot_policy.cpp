@@ -1,0 +1,57 @@
+#include "modbus/slot_policy.hpp"
+
+#include <algorithm>
+#include <map>
+#include <vector>
+
+namespace epa::modbus {
+
+namespace {
+
+// Which clients hold their slot by history: open kHistoryNs with a valid request within the last
+// kHistoryNs, the longest-connected first, at most half the slots.
+std::vector<bool> proved_by_history(std::span<const SlotHolder> clients, std::int64_t now_ns, const SlotLimits& limits) {
+  std::vector<std::size_t> veterans;
+  for (std::size_t i = 0; i < clients.size(); ++i) {
+    const SlotHolder& c = clients[i];
+    if (now_ns - c.connected_ns >= kHistoryNs && c.last_valid_ns >= 0 && now_ns - c.last_valid_ns <= kHistoryNs) veterans.push_back(i);
+  }
+  std::sort(veterans.begin(), veterans.end(), [&](std::size_t a, std::size_t b) { return clients[a].connected_ns < clients[b].connected_ns; });
+  veterans.resize(std::min(veterans.size(), static_cast<std::size_t>(limits.max_clients / 2)));
+  std::vector<bool> kept(clients.size(), false);
+  for (std::size_t i : veterans) kept[i] = true;
+  return kept;
+}
+
+// Whether `a` goes before `b` (which was accepted earlier: on the same clock tick, `a` is younger):
+// a client of an address that holds its whole share, then a client that never completed a request
+// (silent the longest first), then the youngest.
+bool evict_before(const SlotHolder& a, const SlotHolder& b, const std::map<std::string, int>& held, int max_per_address) {
+  const bool a_full = held.at(a.address) >= max_per_address, b_full = held.at(b.address) >= max_per_address;
+  if (a_full != b_full) return a_full;
+  if (a.served != b.served) return !a.served;
+  return a.served ? a.connected_ns >= b.connected_ns : a.connected_ns < b.connected_ns;
+}
+
+}  // namespace
+
+Admission admit(std::span<const SlotHolder> clients, const std::string& address, std::int64_t now_ns, const SlotLimits& limits) {
+  std::map<std::string, int> held;
+  for (const SlotHolder& c : clients) ++held[c.address];
+  const bool address_full = held[address] >= limits.max_per_address;
+  if (!address_full && static_cast<int>(clients.size()) < limits.max_clients) return {};
+
+  const std::vector<bool> veteran = proved_by_history(clients, now_ns, limits);
+  std::size_t pick = clients.size();
+  for (std::size_t i = 0; i < clients.size(); ++i) {
+    const SlotHolder& c = clients[i];
+    if (c.proved || veteran[i] || (address_full && c.address != address)) continue;
+    if (pick == clients.size() || evict_before(c, clients[pick], held, limits.max_per_address)) pick = i;
+  }
+  if (pick < clients.size()) return {Admission::Kind::kEvict, pick, ""};
+  return {Admission::Kind::kRefuse, 0,
+          address_full ? "max_clients_per_address reached, every client of that address proved"
+                       : "max_clients reached, every client proved (unlocked, on write_clients or long-serving)"};
+}
+
+}  // namespace epa::modbus

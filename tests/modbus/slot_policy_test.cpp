@@ -1,0 +1,72 @@
+// Fair Modbus connection slots (slot_policy.hpp), decided without sockets.
+#include "modbus/slot_policy.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace epa::modbus {
+namespace {
+
+constexpr std::int64_t kS = 1'000'000'000;
+using Kind = Admission::Kind;
+
+SlotHolder busy(const std::string& address, std::int64_t connected_ns, std::int64_t now_ns) {
+  return {address, connected_ns, now_ns - kS / 2, true, false};
+}
+
+TEST(SlotPolicy, BelowTheCapsANewcomerIsAdmitted) {
+  const std::vector<SlotHolder> c = {busy("10.0.0.1", 0, kS)};
+  EXPECT_EQ(admit(c, "10.0.0.2", kS, {2, 4}).kind, Kind::kAdmit);
+}
+
+TEST(SlotPolicy, WhenFullTheYoungestUnprovedClientGoesNotTheEstablishedOne) {
+  const std::int64_t now = 5 * kS;
+  const std::vector<SlotHolder> c = {busy("10.0.0.1", 0, now), busy("10.0.0.2", 2 * kS, now), busy("10.0.0.3", 4 * kS, now)};
+  const Admission a = admit(c, "10.0.0.4", now, {3, 4});
+  EXPECT_EQ(a.kind, Kind::kEvict);
+  EXPECT_EQ(a.victim, 2u);
+}
+
+TEST(SlotPolicy, ASilentClientGoesFirstTheOneSilentTheLongest) {
+  const std::int64_t now = 5 * kS;
+  std::vector<SlotHolder> c = {busy("10.0.0.1", 0, now), {"10.0.0.2", 1 * kS, -1, false, false}, {"10.0.0.3", 3 * kS, -1, false, false}};
+  EXPECT_EQ(admit(c, "10.0.0.4", now, {3, 4}).victim, 1u);
+}
+
+TEST(SlotPolicy, ProvedClientsStayAndWithNoneElseTheNewcomerIsRefused) {
+  const std::int64_t now = 20 * kS;
+  std::vector<SlotHolder> c = {busy("10.0.0.1", 19 * kS, now), busy("10.0.0.2", 19 * kS, now)};
+  c[0].proved = c[1].proved = true;  // unlocked, or on write_clients
+  EXPECT_EQ(admit(c, "10.0.0.3", now, {2, 4}).kind, Kind::kRefuse);
+}
+
+TEST(SlotPolicy, LongServingClientsHoldAtMostHalfTheSlots) {
+  const std::int64_t now = 30 * kS;
+  std::vector<SlotHolder> c;
+  for (int i = 0; i < 4; ++i) c.push_back(busy("10.0.0." + std::to_string(i + 1), i * kS, now));  // all open >= 10 s
+  const Admission a = admit(c, "10.0.0.9", now, {4, 4});
+  EXPECT_EQ(a.kind, Kind::kEvict);
+  EXPECT_EQ(a.victim, 3u);  // the two longest-serving are kept; of the others, the youngest goes
+  c[2].proved = c[3].proved = true;
+  EXPECT_EQ(admit(c, "10.0.0.9", now, {4, 4}).kind, Kind::kRefuse);
+}
+
+TEST(SlotPolicy, AboveItsAddressCapANewcomerReplacesItsOwnAddressesClientOrIsRefused) {
+  const std::int64_t now = 5 * kS;
+  std::vector<SlotHolder> c = {busy("10.0.0.1", 0, now), busy("10.0.0.2", 1 * kS, now), busy("10.0.0.2", 2 * kS, now)};
+  const Admission a = admit(c, "10.0.0.2", now, {16, 2});
+  EXPECT_EQ(a.kind, Kind::kEvict);
+  EXPECT_EQ(a.victim, 2u);  // its own address's youngest, though the server has room
+  c[1].proved = c[2].proved = true;
+  EXPECT_EQ(admit(c, "10.0.0.2", now, {16, 2}).kind, Kind::kRefuse);
+}
+
+TEST(SlotPolicy, AnAddressHoldingItsWholeShareGivesUpASlotBeforeOthers) {
+  const std::int64_t now = 5 * kS;
+  const std::vector<SlotHolder> c = {busy("10.0.0.1", 1 * kS, now), busy("10.0.0.1", 2 * kS, now), busy("10.0.0.2", 4 * kS, now)};
+  EXPECT_EQ(admit(c, "10.0.0.3", now, {3, 2}).victim, 1u);  // 10.0.0.1 holds its 2: its youngest, not the younger 10.0.0.2
+}
+
+}  // namespace
+}  // namespace epa::modbus
