@@ -25,8 +25,8 @@
 #include "app/tuning_source.hpp"
 #include "core/audit.hpp"
 #include "core/format.hpp"
-#include "core/version.hpp"
 #include "core/log_throttle.hpp"
+#include "core/version.hpp"
 #include "hal/realtime.hpp"
 #include "runtime/clock.hpp"
 #include "runtime/recorder.hpp"
@@ -59,13 +59,13 @@ namespace {
 // memory stay small.
 constexpr std::size_t kThreadStackBytes = 512 * 1024;
 
-// Applies the command-line overrides on top of the file, re-validating what they touch.
 // Lines of one repeatable kind (audit, move, refused) logged a minute: enough to follow a person
 // at work, far below what a flooding client would make the log hold.
 constexpr int kLinesPerMinute = 30;
 
 std::uint64_t mib(double megabytes) { return static_cast<std::uint64_t>(megabytes * 1024 * 1024); }
 
+// Applies the command-line overrides on top of the file, re-validating what they touch.
 core::Status apply_overrides(const ServeOptions& o, config::ApplianceConfig& c) {
   if (!o.hal.empty()) {
     if (o.hal == "sim") c.backend = config::HalBackend::kSim;
@@ -204,8 +204,6 @@ core::Result<std::unique_ptr<web::WebServer>> start_web(const config::ApplianceC
   return server;
 }
 
-// What the operator should read in the log between two snapshots: mode changes, moves. (Faults
-// come from the loop's events: take_fault_events.)
 // A line of a kind a client can repeat at request speed (moves, refusals, audit entries), through
 // the throttle: the held-back ones are counted in the next summary.
 void log_throttled(core::LogThrottle& throttle, const char* kind, spdlog::level::level_enum level, const std::string& line) {
@@ -215,6 +213,8 @@ void log_throttled(core::LogThrottle& throttle, const char* kind, spdlog::level:
   if (admitted) spdlog::log(level, "{}", line);
 }
 
+// What the operator should read in the log between two snapshots: mode changes, moves. (Faults
+// come from the loop's events: take_fault_events.)
 void log_changes(const runtime::Snapshot& previous, const runtime::Snapshot& s, core::LogThrottle& throttle) {
   if (s.mode != previous.mode) spdlog::info("mode {} -> {}", runtime::to_string(previous.mode), runtime::to_string(s.mode));
   if (s.fault_events_dropped != previous.fault_events_dropped)
@@ -333,9 +333,9 @@ int run_serve(const ServeOptions& o, std::ostream& err) {
   for (const auto& line : control->store.notes) spdlog::info("{}", line);
   for (const auto& line : control->store.warnings) spdlog::warn("{}", line);
   store::StoreWriter& store_writer = *control->store.writer;
+  store_writer.set_limits({.audit_max_rows = c.audit_max_rows, .min_free_bytes = mib(c.store_min_free_mb)});
   auto daq = make_daq(c, control->plant_model.model);
   if (!daq) return fail(daq.error());
-  store_writer.set_limits({.audit_max_rows = c.audit_max_rows, .min_free_bytes = mib(c.store_min_free_mb)});
   spdlog::info("epa {} serve starting: config {}, DAQ {}", core::kVersion, o.config_path, (*daq)->describe());
   spdlog::info("{}", raise_file_limit());  // before any listener: connections are descriptors
   if (auto s = (*daq)->open(); !s) {

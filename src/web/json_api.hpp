@@ -31,8 +31,8 @@ struct StoreStats {
   std::uint64_t saved = 0;       // ... of which on disk
   std::string last_error;        // of the last failed write
   std::string tuning_set;        // the running set's name
-};
   bool disk_low = false;         // free space below [store] min_free_mb: run files stop, the store may be next
+};
 
 // With the status word as "status_word" and bit by bit in "status_bits" (ready, run_enabled, ...:
 // the bits' point names), and the control word as the loop applied it.
