@@ -42,13 +42,17 @@ Admission admit(std::span<const SlotHolder> clients, const std::string& address,
   if (!address_full && static_cast<int>(clients.size()) < limits.max_clients) return {};
 
   const std::vector<bool> veteran = proved_by_history(clients, now_ns, limits);
+  auto arriving = [&](const SlotHolder& c) { return !c.served && now_ns - c.connected_ns < kArrivalNs; };
+  const bool someone_arriving = std::any_of(clients.begin(), clients.end(), arriving);
   std::size_t pick = clients.size();
   for (std::size_t i = 0; i < clients.size(); ++i) {
     const SlotHolder& c = clients[i];
     if (c.proved || veteran[i] || (address_full && c.address != address)) continue;
+    if (arriving(c) || (someone_arriving && c.served)) continue;
     if (pick == clients.size() || evict_before(c, clients[pick], held, limits.max_per_address)) pick = i;
   }
   if (pick < clients.size()) return {Admission::Kind::kEvict, pick, ""};
+  if (someone_arriving) return {Admission::Kind::kRefuse, 0, "full while other clients are arriving: try again"};
   return {Admission::Kind::kRefuse, 0,
           address_full ? "max_clients_per_address reached, every client of that address proved"
                        : "max_clients reached, every client proved (unlocked, on write_clients or long-serving)"};

@@ -34,6 +34,24 @@ TEST(SlotPolicy, ASilentClientGoesFirstTheOneSilentTheLongest) {
   EXPECT_EQ(admit(c, "10.0.0.4", now, {3, 4}).victim, 1u);
 }
 
+// A connect-per-poll HMI is the newest, unanswered client for the ms its poll takes: a
+// reconnecting attacker must not evict it then, nor anyone answered (a crowd arriving at once).
+TEST(SlotPolicy, WhileAClientIsArrivingOnlySilentClientsAreEvicted) {
+  const std::int64_t now = 5 * kS;
+  std::vector<SlotHolder> c = {busy("10.0.0.1", 1 * kS, now), busy("10.0.0.2", 3 * kS, now),
+                               {"127.0.0.1", now - kArrivalNs / 10, -1, false, false}};
+  const Admission refused = admit(c, "10.0.0.9", now, {3, 4});
+  EXPECT_EQ(refused.kind, Kind::kRefuse);
+  EXPECT_STREQ(refused.why, "full while other clients are arriving: try again");
+  c.push_back({"10.0.0.3", 2 * kS, -1, false, false});  // silent for 3 s: it goes
+  const Admission a = admit(c, "10.0.0.9", now, {4, 4});
+  EXPECT_EQ(a.kind, Kind::kEvict);
+  EXPECT_EQ(a.victim, 3u);
+  // Unanswered past the arrival time, it is silent and the one silent the longest goes.
+  c.pop_back();
+  EXPECT_EQ(admit(c, "10.0.0.9", now + kArrivalNs, {3, 4}).victim, 2u);
+}
+
 TEST(SlotPolicy, ProvedClientsStayAndWithNoneElseTheNewcomerIsRefused) {
   const std::int64_t now = 20 * kS;
   std::vector<SlotHolder> c = {busy("10.0.0.1", 19 * kS, now), busy("10.0.0.2", 19 * kS, now)};
