@@ -4,7 +4,8 @@
 # clients (bench/modbus_load, libmodbus clients in a closed loop, 1 s warm-up, then T seconds)
 # against
 #   epa      the appliance (epa serve, sim plant, RUN at 100 mm, loop at SCHED_FIFO 80 with memory
-#            locked and the PM QoS request, as config/epa.toml ships)
+#            locked and the PM QoS request, as config/epa.toml ships; max_clients_per_address
+#            lifted to 16, as the load generator is one host)
 #   minimal  bench/modbus_minimal_server: libmodbus' own multi-client pattern, the ceiling for a
 #            libmodbus-based server
 #   pymodbus bench/pymodbus_server.py: pymodbus 3.0's asyncio server (Debian python3-pymodbus)
@@ -89,6 +90,7 @@ status_interval_s = 0
 [modbus]
 address = "127.0.0.1"
 port = $port
+max_clients_per_address = 16
 register_map = "$repo/registers/epa.csv"
 [web]
 address = "127.0.0.1"
