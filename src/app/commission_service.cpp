@@ -12,7 +12,7 @@ CommissionService::CommissionService(AxisFactory make_axis, commission::Identify
     : make_axis_(std::move(make_axis)), identify_(std::move(identify)), bounds_(std::move(bounds)), log_(std::move(log)), audit_(audit) {}
 
 void CommissionService::audit(const std::string& source, double command) const {
-  if (audit_) audit_->record({{core::unix_time_ms(), source, "commission_command", 0.0, command}});
+  if (audit_) audit_->record({{core::unix_time_ms(), source, std::string(points::name(points::PointId::kCommissionCommand)), 0.0, command}});
 }
 
 CommissionService::~CommissionService() {
