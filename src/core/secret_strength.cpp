@@ -55,6 +55,10 @@ std::string common_word_in(std::string_view token) {
   std::transform(as_written.begin(), as_written.end(), as_written.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   const std::string with_i = as_letters(token, 'i'), with_l = as_letters(token, 'l');
   for (const std::string_view word : kCommonWords) {
+    // A short word inside a long random token is chance, not a weakness ("epa" is in about 1 of
+    // 1,200 random 24-character base64 tokens, what the advice makes): from 24 characters on it
+    // counts only when it is a quarter of the token or more.
+    if (token.size() >= kLongTokenLength && word.size() < kSpeltWithDigitsFrom && word.size() * 4 < token.size()) continue;
     if (as_written.find(word) != std::string::npos) return std::string(word);
     if (word.size() >= kSpeltWithDigitsFrom && (with_i.find(word) != std::string::npos || with_l.find(word) != std::string::npos))
       return std::string(word);
