@@ -170,6 +170,9 @@ struct DeadlineHttpServer::Connection {
   Clock::time_point deadline{};
   bool in_request = false;  // the next request's first byte has come: `deadline` is its deadline
   std::size_t requests_left = 0;
+  std::string out;          // answered, not yet taken by the client
+  bool writing = false;     // the front end writes `out` (EPOLLOUT); `deadline` is the client's time to take it
+  bool close_after_out = false;
 };
 
 namespace {
@@ -191,7 +194,7 @@ class BufferedStream final : public httplib::Stream {
   }
 
   bool is_readable() const override { return pos_ < c_.buffer.size() || poll_for(c_.fd, POLLIN, left()); }
-  bool is_writable() const override { return cut_ == Cut::kNone && poll_for(c_.fd, POLLOUT, limits_.write_timeout); }
+  bool is_writable() const override { return cut_ == Cut::kNone; }
 
   ssize_t read(char* ptr, std::size_t size) override {
     if (cut_ != Cut::kNone) return -1;
@@ -202,14 +205,22 @@ class BufferedStream final : public httplib::Stream {
     return static_cast<ssize_t>(n);
   }
 
+  // Into memory: the worker never waits for a client to read (flush() sends what the socket takes).
   ssize_t write(const char* ptr, std::size_t size) override {
     if (cut_ != Cut::kNone) return -1;
-    for (;;) {
-      if (!poll_for(c_.fd, POLLOUT, limits_.write_timeout)) return -1;
-      const ssize_t n = ::send(c_.fd, ptr, size, MSG_NOSIGNAL);
-      if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
-      return n;
+    c_.out.append(ptr, size);
+    return static_cast<ssize_t>(size);
+  }
+  // Sends what the socket takes now; false when the connection failed.
+  bool flush() {
+    while (!c_.out.empty()) {
+      const ssize_t n = ::send(c_.fd, c_.out.data(), c_.out.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return true;
+      if (n <= 0) return false;
+      c_.out.erase(0, static_cast<std::size_t>(n));
     }
+    return true;
   }
 
   void get_remote_ip_and_port(std::string& ip, int& port) const override { endpoint(::getpeername, ip, port); }
@@ -270,9 +281,9 @@ struct DeadlineHttpServer::Front {
     const std::uint64_t one = 1;
     (void)!::write(wake_fd, &one, sizeof one);
   }
-  bool watch(int fd, int op) const {
+  bool watch(int fd, int op, std::uint32_t events = EPOLLIN) const {
     epoll_event ev{};
-    ev.events = EPOLLIN | EPOLLRDHUP;
+    ev.events = events | EPOLLRDHUP;
     ev.data.fd = fd;
     return ::epoll_ctl(epoll_fd, op, fd, &ev) == 0;
   }
@@ -334,10 +345,15 @@ void DeadlineHttpServer::answer(std::shared_ptr<Connection> c) {
                    late ? "request not complete within its deadline" : "request too large", answer_headers_);
       return hand_back(std::move(c), true);
     }
-    if (!served || connection_closed || c->requests_left == 0) return hand_back(std::move(c), true);
+    // After a request it could not parse, httplib answers 400 and would read on from the next line:
+    // the rest of a malformed request must not be taken as a new one (request smuggling).
+    const bool malformed = c->out.starts_with("HTTP/1.1 400 ");
+    if (!stream.flush()) return hand_back(std::move(c), true);
+    if (!served || connection_closed || malformed || c->requests_left == 0) return hand_back(std::move(c), true);  // after `out`
     stream.consume();
-    // A pipelined request that is already whole is answered here; any other goes back to wait.
-    if (framing(c->buffer, limits_, payload_max_length_) != Framing::kWhole) return hand_back(std::move(c), false);
+    // An answer the client has not taken goes to the front end to write; a pipelined request that is
+    // already whole is answered here; any other goes back to wait.
+    if (!c->out.empty() || framing(c->buffer, limits_, payload_max_length_) != Framing::kWhole) return hand_back(std::move(c), false);
     c->deadline = Clock::now() + limits_.request_deadline;
   }
 }
@@ -455,15 +471,46 @@ void DeadlineHttpServer::take_back() {
   }
   const auto now = Clock::now();
   for (auto& [c, close] : returned) {
+    if (!c->out.empty()) {  // the rest of the answer, as the client reads it, then closed or back to reading
+      c->writing = true, c->close_after_out = close, c->deadline = now + limits_.write_timeout;
+      if (!f.watch(c->fd, EPOLL_CTL_ADD, EPOLLOUT)) {
+        f.close_connection(c);
+        continue;
+      }
+      f.waiting.emplace(c->fd, c);
+      continue;
+    }
     if (close || !f.watch(c->fd, EPOLL_CTL_ADD)) {
       f.close_connection(c);
       continue;
     }
-    c->in_request = !c->buffer.empty();
-    c->deadline = now + (c->in_request ? limits_.request_deadline : limits_.keep_alive_timeout);
     f.waiting.emplace(c->fd, c);
-    if (c->in_request) read_from(c->fd);  // frames what is buffered, and reads anything new
+    wait_for_request(c);
   }
+}
+
+void DeadlineHttpServer::wait_for_request(const std::shared_ptr<Connection>& c) {
+  c->in_request = !c->buffer.empty();
+  c->deadline = Clock::now() + (c->in_request ? limits_.request_deadline : limits_.keep_alive_timeout);
+  if (c->in_request) read_from(c->fd);  // frames what is buffered, and reads anything new
+}
+
+void DeadlineHttpServer::write_to(const std::shared_ptr<Connection>& c) {
+  Front& f = *front_;
+  while (!c->out.empty()) {
+    const ssize_t n = ::send(c->fd, c->out.data(), c->out.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return;  // the client reads on: wait for EPOLLOUT
+    if (n <= 0) break;
+    c->out.erase(0, static_cast<std::size_t>(n));
+  }
+  if (!c->out.empty() || c->close_after_out || !f.watch(c->fd, EPOLL_CTL_MOD)) {
+    f.waiting.erase(c->fd);
+    f.close_connection(c);
+    return;
+  }
+  c->writing = false;
+  wait_for_request(c);
 }
 
 // Waits that ended: a request not whole by its deadline is answered 408, a silent connection closed.
@@ -476,7 +523,7 @@ void DeadlineHttpServer::end_waits(int listen_fd) {
       ++it;
       continue;
     }
-    if (it->second->in_request)
+    if (it->second->in_request && !it->second->writing)
       send_refusal(it->first, 408, "Request Timeout", "request not complete within its deadline", answer_headers_);
     f.close_connection(it->second);
     it = f.waiting.erase(it);
@@ -520,6 +567,8 @@ bool DeadlineHttpServer::serve_after_bind() {
         std::uint64_t count = 0;
         (void)!::read(f.wake_fd, &count, sizeof count);
         take_back();
+      } else if (const auto it = f.waiting.find(fd); it != f.waiting.end() && it->second->writing) {
+        write_to(it->second);
       } else {
         read_from(fd);
       }

@@ -5,7 +5,11 @@
 // at 1000). Here one thread accepts every connection and reads every request into memory; a worker
 // (from new_task_queue) gets a connection only once a whole request has arrived, runs httplib's
 // parsing, routing and answer on it (its protected process_request), and hands the connection back.
-// So a slow or silent connection costs a descriptor and a buffer, never a worker.
+// So a slow or silent connection costs a descriptor and a buffer, never a worker. The same holds
+// the other way: a worker writes its answer into memory and sends what the socket takes at once;
+// the rest the front end writes as the client reads, within `write_timeout`, or it closes the
+// connection. A client that never reads its answers (3,000 of them held every worker blocked in
+// send and starved the page) costs a buffer, not a worker.
 //
 // Bounds: a request's head and body arrive within `request_deadline` of its first byte (else 408),
 // a request past `max_request_bytes` is cut unread (431), a head of more than `max_header_fields`
@@ -29,7 +33,7 @@ namespace epa::web {
 struct RequestLimits {
   std::chrono::milliseconds request_deadline{2000};    // first byte of a request -> its last byte
   std::chrono::milliseconds read_timeout{2000};        // a new connection waits this long for its first byte
-  std::chrono::milliseconds write_timeout{5000};       // per write of the answer
+  std::chrono::milliseconds write_timeout{2000};       // an answer must be taken by the client within this
   std::chrono::milliseconds keep_alive_timeout{2000};  // a kept-alive connection waits this long for the next request
   std::size_t keep_alive_max_requests = 100;
   std::size_t max_request_bytes = 64 * 1024;  // head and body; a larger request is cut, not read
@@ -64,6 +68,8 @@ class DeadlineHttpServer final : public httplib::Server {
   void accept_waiting(int listen_fd);
   void admit(int fd, const std::string& peer);
   void read_from(int fd);
+  void write_to(const std::shared_ptr<Connection>& c);  // the rest of an answer, as the client reads it
+  void wait_for_request(const std::shared_ptr<Connection>& c);  // back to reading: the next request
   void dispatch(const std::shared_ptr<Connection>& c);
   void take_back();
   void end_waits(int listen_fd);
