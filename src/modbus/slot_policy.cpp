@@ -9,7 +9,7 @@ namespace epa::modbus {
 namespace {
 
 // Which clients hold their slot by history: open kHistoryNs with a valid request within the last
-// kHistoryNs, the longest-connected first, at most half the slots.
+// kHistoryNs, the longest-connected first, at most half the slots and an address's share each.
 std::vector<bool> proved_by_history(std::span<const SlotHolder> clients, std::int64_t now_ns, const SlotLimits& limits) {
   std::vector<std::size_t> veterans;
   for (std::size_t i = 0; i < clients.size(); ++i) {
@@ -17,9 +17,15 @@ std::vector<bool> proved_by_history(std::span<const SlotHolder> clients, std::in
     if (now_ns - c.connected_ns >= kHistoryNs && c.last_valid_ns >= 0 && now_ns - c.last_valid_ns <= kHistoryNs) veterans.push_back(i);
   }
   std::sort(veterans.begin(), veterans.end(), [&](std::size_t a, std::size_t b) { return clients[a].connected_ns < clients[b].connected_ns; });
-  veterans.resize(std::min(veterans.size(), static_cast<std::size_t>(limits.max_clients / 2)));
   std::vector<bool> kept(clients.size(), false);
-  for (std::size_t i : veterans) kept[i] = true;
+  std::map<std::string, int> per_address;
+  int kept_count = 0;
+  for (std::size_t i : veterans) {
+    if (kept_count >= limits.max_clients / 2) break;
+    if (per_address[clients[i].address]++ >= limits.max_per_address) continue;
+    kept[i] = true;
+    ++kept_count;
+  }
   return kept;
 }
 
@@ -38,8 +44,10 @@ bool evict_before(const SlotHolder& a, const SlotHolder& b, const std::map<std::
 Admission admit(std::span<const SlotHolder> clients, const std::string& address, std::int64_t now_ns, const SlotLimits& limits) {
   std::map<std::string, int> held;
   for (const SlotHolder& c : clients) ++held[c.address];
+  // A share, not a wall: with room, anyone is admitted (so a crowd holding its address's share
+  // cannot keep out the engineer or the HMI on that address); only a full server takes shares.
+  if (static_cast<int>(clients.size()) < limits.max_clients) return {};
   const bool address_full = held[address] >= limits.max_per_address;
-  if (!address_full && static_cast<int>(clients.size()) < limits.max_clients) return {};
 
   const std::vector<bool> veteran = proved_by_history(clients, now_ns, limits);
   auto arriving = [&](const SlotHolder& c) { return !c.served && now_ns - c.connected_ns < kArrivalNs; };

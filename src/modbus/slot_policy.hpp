@@ -1,21 +1,24 @@
 #pragma once
 // Who gets a Modbus connection slot when a new client connects: fair slots, so that clients which
 // look busy (read every second, reconnect when evicted) cannot push out the plant's HMI.
+//  - With a free slot, a newcomer is admitted, whoever it is. max_per_address is a share, not a
+//    wall: a crowd that holds its address's share cannot keep out the engineer or the HMI on that
+//    address while there is room (a hard cap let 4 reading connections deny their whole address).
 //  - A client that has proved itself is never evicted for a newcomer: it holds the unlock, or its
 //    address is on write_clients, or it is among the longest-serving clients (open kHistoryNs with
-//    a valid request in the last kHistoryNs; at most half the slots are held this way, so a
-//    newcomer can always find room unless unlocked or write_clients connections fill the server).
-//  - A newcomer whose address already holds max_per_address slots takes the place of a client of
-//    its own address that has not proved itself, or is refused (closed at once): it never evicts
-//    another address's client, so one address cannot hold more than its share, and a silent crowd
-//    on the HMI's own address cannot lock the HMI out either.
-//  - When the server is full, a newcomer evicts a client that has not proved itself: one of an
-//    address that holds its whole share (max_per_address) first; then one that never completed a
+//    a valid request in the last kHistoryNs; at most half the slots, and an address's share each,
+//    are held this way, so a newcomer can always find room unless unlocked or write_clients
+//    connections fill the server).
+//  - When the server is full, a newcomer whose address already holds its share takes the place of
+//    a client of its own address that has not proved itself, or is refused (closed at once): it
+//    never evicts another address's client. Any other newcomer evicts a client that has not proved
+//    itself: one of an address that holds its whole share first; then one that never completed a
 //    request (the one silent the longest), else the youngest (so a reconnecting crowd churns among
-//    its newest members while the established clients stay, and a client that connects per poll is
-//    served before anyone newer arrives). With none such, the newcomer is refused. An address below
-//    its share is not preferred for holding more slots than others: an HMI PC with an HMI, a
-//    historian and an engineering tool would then lose its youngest to every newcomer.
+//    its newest members while the established clients stay). A client arriving (kArrivalNs) is
+//    not evicted, and while one arrives neither is an answered one. With none such, the newcomer
+//    is refused. An address below its share is not preferred for holding more slots than others:
+//    an HMI PC with an HMI, a historian and an engineering tool would then lose its youngest to
+//    every newcomer.
 #include <cstddef>
 #include <cstdint>
 #include <span>

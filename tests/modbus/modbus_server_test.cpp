@@ -289,9 +289,10 @@ TEST_F(Server, AnUnlockedClientIsNeverEvictedAndANewcomerIsRefusedWhenAllAreProv
   EXPECT_EQ(server_->evicted(), 0u);
 }
 
-// One address holds at most max_clients_per_address slots: above it a newcomer takes the place of
-// its own address's youngest, never another address's client.
-TEST_F(Server, ANewcomerAboveItsAddressCapReplacesItsOwnAddressesClient) {
+// max_clients_per_address is an address's share: with room anyone is admitted; when the server is
+// full, a newcomer above its address's share takes the place of its own address's youngest, never
+// another address's client.
+TEST_F(Server, ANewcomerAboveItsAddressShareReplacesItsOwnAddressesClientWhenFull) {
   server_->stop();
   ServerConfig c;
   c.max_clients = 4;
@@ -326,12 +327,17 @@ TEST_F(Server, ANewcomerAboveItsAddressCapReplacesItsOwnAddressesClient) {
   const int second = from("127.0.0.1");
   ASSERT_TRUE(served(second));
   std::this_thread::sleep_for(20ms);
-  const int third = from("127.0.0.1");  // the address's third: the server has room, the address not
+  const int third = from("127.0.0.1");  // the address's third: above its share, but the server has room
   EXPECT_TRUE(served(third));
-  EXPECT_FALSE(served(second));  // its own address's youngest made room
+  EXPECT_TRUE(served(second));
+  std::this_thread::sleep_for(20ms);
+  const int fourth = from("127.0.0.1");  // the server is full: the address gives up its own
+  EXPECT_TRUE(served(fourth));
+  EXPECT_FALSE(served(third));   // its own address's youngest made room
   EXPECT_TRUE(served(first));
+  EXPECT_TRUE(served(second));
   EXPECT_TRUE(served(other));    // another address's client is never taken for it
-  EXPECT_EQ(server_->clients(), 3);
+  EXPECT_EQ(server_->clients(), 4);
 }
 
 TEST_F(Server, FreshIdleSocketsAreEvictedBeforeAWorkingClient) {

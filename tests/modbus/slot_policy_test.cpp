@@ -70,14 +70,34 @@ TEST(SlotPolicy, LongServingClientsHoldAtMostHalfTheSlots) {
   EXPECT_EQ(admit(c, "10.0.0.9", now, {4, 4}).kind, Kind::kRefuse);
 }
 
-TEST(SlotPolicy, AboveItsAddressCapANewcomerReplacesItsOwnAddressesClientOrIsRefused) {
+TEST(SlotPolicy, WhenFullANewcomerAboveItsAddressShareReplacesItsOwnAddressesClientOrIsRefused) {
   const std::int64_t now = 5 * kS;
   std::vector<SlotHolder> c = {busy("10.0.0.1", 0, now), busy("10.0.0.2", 1 * kS, now), busy("10.0.0.2", 2 * kS, now)};
-  const Admission a = admit(c, "10.0.0.2", now, {16, 2});
+  const Admission a = admit(c, "10.0.0.2", now, {3, 2});
   EXPECT_EQ(a.kind, Kind::kEvict);
-  EXPECT_EQ(a.victim, 2u);  // its own address's youngest, though the server has room
+  EXPECT_EQ(a.victim, 2u);  // its own address's youngest, not the younger-looking other address
   c[1].proved = c[2].proved = true;
-  EXPECT_EQ(admit(c, "10.0.0.2", now, {16, 2}).kind, Kind::kRefuse);
+  EXPECT_EQ(admit(c, "10.0.0.2", now, {3, 2}).kind, Kind::kRefuse);
+}
+
+// Four connections that read every second held their address's whole share, and the engineer on
+// that address could not connect at all (an outside test: 0 of 30 unlocks).
+TEST(SlotPolicy, WithRoomAnAddressAboveItsShareIsAdmitted) {
+  const std::int64_t now = 30 * kS;
+  std::vector<SlotHolder> c;
+  for (int i = 0; i < 4; ++i) c.push_back(busy("10.0.0.2", i * kS, now));  // long-serving, all of them
+  EXPECT_EQ(admit(c, "10.0.0.2", now, {16, 4}).kind, Kind::kAdmit);
+}
+
+TEST(SlotPolicy, AnAddressHoldsAtMostItsShareOfTheLongServingSlots) {
+  const std::int64_t now = 30 * kS;
+  std::vector<SlotHolder> c;
+  for (int i = 0; i < 6; ++i) c.push_back(busy("10.0.0.2", i * kS, now));  // six long-serving from one address
+  c.push_back(busy("10.0.0.3", 25 * kS, now));
+  c.push_back(busy("10.0.0.4", 26 * kS, now));
+  const Admission a = admit(c, "10.0.0.9", now, {8, 4});
+  EXPECT_EQ(a.kind, Kind::kEvict);
+  EXPECT_EQ(a.victim, 5u);  // only 4 of 10.0.0.2's count as long-serving; its youngest goes (it is over its share)
 }
 
 TEST(SlotPolicy, AnAddressHoldingItsWholeShareGivesUpASlotBeforeOthers) {
