@@ -139,8 +139,13 @@ void ModbusServer::serve() {
     return a.kind != Admission::Kind::kRefuse;
   };
 
+  // Out of file descriptors, accept fails and the listener stays readable: it is left out of the
+  // poll for kAcceptPauseNs, or the loop would spin on it (the clients already connected are served).
+  constexpr std::int64_t kAcceptPauseNs = 50'000'000;
+  std::int64_t accept_paused_until_ns = 0;
   while (!stop_.load()) {
-    fds.assign(1, pollfd{m.listener, POLLIN, 0});
+    const bool accepting = m.clock.now_ns() >= accept_paused_until_ns;
+    fds.assign(1, pollfd{accepting ? m.listener : -1, POLLIN, 0});
     for (const auto& cl : m.clients) fds.push_back({cl.fd, POLLIN, 0});
     if (poll(fds.data(), fds.size(), 100) < 0 && errno != EINTR) break;
     const std::int64_t now = m.clock.now_ns();
@@ -152,6 +157,10 @@ void ModbusServer::serve() {
         sockaddr_storage peer{};  // IPv4 or IPv6; "::" hands IPv4 peers over as mapped addresses (ip_text unmaps them)
         socklen_t len = sizeof peer;
         const int fd = accept4(m.listener, reinterpret_cast<sockaddr*>(&peer), &len, SOCK_NONBLOCK | SOCK_CLOEXEC);
+        if (fd < 0 && (errno == EMFILE || errno == ENFILE)) {
+          m.slot_log.out_of_descriptors(now);
+          accept_paused_until_ns = now + kAcceptPauseNs;
+        }
         if (fd < 0) break;
         const std::string ip = core::ip_text(peer);
         if (!make_room(ip, now)) {
@@ -197,6 +206,9 @@ void ModbusServer::serve() {
         if (protocol != 0 || count < 2 || kMbapLength + count > kMaxAdu) { drop(i, "malformed frame"); dropped = true; break; }
         const auto total = static_cast<std::size_t>(kMbapLength + count);
         if (cl.buffer.size() < total) break;
+        // Function codes 128-255 are the exception answers' own: no request has one, and an
+        // exception answer to it would wrap into a valid-looking function code.
+        if (cl.buffer[kMbapLength + 1] & 0x80) { drop(i, "malformed frame: a function code of 128 or more"); dropped = true; break; }
         m.handler.set_clients(static_cast<int>(m.clients.size()));
         const Reply reply = m.handler.handle(cl.buffer.data(), static_cast<int>(total), cl.session, now, m.image);
         modbus_set_socket(m.ctx, cl.fd);

@@ -362,6 +362,17 @@ TEST_F(Server, AnIdleClientIsDisconnected) {
   EXPECT_EQ(n, 0);  // orderly close by the server
 }
 
+// FC 0x84 once got "04 01": libmodbus' exception bit wrapped it into a valid-looking FC4 answer.
+TEST_F(Server, AFunctionCodeWithTheExceptionBitClosesTheConnection) {
+  const int fd = raw_socket();
+  const std::uint8_t frame[] = {0x00, 0x01, 0x00, 0x00, 0x00, 0x06, 0x01, 0x84, 0x00, 0x00, 0x00, 0x02};
+  ASSERT_EQ(send(fd, frame, sizeof frame, MSG_NOSIGNAL), static_cast<ssize_t>(sizeof frame));
+  timeval tv{2, 0};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  std::uint8_t answer[64];
+  EXPECT_EQ(recv(fd, answer, sizeof answer, 0), 0);  // closed, nothing answered
+}
+
 TEST_F(Server, AClientSendingOneByteAtATimeDoesNotBlockOthers) {
   const int slow = raw_socket();
   const std::uint8_t frame[] = {0x00, 0x01, 0x00, 0x00, 0x00, 0x06, 0x01, 0x04, 0x00, 0x00, 0x00, 0x02};
