@@ -17,6 +17,7 @@ class SlotLog {
 
   void evicted(std::int64_t now_ns) { note(now_ns), ++evicted_, ++evicted_total_; }
   void refused(std::int64_t now_ns) { note(now_ns), ++refused_, ++refused_total_; }
+  void out_of_descriptors(std::int64_t now_ns) { note(now_ns), ++no_descriptors_; }  // accept failed: EMFILE/ENFILE
   // Whether a disconnect line may be logged now (else it is counted for the summary).
   bool disconnect_line(std::int64_t now_ns) {
     if (now_ns - disconnect_window_ns_ >= kWindowNs) disconnect_window_ns_ = now_ns, disconnect_lines_ = 0;
@@ -33,7 +34,9 @@ class SlotLog {
                        std::to_string((now_ns - pending_since_ns_) / 1'000'000'000) + " s (max_clients " +
                        std::to_string(max_clients) + ", max_clients_per_address " + std::to_string(max_per_address) + ")";
     if (unlogged_ > 0) line += "; " + std::to_string(unlogged_) + " disconnect lines not logged";
-    evicted_ = refused_ = unlogged_ = 0;
+    if (no_descriptors_ > 0)
+      line += "; accepting paused " + std::to_string(no_descriptors_) + " times: out of file descriptors (LimitNOFILE)";
+    evicted_ = refused_ = unlogged_ = no_descriptors_ = 0;
     pending_since_ns_ = -1;
     last_line_ns_ = now_ns;
     return line;
@@ -45,7 +48,7 @@ class SlotLog {
   void note(std::int64_t now_ns) {
     if (pending_since_ns_ < 0) pending_since_ns_ = now_ns;
   }
-  std::uint64_t evicted_ = 0, refused_ = 0, unlogged_ = 0, evicted_total_ = 0, refused_total_ = 0;
+  std::uint64_t evicted_ = 0, refused_ = 0, unlogged_ = 0, no_descriptors_ = 0, evicted_total_ = 0, refused_total_ = 0;
   std::int64_t pending_since_ns_ = -1;
   std::int64_t last_line_ns_ = -kWindowNs - 1;
   std::int64_t disconnect_window_ns_ = -kWindowNs - 1;
