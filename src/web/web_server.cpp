@@ -3,7 +3,9 @@
 #include <httplib.h>
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <condition_variable>
 #include <filesystem>
@@ -158,8 +160,11 @@ struct WebServer::Impl {
       return false;
     }
     const std::string header = req.get_header_value("Authorization");
-    const std::string prefix = "Bearer ";
-    if (header.compare(0, prefix.size(), prefix) == 0 && constant_time_equal(header.substr(prefix.size()), config.token)) {
+    const std::string prefix = "bearer ";  // the scheme is case-insensitive (RFC 9110 11.1)
+    const bool bearer = header.size() >= prefix.size() &&
+                        std::equal(prefix.begin(), prefix.end(), header.begin(),
+                                   [](char p, char h) { return p == std::tolower(static_cast<unsigned char>(h)); });
+    if (bearer && constant_time_equal(header.substr(prefix.size()), config.token)) {
       token_guesses.right(who);
       return true;
     }

@@ -995,6 +995,8 @@ TEST_F(WebServerTest, TheTokenFollowedByNulAndJunkIsRefused) {
   EXPECT_EQ(status_line(post_with(std::string("Bearer a-token-of-sixteen-chars\0", 32))), "HTTP/1.1 400 Bad Request");
   EXPECT_TRUE(queued().empty());
   EXPECT_EQ(status_line(post_with("Bearer a-token-of-sixteen-chars")), "HTTP/1.1 200 OK");
+  EXPECT_EQ(status_line(post_with("bearer a-token-of-sixteen-chars")), "HTTP/1.1 200 OK");  // the scheme's case is free
+  EXPECT_EQ(status_line(post_with("Basic a-token-of-sixteen-chars")), "HTTP/1.1 401 Unauthorized");
 }
 
 // One address holds at most 32 connections (the default): the 33rd is closed at once with 503,
