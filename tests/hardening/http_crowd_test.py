@@ -7,6 +7,11 @@ the client side), while the status page polls /api/status once a second:
   one address     1,000 connections from 127.0.0.2 alone (the per-address cap closes all but 32 at
                   once; they reconnect a second later)
 
+  slow readers    1,500 connections from 50 addresses (30 each, under the cap), each with a 4 KiB
+                  receive buffer, pipelining 200 requests for /api/trend and never reading an
+                  answer (workers once blocked writing to them: 0 % of polls at 3,000), reconnecting
+                  a second after the appliance closes one
+
 For each, two pollers from 127.0.0.1: one that opens a fresh connection per poll and one that keeps
 its connection. Passes when each answers within 1 s for at least 95 % of its polls. It also checks
 that the appliance raised its open-files soft limit (started here with 1024) and that refusals are
@@ -18,6 +23,7 @@ Loopback only, every loop bounded; the appliance is stopped by its PID. Exit 0 w
 holds, 1 otherwise.
 """
 import errno
+import multiprocessing
 import os
 import resource
 import selectors
@@ -119,6 +125,81 @@ class SlowCrowd:
         self.thread.join(timeout=10)
 
 
+class SlowReaders:
+    """`count` connections from `sources` that pipeline requests and never read; one is opened
+    again a second after the appliance closes it. In a process of its own: a crowd that shares the
+    pollers' interpreter would delay their polls itself."""
+
+    REQUESTS = b"GET /api/trend HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n" * 200
+
+    def __init__(self, port, sources, count):
+        self.stop_flag = multiprocessing.Event()
+        self.held = multiprocessing.Value("i", 0)
+        self.connects = multiprocessing.Value("i", 0)
+        self.process = multiprocessing.Process(target=SlowReaders._run, args=(port, sources, count, self.stop_flag, self.held,
+                                                                               self.connects), daemon=True)
+        self.process.start()
+
+    @property
+    def open_samples(self):
+        return [self.held.value]
+
+    @property
+    def reconnects(self):
+        return self.connects.value
+
+    @staticmethod
+    def _open(port, source):
+        s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        try:
+            s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+            s.bind((source, 0))
+            s.settimeout(0.5)
+            s.connect(("127.0.0.1", port))
+            s.setblocking(False)
+            try:
+                s.send(SlowReaders.REQUESTS)
+            except OSError:
+                pass  # what the socket took is enough
+            return s
+        except OSError:
+            s.close()
+            return None
+
+    @staticmethod
+    def _run(port, sources, count, stop_flag, held, connects):
+        slots = [None] * count
+        retry_at = [0.0] * count
+        while not stop_flag.is_set():
+            now = time.monotonic()
+            for i in range(count):
+                s = slots[i]
+                if s is not None:
+                    try:  # closed by the appliance? (a peek, never a read of an answer)
+                        if s.recv(1, socket.MSG_PEEK) == b"":
+                            s.close()
+                            slots[i], retry_at[i] = None, now + 1.0
+                    except BlockingIOError:
+                        pass
+                    except OSError:
+                        s.close()
+                        slots[i], retry_at[i] = None, now + 1.0
+                elif now >= retry_at[i]:
+                    slots[i] = SlowReaders._open(port, sources[i % len(sources)])
+                    connects.value += 1
+                    if slots[i] is None:
+                        retry_at[i] = now + 1.0
+            held.value = sum(1 for s in slots if s is not None)
+            stop_flag.wait(0.2)
+        for s in slots:
+            if s is not None:
+                s.close()
+
+    def close(self):
+        self.stop_flag.set()
+        self.process.join(timeout=20)
+
+
 def read_answer(s, deadline):
     """One HTTP answer (head and Content-Length body) from `s`; the status line, or None."""
     data = b""
@@ -170,9 +251,9 @@ def poll(port, seconds, persistent, results):
         conn.close()
 
 
-def crowd_row(app, name, sources, seconds):
-    crowd = SlowCrowd(app.web_port, sources)
-    time.sleep(2.0)  # the crowd connects
+def crowd_row(app, name, sources, seconds, readers=0):
+    crowd = SlowReaders(app.web_port, sources, readers) if readers else SlowCrowd(app.web_port, sources)
+    time.sleep(3.0 if readers else 2.0)  # the crowd connects
     fresh, kept = [], []
     pollers = [threading.Thread(target=poll, args=(app.web_port, seconds, False, fresh)),
                threading.Thread(target=poll, args=(app.web_port, seconds, True, kept))]
@@ -189,7 +270,7 @@ def crowd_row(app, name, sources, seconds):
         check(len(results) >= seconds - 2 and share >= 95.0,
               f"{name}: /api/status within 1 s, {label}: {answered}/{len(results)} = {share:.0f} % (>= 95 %), "
               f"slowest {worst:.3f} s; crowd: {held} connections open (median), {crowd.reconnects} connects")
-    return held, crowd.refused
+    return held, getattr(crowd, "refused", 0)
 
 
 def main():
@@ -208,6 +289,9 @@ def main():
               f"the many-address crowd was held open ({held} of 1,000, {refused} refused; each address is under its cap)")
         held, refused = crowd_row(app, "1,000 slow connections from one address", ["127.0.0.2"], seconds)
         check(refused >= 1000, f"one address past its cap of 32 is refused at once (503 {refused} times)")
+        held, _ = crowd_row(app, "1,500 slow readers from 50 addresses", [f"127.0.0.{120 + i}" for i in range(50)],
+                            max(5, seconds * 2 // 3), readers=1500)
+        check(held >= 1000, f"the slow readers were held open ({held} of 1,500 at the median)")
         time.sleep(0.3)
         log = app.log_text()
         refusal_lines = [line for line in log.splitlines() if "too many from one address" in line]
