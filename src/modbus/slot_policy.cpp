@@ -50,7 +50,11 @@ Admission admit(std::span<const SlotHolder> clients, const std::string& address,
   const bool address_full = held[address] >= limits.max_per_address;
 
   const std::vector<bool> veteran = proved_by_history(clients, now_ns, limits);
-  auto arriving = [&](const SlotHolder& c) { return !c.served && now_ns - c.connected_ns < kArrivalNs; };
+  // Arriving clients of an address within its share: a burst of silent connects from one address
+  // (a reconnect storm) is not shielded by the rule, and the client after it gets a slot.
+  auto arriving = [&](const SlotHolder& c) {
+    return !c.served && now_ns - c.connected_ns < kArrivalNs && held.at(c.address) <= limits.max_per_address;
+  };
   const bool someone_arriving = std::any_of(clients.begin(), clients.end(), arriving);
   std::size_t pick = clients.size();
   for (std::size_t i = 0; i < clients.size(); ++i) {

@@ -47,9 +47,9 @@ struct Admission {
 };
 
 inline constexpr std::int64_t kHistoryNs = 10'000'000'000; // connected this long with valid requests: proved
-// A client connected less than this long ago and not yet answered is arriving: its first request
-// is on its way (one round trip on a plant network). It is not evicted, and while one is arriving
-// no answered client is evicted either, only silent ones: a crowd that connects at once cannot
+// A client connected less than this long ago and not yet answered, of an address within its share,
+// is arriving: its first request is on its way (one round trip on a plant network). It is not
+// evicted, and while one is arriving no answered client is evicted either, only silent ones: a crowd that connects at once cannot
 // push out a working HMI, and a reconnecting crowd cannot evict a connect-per-poll HMI between
 // its connect and its answer (it did, in 1 of about 80 polls, before this rule).
 inline constexpr std::int64_t kArrivalNs = 50'000'000;

@@ -289,9 +289,12 @@ def main():
               f"the many-address crowd was held open ({held} of 1,000, {refused} refused; each address is under its cap)")
         held, refused = crowd_row(app, "1,000 slow connections from one address", ["127.0.0.2"], seconds)
         check(refused >= 1000, f"one address past its cap of 32 is refused at once (503 {refused} times)")
-        held, _ = crowd_row(app, "1,500 slow readers from 50 addresses", [f"127.0.0.{120 + i}" for i in range(50)],
-                            max(5, seconds * 2 // 3), readers=1500)
-        check(held >= 1000, f"the slow readers were held open ({held} of 1,500 at the median)")
+        # Under a sanitizer every answer costs several times the CPU: a third of the crowd (the
+        # same paths; what is judged there is memory, not capacity).
+        readers = 500 if os.environ.get("EPA_SANITIZER_RUN") else 1500
+        held, _ = crowd_row(app, f"{readers:,} slow readers from 50 addresses", [f"127.0.0.{120 + i}" for i in range(50)],
+                            max(5, seconds * 2 // 3), readers=readers)
+        check(held >= readers * 2 // 3, f"the slow readers were held open ({held} of {readers:,} at the median)")
         time.sleep(0.3)
         log = app.log_text()
         refusal_lines = [line for line in log.splitlines() if "too many from one address" in line]

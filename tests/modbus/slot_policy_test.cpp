@@ -52,6 +52,17 @@ TEST(SlotPolicy, WhileAClientIsArrivingOnlySilentClientsAreEvicted) {
   EXPECT_EQ(admit(c, "10.0.0.9", now + kArrivalNs, {3, 4}).victim, 2u);
 }
 
+// A burst of silent connects from one address is beyond its share: not shielded as arriving, so
+// the client that comes after the burst gets a slot.
+TEST(SlotPolicy, ABurstFromOneAddressIsNotShieldedAsArriving) {
+  const std::int64_t now = 5 * kS;
+  std::vector<SlotHolder> c = {busy("10.0.0.1", 1 * kS, now)};
+  for (int i = 0; i < 5; ++i) c.push_back({"10.0.0.7", now - kArrivalNs / 2 + i, -1, false, false});
+  const Admission a = admit(c, "10.0.0.9", now, {6, 4});
+  EXPECT_EQ(a.kind, Kind::kEvict);
+  EXPECT_EQ(a.victim, 1u);  // of the burst's address (over its share), the one silent the longest
+}
+
 TEST(SlotPolicy, ProvedClientsStayAndWithNoneElseTheNewcomerIsRefused) {
   const std::int64_t now = 20 * kS;
   std::vector<SlotHolder> c = {busy("10.0.0.1", 19 * kS, now), busy("10.0.0.2", 19 * kS, now)};
