@@ -12,6 +12,11 @@
 #  - the browser tests (browser.*: 140 s, run alone): what they add to the suite is the page in
 #    Chromium, which no sanitizer sees; the HTTP paths the page calls run instrumented in web_test,
 #    and the integration tests (write gate, faults, records, commissioning) call them over HTTP;
+#  - the crowd capacity checks hardening.fair_slots, hardening.shared_lockout and
+#    hardening.http_crowd (140 s, run alone): they judge answer times under load, which an
+#    instrumented build does not have; the paths they drive (the front end's buffered answers,
+#    the slot policy, the back-off) run instrumented in web_test and modbus_test and under
+#    hardening.attack, abuse and disk_flood here (all three also passed under ASan by hand);
 #  - figures from more of the same paths (EPA_SANITIZER_RUN=1 in the preset; its tests say which,
 #    tests/support/sanitizer_run.hpp): the self-check's three seeds (one here), the two other
 #    physics plants' identification, the commissioning test's HMI moves after the deployment
@@ -24,5 +29,5 @@ cmake --preset asan >/dev/null
 cmake --build --preset asan
 built=$(date +%s)
 [ "${1:-}" = --build-only ] && exit 0  # .ci/run compiles ahead while the release suite runs
-ctest --preset asan -E '^browser\.' "$@"
+ctest --preset asan -E '^(browser\.|hardening\.(fair_slots|shared_lockout|http_crowd)$)' "$@"
 echo "test-sanitizers: build $((built - start)) s, tests $(($(date +%s) - built)) s"
