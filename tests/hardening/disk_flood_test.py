@@ -190,6 +190,7 @@ def run_flood(port, regs, work):
     worst_runs = worst_db = 0
     lagging = 0
     newest_record = 0  # record files are numbered: a number above the files left means the oldest went
+    moves_seen = False  # a move file in some look (the quota may rotate them all out by the end)
     started = time.monotonic()
     in_run = False
     try:
@@ -201,6 +202,7 @@ def run_flood(port, regs, work):
                 in_run = True
             names = os.listdir(os.path.join(work, "runs")) if os.path.isdir(os.path.join(work, "runs")) else []
             newest_record = max([newest_record] + [int(n[7:11]) for n in names if re.match(r"record-\d{4}-", n)])
+            moves_seen = moves_seen or any(n.startswith("move-") for n in names)
             runs = bytes_in(os.path.join(work, "runs"), r"(move|record|excite)-.*\.csv$")
             db = bytes_in(work, r"epa\.db")
             worst_runs, worst_db = max(worst_runs, runs), max(worst_db, db)
@@ -230,7 +232,7 @@ def run_flood(port, regs, work):
     print("record files: %d written, %d left" % (newest_record, len(record_files)))
     if newest_record <= len(record_files):
         fail("no record file was rotated out: the flood never reached the %g MiB quota, so it was not tested" % QUOTA_MB)
-    if not any(n.startswith("move-") for n in run_files):
+    if not moves_seen and not any(n.startswith("move-") for n in run_files):
         fail("no move file: the flood in RUN made no moves")
     accepted_records = record_counts.get(0, 0)
     if accepted_records > elapsed / 5.0 + 2:
