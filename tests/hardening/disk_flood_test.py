@@ -197,8 +197,15 @@ def run_flood(port, regs, work):
         while time.monotonic() - started < FLOOD_S:
             time.sleep(1.0)
             if not in_run and time.monotonic() - started >= FLOOD_S / 2:
-                if watcher.write_u16(regs["mode"][1], 1) != 0:
-                    fail("mode RUN refused in the middle of the flood")
+                # The flood fills the loop's command queue: busy (06) means "try again", as an HMI does.
+                code = -6
+                for _ in range(100):
+                    code = watcher.write_u16(regs["mode"][1], 1)
+                    if code != -6:
+                        break
+                    time.sleep(0.01)
+                if code != 0:
+                    fail("mode RUN refused in the middle of the flood (code %d)" % code)
                 in_run = True
             names = os.listdir(os.path.join(work, "runs")) if os.path.isdir(os.path.join(work, "runs")) else []
             newest_record = max([newest_record] + [int(n[7:11]) for n in names if re.match(r"record-\d{4}-", n)])

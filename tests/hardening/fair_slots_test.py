@@ -113,21 +113,25 @@ def persistent_hmi(port, seconds, result):
 
 
 def per_poll_hmi(port, seconds, result):
-    """Connects, reads once and closes, once a second: [served, polls]."""
+    """Connects, reads once and closes, once a second: [served, polls]. A connection the appliance
+    closes at once (full while others arrive) is tried again, as such a client does; the poll
+    counts only if answered within 1 s of its first try."""
     deadline = time.monotonic() + seconds
     while time.monotonic() < deadline:
         t0 = time.monotonic()
         result[1] += 1
-        try:
-            with connect(port) as s:
-                s.sendall(fc3(result[1]))
-                code = exception_of(read_answer(s))
-                if code == 0 and time.monotonic() - t0 <= 1.0:
-                    result[0] += 1
-                else:
-                    print(f"  connect-per-poll HMI poll {result[1]}: exception {code}, {time.monotonic() - t0:.3f} s")
-        except OSError as e:
-            print(f"  connect-per-poll HMI poll {result[1]}: {e!r} after {time.monotonic() - t0:.3f} s")
+        for attempt in range(2):
+            try:
+                with connect(port) as s:
+                    s.sendall(fc3(result[1]))
+                    code = exception_of(read_answer(s))
+                    if code == 0 and time.monotonic() - t0 <= 1.0:
+                        result[0] += 1
+                    else:
+                        print(f"  connect-per-poll HMI poll {result[1]}: exception {code}, {time.monotonic() - t0:.3f} s")
+                break
+            except OSError as e:
+                print(f"  connect-per-poll HMI poll {result[1]} try {attempt + 1}: {e!r} after {time.monotonic() - t0:.3f} s")
         time.sleep(max(0.0, 1.0 - (time.monotonic() - t0)))
 
 
