@@ -62,8 +62,15 @@ class Server : public ::testing::Test {
     clients_.push_back(ctx);
     return ctx;
   }
-  int raw_socket() {
+  // A connection that speaks raw bytes; from `source` (any loopback address: all of 127/8 is lo).
+  int raw_socket(const char* source = nullptr) {
     const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    if (source) {
+      sockaddr_in local{};
+      local.sin_family = AF_INET;
+      inet_pton(AF_INET, source, &local.sin_addr);
+      EXPECT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&local), sizeof local), 0);
+    }
     sockaddr_in a{};
     a.sin_family = AF_INET;
     a.sin_port = htons(static_cast<std::uint16_t>(server_->port()));
@@ -298,20 +305,7 @@ TEST_F(Server, ANewcomerAboveItsAddressShareReplacesItsOwnAddressesClientWhenFul
   c.max_clients = 4;
   c.max_clients_per_address = 2;
   start(c);  // on 127.0.0.1; clients bound to 127.0.0.2 reach it too (all of 127/8 is loopback)
-  auto from = [&](const char* source) {
-    const int fd = socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in local{};
-    local.sin_family = AF_INET;
-    inet_pton(AF_INET, source, &local.sin_addr);
-    EXPECT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&local), sizeof local), 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(static_cast<std::uint16_t>(server_->port()));
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    EXPECT_EQ(connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
-    raw_.push_back(fd);
-    return fd;
-  };
+  auto from = [&](const char* source) { return raw_socket(source); };
   const std::uint8_t read[] = {0x00, 0x01, 0x00, 0x00, 0x00, 0x06, 0x01, 0x04, 0x00, 0x00, 0x00, 0x02};
   auto served = [&](int fd) {
     timeval tv{1, 0};
