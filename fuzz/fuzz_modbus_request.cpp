@@ -75,7 +75,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                          control::paper_controller_config(control::ControllerKind::kPpFfidz), channels, &audit);
   modbus::RequestHandler handler(fx.map, modbus::WritePolicy{.read_only = false, .unlock_key = 0x5e3a9c17d24b086f, .unlock_timeout_s = 10},
                                  {1, 0, 0xFF}, modbus::status_page_url(8080), gate, channels);
-  modbus::Session session{"127.0.0.1", "127.0.0.1:50000", 0};
+  modbus::Session session{.address = "127.0.0.1", .peer = "127.0.0.1:50000"};
   std::int64_t now_ns = 0;
   std::size_t pos = 0;
   while (size - pos >= static_cast<std::size_t>(kMbapLength + 1)) {
