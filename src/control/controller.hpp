@@ -14,7 +14,7 @@ namespace epa::control {
 // What a user or a file provides; checked by ControllerParams::make.
 struct ControllerConfig {
   ControllerKind kind = ControllerKind::kPpFfidz;
-  core::Polynomial F, G, H;  // H empty: H = G (error feedback, NOTES.md)
+  core::Polynomial F, G, H;  // H empty: H = G (error feedback, docs/paper.md)
   core::DeadZone dead_zone;  // what NG-IDZ and FF-IDZ invert
   double lc_v = 0.1;         // FF-IDZ switch-off band l_c, sensor volts (5 mm at 50 mm/V)
   double valve_limit_v = 5.0;  // final valve command saturates at +-limit (paper section 4.1)

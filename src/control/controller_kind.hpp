@@ -1,5 +1,5 @@
 #pragma once
-// The four controllers, named the same everywhere (FORMATS.md): command line, configuration,
+// The four controllers, named the same everywhere (docs/formats.md): command line, configuration,
 // register enumeration (0, 1, 2, 3), run-file metadata and reports.
 #include <array>
 #include <string_view>

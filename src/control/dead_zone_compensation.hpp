@@ -1,5 +1,5 @@
 #pragma once
-// The dead-zone compensations applied to the pole-placement output u (volts), as NOTES.md
+// The dead-zone compensations applied to the pole-placement output u (volts), as docs/paper.md
 // reads the paper. Both are pure functions of the current sample.
 #include <algorithm>
 #include <cmath>

@@ -35,7 +35,7 @@ core::Result<DiophantineSolution> solve_diophantine(const Polynomial& A, const P
   for (int i = 0; i < n; ++i) t(i) = T[static_cast<std::size_t>(i)];
 
   // With B[0] = 0 (a delay in the plant) the q^0 row only says f0 = t0 / a0; solving the other
-  // rows on their own gives the conditioning of what is actually determined (NOTES.md's 3.6e3).
+  // rows on their own gives the conditioning of what is actually determined (docs/paper.md: 3.6e3).
   const int skip = B[0] == 0.0 ? 1 : 0;
   Eigen::VectorXd x(n);
   if (skip) {

@@ -1,7 +1,7 @@
 #pragma once
 // The Diophantine equation of pole placement (paper eq 4): A F + B G = T, solved through the
 // Sylvester matrix. The condition number is reported because it decides how many digits of F, G
-// the printed digits of A, B, T can determine (NOTES.md: about 3.6e3 for the paper's model).
+// the printed digits of A, B, T can determine (docs/paper.md: about 3.6e3 for the paper's model).
 #include "core/polynomial.hpp"
 #include "core/result.hpp"
 

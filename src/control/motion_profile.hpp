@@ -18,7 +18,7 @@ struct MotionLimits {
   double accel_v_s2 = 100.0;    // acceleration and braking at most, V/s^2
   // Short moves accelerate less: accel = min(accel_v_s2, accel_per_distance |move|), 1/s^2, so a
   // move of any length takes at least 2 / sqrt(accel_per_distance). A plant whose response leads
-  // its input's acceleration (the paper's B, NOTES.md) would otherwise overshoot a short move.
+  // its input's acceleration (the paper's B, docs/paper.md) would otherwise overshoot a short move.
   // 0: accel_v_s2 always.
   double accel_per_distance = 0.0;
   std::size_t smoothing_samples = 1;  // 1..kMaxSmoothingSamples; 1: no smoothing (trapezoid)

@@ -44,7 +44,7 @@ struct ClosedLoopBranch {
   JuryResult jury;
 };
 
-// Nominal A F + B G; left A F + (1 + m_l) B G; right A F + (1 + m_r) B G (NOTES.md: the FF-IDZ
+// Nominal A F + B G; left A F + (1 + m_l) B G; right A F + (1 + m_r) B G (docs/paper.md: the FF-IDZ
 // term (1 + 1/m*) u + b* through the dead zone gives (1 + m*) u).
 std::vector<ClosedLoopBranch> analyse_branches(const core::HammersteinModel& model, const core::Polynomial& F,
                                                const core::Polynomial& G);

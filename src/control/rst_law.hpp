@@ -1,6 +1,6 @@
 #pragma once
 // The linear pole-placement law in RST form, F(q) u = H(q) r - G(q) y, with fixed-size storage so
-// a step allocates nothing. With H = G (NOTES.md) it is error feedback F u = G (r - y).
+// a step allocates nothing. With H = G (docs/paper.md) it is error feedback F u = G (r - y).
 #include <array>
 #include <cstddef>
 

@@ -35,8 +35,7 @@ constexpr double kSensorSpanV = core::mm_to_sensor_v(core::kStrokeMm);  // the s
 // Each direction's offset is the running mean of what its stops asked for (gain 1, 1/2, 1/3), then
 // of about the last 4 (gain 1/4): on the commissioning test's rig through its remote I/O a stop
 // scatters by +-0.8 mm about what the coast predicts, and with a gain of 1 the retries chased that
-// scatter (1 of 2 runs on 2026-11-27 used all 3 retries on a move, alternating 0.8 mm short and
-// past). Offline on that rig with 0.05 mm noise, a jittering 1-2 sample I/O delay and 40 moves:
+// scatter (one run in two used all 3 retries on a move, alternating 0.8 mm short and past). Offline on that rig with 0.05 mm noise, a jittering 1-2 sample I/O delay and 40 moves:
 // 2-10 retries in all and no move with 3, against 1-16 and 5 moves with 3 at a gain of 1.
 constexpr int kLearningMemory = 4;
 

@@ -250,7 +250,7 @@ TrajectoryOutput trajectory_step(const TrajectoryParams& p, TrajectoryState& s, 
   const double u_fb = feedback_step(p, s, e);
   // The creeping inverse takes over from NG-IDZ gradually: a margin that jumped at arrival would
   // step the drive by up to the margin's worth, and the printed B answers a step of its drive with
-  // a spike at the Nyquist rate (NOTES.md), on a plant whose dead band or gain is not the model's.
+  // a spike at the Nyquist rate (docs/paper.md), on a plant whose dead band or gain is not the model's.
   s.creep_margin_v = arrived ? std::min(p.creep_margin_v, s.creep_margin_v + p.creep_margin_step_v) : 0.0;
   TrajectoryOutput out;
   out.u = t.u_ff + u_fb + s.integral;

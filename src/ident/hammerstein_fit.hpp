@@ -11,7 +11,7 @@
 //   x = (ln(m_r / m_l), b_r, b_l),   b_r in [0, largest positive u],  b_l in [most negative u, 0],
 // and the result is rescaled to m_l := options.m_l (the paper's 1.0707 by default) with B divided by
 // the same factor. With that convention the fit of data from the paper's plant returns eq 9 and
-// eq 10 themselves, and the FF-IDZ loop gain (1 + m*) B G of a design (NOTES.md, eq 14-15), which
+// eq 10 themselves, and the FF-IDZ loop gain (1 + m*) B G of a design (docs/paper.md, eq 14-15), which
 // is NOT invariant under the rescaling, has the meaning it has in the paper. Break points and the
 // ratio m_r / m_l do not depend on the convention and compare directly with eq 10.
 #include <cstdint>

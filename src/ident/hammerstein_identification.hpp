@@ -8,7 +8,7 @@
 //      point must stay in;
 //   3. every order of the search refined on the free-run simulation error from the swarm's dead
 //      zone, and one chosen (simulation_refinement.hpp, the rule of order_selection.hpp);
-//   or with the one-step criterion (what `epa identify` did before issue 19):
+//   or with the one-step criterion (`--criterion one-step`):
 //   2'. the order chosen on least squares through the swarm's dead zone;
 //   3'. the dead zone polished for that order.
 // A side of the dead zone the data never drive beyond is an error that says what to record.

@@ -1,7 +1,7 @@
 #pragma once
 // Unmodelled effects that can be switched on in the plant simulators and fitted by the sim-to-real
 // diagnosis (`epa diagnose`): each a small parametric model with 1-3 parameters in physical units,
-// named exactly as FORMATS.md (epa-gap-report/1) names them.
+// named exactly as the gap report (epa-gap-report/1, docs/formats.md) names them.
 //
 // Where each acts, in signal order (one sample, valve command u in V -> measured position):
 //   u -> input_delay -> valve_lag -> dead zone (+ deadzone_shift) -> gain_change
@@ -43,7 +43,7 @@ inline constexpr std::array<EffectKind, kEffectCount> kAllEffects = {
     EffectKind::kPositionDependentGain, EffectKind::kSensorQuantization};
 
 std::string_view to_string(EffectKind kind);
-// The FORMATS.md name; the error lists the eight valid names.
+// The gap report's name; the error lists the eight valid names.
 core::Result<EffectKind> parse_effect(std::string_view name);
 inline std::size_t index(EffectKind kind) { return static_cast<std::size_t>(kind); }
 

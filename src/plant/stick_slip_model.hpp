@@ -1,5 +1,5 @@
 #pragma once
-// A reduced model of a pneumatic axis for identification (issue 19): few parameters, each in
+// A reduced model of a pneumatic axis for identification: few parameters, each in
 // physical units, and the two things a Hammerstein model cannot hold. Per unit of moving mass:
 //
 //   valve       s' = (u(k - delay) - s) / spool_lag_s         the spool follows the command

@@ -22,7 +22,7 @@ class PlantSimulator;
 namespace epa::sim {
 
 struct StepRunOptions {
-  double step_mm = 25.0;     // reference applied at k = 0 (NOTES.md: at rest, y = 0, r applied at k = 0)
+  double step_mm = 25.0;     // reference applied at k = 0 (docs/paper.md: at rest, y = 0, r applied at k = 0)
   double initial_mm = 0.0;   // piston at rest here
   double duration_s = 20.0;
   double noise_std_mm = 0.0; // seeded Gaussian sensor noise
@@ -49,7 +49,7 @@ core::Result<StepRun> simulate_step_on(plant::PlantSimulator& plant, double mm_p
 std::size_t count_sign_changes(std::span<const double> values);
 
 // The same over the valve commands of the run's last `seconds` (all of it when shorter): where
-// chatter is judged once a move has settled (issue 17: the last 10 s of a 20 s run).
+// chatter is judged once a move has settled (the pp-traj tables: the last 10 s of a 20 s run).
 std::size_t valve_sign_changes_in_last(const StepRun& run, double seconds);
 
 }  // namespace epa::sim
