@@ -31,7 +31,7 @@
 #include "modbus/register_map.hpp"
 #include "modbus/unlock_guard.hpp"
 #include "points/write_gate.hpp"
-#include "runtime/scan_cycle.hpp"
+#include "runtime/loop_channels.hpp"
 
 struct _modbus_mapping_t;  // libmodbus' register image (modbus_mapping_t)
 

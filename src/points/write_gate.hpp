@@ -4,8 +4,8 @@
 // against the catalog's access, one set of limits (write_limits.hpp), the client's rights, the
 // tuning lock, and the scan cycle's own rules in the state it last published
 // (runtime/command_rules.hpp). It then either queues one command group for the loop and hands the
-// audit trail its entries, or refuses with one reason that each interface maps to its own error
-// (Modbus exception 02/03/04/06, HTTP 400/403/409/503). Nothing is half-applied.
+// audit trail its entries, or refuses with one kind and reason (gate_result.hpp) that each
+// interface maps to its own error. Nothing is half-applied.
 //
 // The gate owns the running tuning: tuning writes edit its copy, which becomes the loop's whole
 // at the next cycle; everyone else reads it (running_tuning(), the snapshot). It owns the next
@@ -32,32 +32,18 @@
 #include "control/controller.hpp"
 #include "core/audit.hpp"
 #include "points/commission_control.hpp"
+#include "points/gate_result.hpp"
 #include "points/point_catalog.hpp"
 #include "points/point_id.hpp"
 #include "points/position_records.hpp"
 #include "points/write_limits.hpp"
-#include "runtime/scan_cycle.hpp"
+#include "runtime/loop_channels.hpp"
 
 namespace epa::points {
 
 struct PointWrite {
   PointId id = PointId::kCount;
   double value = 0;
-};
-
-enum class Refusal : std::uint8_t {
-  kNone,
-  kNotWritable,   // a read-only point                                  Modbus 02, HTTP 400
-  kInvalidValue,  // out of range, not whole, tuning that does not validate  03, 400
-  kForbidden,     // no write rights, or a tuning point while locked          04, 403
-  kConflict,      // not now: wrong mode, a fault latched                     04, 409
-  kBusy,          // the loop's command queue is full: try again              06, 503
-};
-
-struct GateResult {
-  Refusal refusal = Refusal::kNone;
-  std::string reason;  // names the point and what was wrong
-  bool accepted() const { return refusal == Refusal::kNone; }
 };
 
 // Who writes, as the interface knows it.
@@ -149,9 +135,5 @@ class WriteGate {
   void remember_unapplied(std::span<const runtime::Command> commands);  // queued: reads show them; mutex_ held
   static constexpr std::size_t kUnapplied = 256;
 };
-
-// The interfaces' codes for a refusal.
-std::uint8_t modbus_exception(Refusal r);  // 02, 03, 04 or 06
-int http_status(Refusal r);                // 400, 403, 409 or 503
 
 }  // namespace epa::points

@@ -12,8 +12,8 @@
 #include <thread>
 
 #include "core/run.hpp"
+#include "runtime/loop_channels.hpp"
 #include "runtime/run_directory_quota.hpp"
-#include "runtime/scan_cycle.hpp"
 
 namespace epa::runtime {
 

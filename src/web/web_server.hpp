@@ -14,7 +14,7 @@
 #include "core/audit.hpp"
 #include "core/result.hpp"
 #include "points/write_gate.hpp"
-#include "runtime/scan_cycle.hpp"
+#include "runtime/loop_channels.hpp"
 #include "web/json_api.hpp"
 
 namespace epa::web {

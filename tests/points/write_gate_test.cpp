@@ -17,6 +17,7 @@
 #include "../runtime/fake_daq.hpp"
 #include "control/paper_controller.hpp"
 #include "points/point_catalog.hpp"
+#include "runtime/scan_cycle.hpp"
 #include "runtime/tuning.hpp"
 
 namespace epa::points {
