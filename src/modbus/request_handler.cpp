@@ -7,6 +7,7 @@
 
 #include "core/tiny_number.hpp"
 #include "modbus/exception_codes.hpp"
+#include "modbus/refusal_exception.hpp"
 
 namespace epa::modbus {
 
@@ -224,7 +225,7 @@ std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, Sess
     unlock = true;
   }
   if (!group.empty())
-    if (const auto r = gate_.submit(group, who); !r.accepted()) return points::modbus_exception(r.refusal);
+    if (const auto r = gate_.submit(group, who); !r.accepted()) return exception_code(r.refusal);
   if (unlock) {
     // An unlock opens the tuning to this connection: in the audit trail as unlock 0 -> 1 (once per
     // unlock; a key written again while open renews it and is not a change).

@@ -450,28 +450,4 @@ void WriteGate::take_refusals(const std::function<void(const std::string&)>& log
   }
 }
 
-std::uint8_t modbus_exception(Refusal r) {
-  switch (r) {
-    case Refusal::kNone: return 0;
-    case Refusal::kNotWritable: return 0x02;
-    case Refusal::kInvalidValue: return 0x03;
-    case Refusal::kForbidden:
-    case Refusal::kConflict: return 0x04;
-    case Refusal::kBusy: return 0x06;
-  }
-  return 0x04;
-}
-
-int http_status(Refusal r) {
-  switch (r) {
-    case Refusal::kNone: return 200;
-    case Refusal::kNotWritable:
-    case Refusal::kInvalidValue: return 400;
-    case Refusal::kForbidden: return 403;
-    case Refusal::kConflict: return 409;
-    case Refusal::kBusy: return 503;
-  }
-  return 400;
-}
-
 }  // namespace epa::points

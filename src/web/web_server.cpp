@@ -25,6 +25,7 @@
 #include "web/host_check.hpp"
 #include "web/prometheus.hpp"
 #include "web/recent_audit.hpp"
+#include "web/refusal_status.hpp"
 #include "web/static_files.hpp"
 #include "web/trend_buffer.hpp"
 
@@ -212,7 +213,7 @@ struct WebServer::Impl {
     if (!gate) return send_error(res, 503, "this server takes no commands (no write gate)");
     const points::Requester who{"web " + req.remote_addr, true, "", /*tuning_unlocked=*/true};  // the token is the unlock
     const points::GateResult r = gate->submit(body.writes, who);
-    if (!r.accepted()) return send_error(res, points::http_status(r.refusal), r.reason);
+    if (!r.accepted()) return send_error(res, http_status(r.refusal), r.reason);
     res.set_content(R"({"accepted":true})", kJson);
   }
 

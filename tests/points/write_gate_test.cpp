@@ -16,14 +16,20 @@
 
 #include "../runtime/fake_daq.hpp"
 #include "control/paper_controller.hpp"
+#include "modbus/refusal_exception.hpp"
 #include "points/point_catalog.hpp"
 #include "runtime/scan_cycle.hpp"
 #include "runtime/tuning.hpp"
+#include "web/refusal_status.hpp"
 
 namespace epa::points {
 namespace {
 
 using runtime::Mode;
+using web::http_status;
+
+// The codes each interface answers a refusal with (modbus/, web/): held here against the gate's kinds.
+std::uint8_t modbus_exception(Refusal r) { return modbus::exception_code(r); }
 
 struct RecordingSink final : core::AuditSink {
   std::vector<core::AuditEntry> entries;
