@@ -9,12 +9,12 @@
 
 namespace epa::app {
 
-std::string apply_module_command(const std::string& line, hal::RemoteIoSimulator& sim, hal::ModuleFaults& f) {
+std::string apply_module_command(const std::string& line, rig::RemoteIoSimulator& sim, rig::ModuleFaults& f) {
   std::istringstream in(line);
   std::string what, how;
   in >> what >> how;
-  using A = hal::ModuleFaults::Answers;
-  using S = hal::ModuleFaults::Sensor;
+  using A = rig::ModuleFaults::Answers;
+  using S = rig::ModuleFaults::Sensor;
   if (what == "status")
     return "valve " + core::format_number(sim.valve_v()) + " position " + core::format_number(sim.position_mm()) +
            " steps_to_safe " + std::to_string(sim.steps_to_safe_valve()) + " watchdog " + (sim.watchdog_tripped() ? "tripped" : "ok");
@@ -37,7 +37,7 @@ std::string apply_module_command(const std::string& line, hal::RemoteIoSimulator
   return "ok " + line;
 }
 
-ModuleFaultControl::ModuleFaultControl(hal::RemoteIoSimulator& sim, std::ostream& out) : sim_(sim), out_(out) {
+ModuleFaultControl::ModuleFaultControl(rig::RemoteIoSimulator& sim, std::ostream& out) : sim_(sim), out_(out) {
   thread_ = std::thread([this] { run(); });
 }
 
@@ -47,7 +47,7 @@ void ModuleFaultControl::stop() {
 }
 
 void ModuleFaultControl::run() {
-  hal::ModuleFaults faults;
+  rig::ModuleFaults faults;
   std::string pending;
   char buf[256];
   while (!stop_) {

@@ -11,17 +11,17 @@
 #include <string>
 #include <thread>
 
-#include "hal/remote_io_simulator.hpp"
+#include "rig/remote_io_simulator.hpp"
 
 namespace epa::app {
 
 // Applies one command line to `sim`; returns the answer line.
-std::string apply_module_command(const std::string& line, hal::RemoteIoSimulator& sim, hal::ModuleFaults& faults);
+std::string apply_module_command(const std::string& line, rig::RemoteIoSimulator& sim, rig::ModuleFaults& faults);
 
 // Reads standard input on its own thread (polling, so stop() returns within 100 ms) until EOF or stop().
 class ModuleFaultControl {
  public:
-  ModuleFaultControl(hal::RemoteIoSimulator& sim, std::ostream& out);
+  ModuleFaultControl(rig::RemoteIoSimulator& sim, std::ostream& out);
   ~ModuleFaultControl() { stop(); }
   ModuleFaultControl(const ModuleFaultControl&) = delete;
   ModuleFaultControl& operator=(const ModuleFaultControl&) = delete;
@@ -29,7 +29,7 @@ class ModuleFaultControl {
 
  private:
   void run();
-  hal::RemoteIoSimulator& sim_;
+  rig::RemoteIoSimulator& sim_;
   std::ostream& out_;
   std::atomic<bool> stop_{false};
   std::thread thread_;

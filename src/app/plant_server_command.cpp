@@ -14,8 +14,8 @@
 #include "app/module_fault_control.hpp"
 #include "app/tuning_source.hpp"
 #include "core/format.hpp"
-#include "hal/remote_io_simulator.hpp"
 #include "plant/plant_adapter.hpp"
+#include "rig/remote_io_simulator.hpp"
 
 namespace epa::app {
 
@@ -95,7 +95,7 @@ class BlockedStopSignals {
 int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostream& err) {
   auto model_file = load_model(o.model_path);
   if (!model_file) return err << "epa plant-server: " << model_file.error().message << "\n", 1;
-  hal::RemoteIoSimulatorConfig config;
+  rig::RemoteIoSimulatorConfig config;
   config.address = o.address;
   config.port = o.port;
   config.unit_id = o.unit_id;
@@ -110,7 +110,7 @@ int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostrea
 
   BlockedStopSignals signals;  // before start(): the simulator's threads must not take the signals
   if (!signals.ok()) return err << "epa plant-server: cannot block SIGINT/SIGTERM: " << std::strerror(errno) << "\n", 1;
-  core::Result<std::unique_ptr<hal::RemoteIoSimulator>> sim = core::invalid_argument("not started");
+  core::Result<std::unique_ptr<rig::RemoteIoSimulator>> sim = core::invalid_argument("not started");
   if (o.plant == "physics" && !o.effects.empty())
     return err << "epa plant-server: --effect applies to the hammerstein plant only\n", 1;
   if (o.plant == "physics") {
@@ -118,15 +118,15 @@ int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostrea
                                                         .noise_std_mm = o.noise_mm, .seed = o.seed,
                                                         .sensor_bits = o.sensor_bits, .Ts = config.model.Ts});
     if (!plant) return err << "epa plant-server: " << plant.error().message << "\n", 1;
-    sim = hal::RemoteIoSimulator::start(config, std::move(*plant));
+    sim = rig::RemoteIoSimulator::start(config, std::move(*plant));
   } else if (!o.effects.empty()) {
     auto effects = plant::parse_effect_specs(o.effects);
     if (!effects) return err << "epa plant-server: --effect: " << effects.error().message << "\n", 1;
     auto plant = plant::make_augmented_simulator(config.model, *effects, config.plant);
     if (!plant) return err << "epa plant-server: " << plant.error().message << "\n", 1;
-    sim = hal::RemoteIoSimulator::start(config, std::move(*plant));
+    sim = rig::RemoteIoSimulator::start(config, std::move(*plant));
   } else {
-    sim = hal::RemoteIoSimulator::start(config);
+    sim = rig::RemoteIoSimulator::start(config);
   }
   if (!sim) return err << "epa plant-server: " << sim.error().message << "\n", 1;
 

@@ -1,6 +1,6 @@
 #pragma once
 // `epa plant-server`: the paper's plant (or any epa-model/1 model) stepped in real time behind a
-// Modbus TCP server that looks like a remote analog I/O module (hal::RemoteIoSimulator, default
+// Modbus TCP server that looks like a remote analog I/O module (rig::RemoteIoSimulator, default
 // register layout: sensor in input register 0, valve in holding register 0, int16, ±10 V =
 // ±32767). For hardware-in-the-loop tests of `epa serve` with the modbus-io backend. Runs until
 // SIGINT or SIGTERM.

@@ -23,13 +23,16 @@
 #include <vector>
 
 #include "core/paper_reference.hpp"
-#include "hal/remote_io_simulator.hpp"
 #include "plant/plant_adapter.hpp"
+#include "rig/remote_io_simulator.hpp"
 
 #include "../support/counting_new.hpp"  // the cycle calls must allocate nothing
 
 namespace epa::hal {
 namespace {
+
+using rig::RemoteIoSimulator;
+using rig::RemoteIoSimulatorConfig;
 
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;

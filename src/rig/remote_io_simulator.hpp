@@ -1,5 +1,5 @@
 #pragma once
-// A stand-in for a remote analog I/O module with the plant behind it: a Modbus TCP server
+// A test rig, not part of the product's HAL: a stand-in for a remote analog I/O module with the plant behind it: a Modbus TCP server
 // (libmodbus) whose registers follow a RemoteIoLayout, and a plant thread that steps a plant in
 // real time: the paper's Hammerstein plant, or any plant::PlantSimulator (the physics model). `epa plant-server` runs it in its own process; the modbus-io
 // tests run it in-process on a free port.
@@ -38,13 +38,13 @@
 #include "plant/hammerstein_plant.hpp"
 #include "plant/plant_simulator.hpp"
 
-namespace epa::hal {
+namespace epa::rig {
 
 struct RemoteIoSimulatorConfig {
   std::string address = "127.0.0.1";  // IPv4 address to listen on; "0.0.0.0" for all
   int port = 1502;                    // 0: pick a free port (see RemoteIoSimulator::port())
   int unit_id = 1;                    // 0..247; others (except 0xFF) get exception 0x0B
-  RemoteIoLayout layout = default_remote_io_layout();
+  hal::RemoteIoLayout layout = hal::default_remote_io_layout();
   core::HammersteinModel model;       // its Ts is the real-time step period
   plant::PlantOptions plant;          // model and plant: for start(config) only
   int realtime_priority = 0;          // SCHED_FIFO for both threads, as a module's firmware answers in
@@ -109,4 +109,4 @@ class RemoteIoSimulator {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace epa::hal
+}  // namespace epa::rig

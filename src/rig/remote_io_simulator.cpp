@@ -1,7 +1,7 @@
-#include "hal/remote_io_simulator.hpp"
+#include "rig/remote_io_simulator.hpp"
 
-#include "hal/realtime.hpp"
 #include "core/word_order.hpp"
+#include "hal/realtime.hpp"
 #include "plant/plant_adapter.hpp"
 
 #include <arpa/inet.h>
@@ -27,7 +27,13 @@
 #include <thread>
 #include <vector>
 
-namespace epa::hal {
+namespace epa::rig {
+
+using hal::AnalogEncoding;
+using hal::AnalogPoint;
+using hal::PointWords;
+using hal::RegisterTable;
+using hal::RemoteIoLayout;
 
 namespace {
 
@@ -348,13 +354,13 @@ core::Result<std::unique_ptr<RemoteIoSimulator>> RemoteIoSimulator::start(const 
   try {
     impl->client_fds.reserve(kMaxClients);  // push_back in the server loop stays within capacity
     Impl* self = impl.get();
-    const RealtimeRequest rt{.fifo_priority = c.realtime_priority, .lock_memory = false, .cpu_dma_latency_us = -1};
+    const hal::RealtimeRequest rt{.fifo_priority = c.realtime_priority, .lock_memory = false, .cpu_dma_latency_us = -1};
     impl->server_thread = std::thread([self, rt] {
-      if (rt.fifo_priority > 0) request_realtime(rt);
+      if (rt.fifo_priority > 0) hal::request_realtime(rt);
       self->serve();
     });
     impl->plant_thread = std::thread([self, rt] {
-      if (rt.fifo_priority > 0) request_realtime(rt);
+      if (rt.fifo_priority > 0) hal::request_realtime(rt);
       self->run_plant();
     });
   } catch (const std::exception& e) {
@@ -393,4 +399,4 @@ void RemoteIoSimulator::inject(const ModuleFaults& f) {
   impl_->sensor_fault.store(f.sensor);
 }
 
-}  // namespace epa::hal
+}  // namespace epa::rig
