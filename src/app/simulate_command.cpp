@@ -20,6 +20,7 @@
 #include "plant/pneumatic_params.hpp"
 #include "plant/stick_slip_model.hpp"
 #include "store/trajectory_settings.hpp"
+#include "store/tuning_set.hpp"
 #include "sim/model_perturbation.hpp"
 
 namespace epa::app {
@@ -112,11 +113,10 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
   trajectory.coast_s = *coast;
   std::vector<SimulationCase> cases;
   for (auto kind : kinds) {
-    control::ControllerConfig config{.kind = kind, .F = polynomials->F, .G = polynomials->G, .H = polynomials->H,
-                                     .dead_zone = model.dead_zone, .lc_v = o.lc_mm / model.mm_per_volt,
-                                     .valve_limit_v = core::paper::kValveLimitV, .safe_valve_v = 0.0,
-                                     .A = model.A, .B = model.B, .Ts = model.Ts,
-                                     .trajectory = store::to_trajectory_config(trajectory, model.mm_per_volt)};
+    store::TuningSet set;
+    set.controller = kind, set.F = polynomials->F, set.G = polynomials->G, set.H = polynomials->H;
+    set.dead_zone = model.dead_zone, set.lc_mm = o.lc_mm, set.valve_limit_v = core::paper::kValveLimitV, set.trajectory = trajectory;
+    const control::ControllerConfig config = store::controller_config(set, model, 0.0);
     auto params = control::ControllerParams::make(config);
     if (!params) return err << "epa simulate: " << params.error().message << "\n", 1;
     for (double step : o.steps_mm) {

@@ -5,6 +5,7 @@
 
 #include "core/format.hpp"
 #include "points/point_catalog.hpp"
+#include "points/tuning_values.hpp"
 #include "runtime/tuning.hpp"
 
 namespace epa::points {
@@ -53,6 +54,7 @@ WriteGate::WriteGate(WriteLimits limits, const runtime::RuntimeConfig& loop_rule
                      runtime::LoopChannels& channels, core::AuditSink* audit, const PositionRecords& records)
     : limits_(std::move(limits)),
       loop_rules_(loop_rules),
+      sensor_{loop_rules.mm_per_volt},
       channels_(channels),
       audit_(audit),
       tuning_(std::move(tuning)),
@@ -128,7 +130,7 @@ runtime::Snapshot WriteGate::with_unapplied(runtime::Snapshot s) const {
         break;
       }
       case runtime::CommandKind::kTuning:  // the gate's copy is what the loop takes
-        s.tuning.set_writable(tuning_.dead_zone, tuning_.lc_v, tuning_.trajectory, loop_rules_.mm_per_volt);
+        s.tuning.set_writable(tuning_.dead_zone, tuning_.lc_v, tuning_.trajectory, sensor_);
         break;
       case runtime::CommandKind::kReset:
       case runtime::CommandKind::kRecord: break;
@@ -227,6 +229,10 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
   };
   PointId first_tuning_point = PointId::kCount, first_excitation_point = PointId::kCount;
   for (const PointWrite& w : writes) {
+    if (set_tuning_value(out.tuning, w.id, w.value, sensor_)) {
+      if (first_tuning_point == PointId::kCount) first_tuning_point = w.id;
+      continue;
+    }
     runtime::Command c;
     switch (w.id) {
       case PointId::kSetpoint: c = runtime::setpoint_command(w.value); break;
@@ -245,14 +251,6 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
       case PointId::kRecord: c = runtime::record_command(w.value); break;
       case PointId::kControlWord: control(static_cast<std::uint16_t>(w.value), c); break;
       case PointId::kRecordSelect: continue;  // the gate's own: taken above
-      case PointId::kMr: out.tuning.dead_zone.m_r = w.value; break;
-      case PointId::kMl: out.tuning.dead_zone.m_l = w.value; break;
-      case PointId::kBr: out.tuning.dead_zone.b_r = w.value; break;
-      case PointId::kBl: out.tuning.dead_zone.b_l = w.value; break;
-      case PointId::kLc: out.tuning.lc_v = w.value / loop_rules_.mm_per_volt; break;
-      case PointId::kTrajSpeedFraction: out.tuning.trajectory.speed_fraction = w.value; break;
-      case PointId::kTrajBandwidth: out.tuning.trajectory.feedback_bandwidth_rad_s = w.value; break;
-      case PointId::kTrajHoldBand: out.tuning.trajectory.hold_band_v = w.value / loop_rules_.mm_per_volt; break;
       case PointId::kExciteSeed: out.excitation.seed = static_cast<std::uint32_t>(w.value); break;
       case PointId::kExciteAmplitudeMin: out.excitation.amplitude_min_v = w.value; break;
       case PointId::kExciteAmplitudeMax: out.excitation.amplitude_max_v = w.value; break;

@@ -31,6 +31,7 @@
 
 #include "control/controller.hpp"
 #include "core/audit.hpp"
+#include "core/sensor_calibration.hpp"
 #include "points/commission_control.hpp"
 #include "points/gate_result.hpp"
 #include "points/point_catalog.hpp"
@@ -114,6 +115,7 @@ class WriteGate {
 
   const WriteLimits limits_;
   const runtime::RuntimeConfig loop_rules_;
+  const core::SensorCalibration sensor_;  // the loop's: tuning points in mm, the law's lengths in volts
   runtime::LoopChannels& channels_;
   core::AuditSink* audit_;
   CommissionControl* commission_ = nullptr;

@@ -555,7 +555,7 @@ void ScanCycle::publish(bool full_stats) noexcept {
   s.tuning.nH = static_cast<std::uint8_t>(rst.nH);
   s.tuning.valve_limit_v = p.valve_limit_v();
   // pp-traj's settings whichever law runs: they are points whatever the law
-  s.tuning.set_writable(p.dead_zone(), p.lc_v(), tuning_.traj.trajectory_config(), config_.mm_per_volt);
+  s.tuning.set_writable(p.dead_zone(), p.lc_v(), tuning_.traj.trajectory_config(), core::SensorCalibration{config_.mm_per_volt});
   ch_.snapshot.publish(s);
 }
 

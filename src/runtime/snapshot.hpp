@@ -8,6 +8,7 @@
 #include "control/rst_law.hpp"
 #include "control/trajectory_law.hpp"
 #include "core/dead_zone.hpp"
+#include "core/sensor_calibration.hpp"
 #include "runtime/command_rules.hpp"
 #include "runtime/excitation_settings.hpp"
 #include "runtime/loop_stats.hpp"
@@ -32,12 +33,12 @@ struct TuningView {
 
   // The writable settings (the tuning points), in the units the points show: the loop fills them
   // from what runs, the write gate from what it has accepted and the loop has not taken yet.
-  void set_writable(const core::DeadZone& dz, double lc_v, const control::TrajectoryConfig& traj, double mm_per_volt) noexcept {
+  void set_writable(const core::DeadZone& dz, double lc_v, const control::TrajectoryConfig& traj, core::SensorCalibration sensor) noexcept {
     m_r = dz.m_r, m_l = dz.m_l, b_r = dz.b_r, b_l = dz.b_l;
-    lc_mm = lc_v * mm_per_volt;
+    lc_mm = sensor.to_mm(lc_v);
     traj_speed_fraction = traj.speed_fraction;
     traj_bandwidth_rad_s = traj.feedback_bandwidth_rad_s;
-    traj_hold_band_mm = traj.hold_band_v * mm_per_volt;
+    traj_hold_band_mm = sensor.to_mm(traj.hold_band_v);
   }
 };
 

@@ -36,27 +36,27 @@ constexpr std::array<std::pair<const char*, Member>, 21> kKeys = {{
 
 }  // namespace
 
-control::TrajectoryConfig to_trajectory_config(const TrajectorySettings& s, double mm_per_volt) {
+control::TrajectoryConfig to_trajectory_config(const TrajectorySettings& s, core::SensorCalibration sensor) {
   control::TrajectoryConfig c;
   c.speed_fraction = s.speed_fraction;
-  c.accel_v_s2 = s.accel_mm_s2 / mm_per_volt;
+  c.accel_v_s2 = sensor.to_volts(s.accel_mm_s2);
   c.accel_per_distance = s.accel_per_distance_per_s2;
   c.smoothing_s = s.smoothing_s;
   c.feedback_bandwidth_rad_s = s.feedback_bandwidth_rad_s;
   c.filter_ratio = s.filter_ratio;
-  c.integral_gain_per_s = s.integral_gain_per_mm_s * mm_per_volt;  // u per (mm s) -> u per (V s)
-  c.integrator_band_v = s.integrator_band_mm / mm_per_volt;
-  c.hold_band_v = s.hold_band_mm / mm_per_volt;
+  c.integral_gain_per_s = s.integral_gain_per_mm_s * sensor.mm_per_volt;  // u per (mm s) -> u per (V s)
+  c.integrator_band_v = sensor.to_volts(s.integrator_band_mm);
+  c.hold_band_v = sensor.to_volts(s.hold_band_mm);
   c.error_filter_s = s.error_filter_s;
   c.idz_ramp = s.idz_ramp_v;
   c.creep_margin_v = s.creep_margin_v;
   c.creep_blend_s = s.creep_blend_s;
   c.coast_s = s.coast_s;
-  c.coast_dead_length_v = s.coast_dead_length_mm / mm_per_volt;
-  c.approach_speed_v_s = s.approach_speed_mm_s / mm_per_volt;
-  c.approach_length_v = s.approach_mm / mm_per_volt;
-  c.approach_decel_v_s2 = s.approach_decel_mm_s2 / mm_per_volt;
-  c.retry_band_v = s.retry_band_mm / mm_per_volt;
+  c.coast_dead_length_v = sensor.to_volts(s.coast_dead_length_mm);
+  c.approach_speed_v_s = sensor.to_volts(s.approach_speed_mm_s);
+  c.approach_length_v = sensor.to_volts(s.approach_mm);
+  c.approach_decel_v_s2 = sensor.to_volts(s.approach_decel_mm_s2);
+  c.retry_band_v = sensor.to_volts(s.retry_band_mm);
   c.max_retries = s.max_retries;
   c.approach_settle_s = s.approach_settle_s;
   return c;

@@ -10,6 +10,7 @@
 
 #include "control/trajectory_law.hpp"
 #include "core/result.hpp"
+#include "core/sensor_calibration.hpp"
 #include "core/units.hpp"
 
 namespace epa::store {
@@ -44,8 +45,8 @@ struct TrajectorySettings {
   bool operator==(const TrajectorySettings&) const = default;
 };
 
-// The law's configuration in sensor volts for a model with `mm_per_volt`.
-control::TrajectoryConfig to_trajectory_config(const TrajectorySettings& s, double mm_per_volt);
+// The law's configuration in sensor volts for a model whose sensor reads `sensor`.
+control::TrajectoryConfig to_trajectory_config(const TrajectorySettings& s, core::SensorCalibration sensor);
 
 std::string to_json_text(const TrajectorySettings& s);
 // Errors name `what`, the key and what was expected (a number; no unknown keys).

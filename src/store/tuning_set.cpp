@@ -3,14 +3,20 @@
 #include <cmath>
 
 #include "core/format.hpp"
+#include "store/tuning_points.hpp"
 
 namespace epa::store {
 
 control::ControllerConfig controller_config(const TuningSet& set, const core::HammersteinModel& model, double safe_valve_v) {
-  return {.kind = set.controller, .F = set.F, .G = set.G, .H = set.H, .dead_zone = set.dead_zone,
-          .lc_v = set.lc_mm / model.mm_per_volt, .valve_limit_v = set.valve_limit_v, .safe_valve_v = safe_valve_v,
-          .A = model.A, .B = model.B, .Ts = model.Ts,
-          .trajectory = to_trajectory_config(set.trajectory, model.mm_per_volt)};
+  const core::SensorCalibration sensor{model.mm_per_volt};
+  control::ControllerConfig law;
+  law.kind = set.controller;
+  law.F = set.F, law.G = set.G, law.H = set.H;
+  law.valve_limit_v = set.valve_limit_v;
+  law.safe_valve_v = safe_valve_v;
+  law.A = model.A, law.B = model.B, law.Ts = model.Ts;
+  law.trajectory = to_trajectory_config(set.trajectory, sensor);
+  return points::with_tuning_values(law, tuning_values(set), sensor);  // the dead zone, l_c and the tuning points' own
 }
 
 core::Status validate(const TuningSet& set, const core::HammersteinModel& model) {

@@ -26,7 +26,8 @@ struct TuningSet {
   TrajectorySettings trajectory;   // pp-traj's own parameters
 };
 
-// The control law's configuration for `set` designed on `model` (l_c through its sensor scale).
+// The control law's configuration for `set` designed on `model`: the one place a set's lengths
+// (l_c, pp-traj's) become the law's sensor volts, through the model's sensor calibration.
 control::ControllerConfig controller_config(const TuningSet& set, const core::HammersteinModel& model, double safe_valve_v);
 
 // Validates the set as the loop would use it; the message names the set and what is wrong.
