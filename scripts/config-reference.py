@@ -223,7 +223,8 @@ def main(argv):
     if unknown:
         print(f"usage: {argv[0]} [--check]", file=sys.stderr)
         return 2
-    wanted = render(CONFIG.read_text(encoding="utf-8"), LOADER.read_text(encoding="utf-8"))
+    loader = LOADER.read_text(encoding="utf-8") if LOADER.exists() else ""  # ranges are left blank without it
+    wanted = render(CONFIG.read_text(encoding="utf-8"), loader)
     if not check:
         OUTPUT.write_text(wanted, encoding="utf-8")
         print(f"wrote {OUTPUT.relative_to(ROOT)}")
