@@ -250,7 +250,7 @@ def judged(rig, monitor, name, attempt):
 
     failures, no_verdict = monitor.judged(name, run, fresh_axis)
     if no_verdict:
-        INCONCLUSIVE.append(no_verdict)
+        INCONCLUSIVE.append(monitor.not_judged("hardening.fault_injection", no_verdict))
         return [], f"{name:32} -> no verdict: the machine stalled in both runs"
     row = rows[-1]
     if len(rows) == 2 and row:
@@ -406,7 +406,7 @@ def main():
     for f in failures:
         print("FAIL:", f)
     for f in INCONCLUSIVE:
-        print("NO VERDICT:", f)
+        print(f)  # again beside the failures: each NOT JUDGED line
     print(f"fault injection: {len(rows)} checks, {len(failures)} failures, {len(INCONCLUSIVE)} without a verdict "
           f"(the machine stalled {100 * monitor.stalled_share(started):.2f} % of the test's time)")
     sys.exit(1 if failures else SKIP_RETURN_CODE if INCONCLUSIVE else 0)

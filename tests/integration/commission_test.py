@@ -335,9 +335,8 @@ def main():
         print(f"      the machine during the test: {monitor.describe(t0)}")
     finally:
         monitor.stop()
-    verdict = no_verdict and f"NO VERDICT: {no_verdict}: it could not run the loop in real time"
-    if verdict:
-        print(verdict)
+    if no_verdict:
+        monitor.not_judged("integration.commission", f"{no_verdict}: it could not run the loop in real time")
         sys.exit(SKIP_RETURN_CODE)
     if FAILURES:
         print(f"{len(FAILURES)} failure(s)")

@@ -41,7 +41,7 @@ def main(argv):
     finally:
         monitor.stop()
     if no_verdict:
-        print(f"NO VERDICT: {no_verdict}", flush=True)
+        monitor.not_judged(name, no_verdict)
         return SKIP_RETURN_CODE
     if failures:
         print(f"FAILED: {name}: {'; '.join(failures)}", flush=True)

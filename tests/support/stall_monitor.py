@@ -60,6 +60,8 @@ class StallMonitor:
         self.threshold_ms = threshold_ms
         self.unfit_stall_s = unfit_stall_s
         self.stalls = []  # (monotonic time the wake-up was due, how late in seconds)
+        self.worst_stall_ms = 0.0  # of the second run when judged() returned no verdict
+        self.stalled_percent = 0.0
         self.realtime = []  # per watcher: whether it got SCHED_FIFO
         self.pipes, self.procs = [], []
         cpus = sorted(os.sched_getaffinity(0))
@@ -125,8 +127,19 @@ class StallMonitor:
         t1 = time.monotonic()
         failures = attempt()
         if failures and self.unfit_since(t1):
+            stalls = self.stalls_since(t1)
+            self.worst_stall_ms = max(late for _, late in stalls) * 1000
+            self.stalled_percent = 100 * self._share(stalls, t1)
             return failures, f"{name}: {'; '.join(failures)} -- again with {self.describe(t1)}"
         return failures, None
+
+    def not_judged(self, test, no_verdict):
+        """The one line a check without a verdict prints (the test then exits SKIP_RETURN_CODE, which
+        ctest counts as skipped and scripts/test.sh counts as not judged): what stalled, how long."""
+        line = (f"NOT JUDGED: {test}: the machine stalled {self.worst_stall_ms:.0f} ms at worst "
+                f"({self.stalled_percent:.1f} % of the time) while it failed twice: {no_verdict}")
+        print(line, flush=True)
+        return line
 
     def stop(self):
         """Ends the watchers; what they saw stays readable."""
