@@ -165,7 +165,24 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
                             const control::ControllerConfig& tuning, const runtime::ExcitationSettings& excitation,
                             Decision& out) const {
   if (writes.empty()) return refuse(Refusal::kInvalidValue, "nothing to write");
-  // 1. Each value: a writable point, within the one set of limits, whole where it must be.
+  if (GateResult r = check_values(writes); !r.accepted()) return r;
+  if (GateResult r = check_rights(writes, who); !r.accepted()) return r;
+  // A commissioning command goes to the service, not the loop: nothing more to decide here.
+  if (std::ranges::any_of(writes, [](const PointWrite& w) { return w.id == PointId::kCommissionCommand; }))
+    return check_commission_command(writes);
+  // The commands, all of them or none, from the gate's state as it stands.
+  out.tuning = tuning;
+  out.excitation = excitation;
+  out.control_word = control_word_;
+  out.record_select = record_select_;
+  out.records = records_;
+  if (GateResult r = edit_records(writes, out); !r.accepted()) return r;
+  if (GateResult r = add_commands(writes, snap, tuning, out); !r.accepted()) return r;
+  return check_loop_rules(out, snap, excitation);
+}
+
+// Each value: a writable point, within the one set of limits, whole where it must be.
+GateResult WriteGate::check_values(std::span<const PointWrite> writes) const {
   for (const PointWrite& w : writes) {
     if (index(w.id) >= kPointCount) return refuse(Refusal::kNotWritable, "unknown point");
     const PointDef& p = point(w.id);
@@ -174,115 +191,126 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
     if (p.integer && w.value != std::floor(w.value))
       return refuse(Refusal::kInvalidValue, quoted(w.id) + " takes whole numbers, not " + core::format_number(w.value));
   }
-  // 2. The client's rights.
+  return {};
+}
+
+// The client's rights: to write at all, and to write tuning.
+GateResult WriteGate::check_rights(std::span<const PointWrite> writes, const Requester& who) {
   if (!who.may_write) return refuse(Refusal::kForbidden, who.no_write_reason.empty() ? "this client may not write" : who.no_write_reason);
   for (const PointWrite& w : writes)
     if (point(w.id).tuning() && !who.tuning_unlocked)
       return refuse(Refusal::kForbidden, quoted(w.id) + " is a tuning point: unlock the tuning first");
-  // A commissioning command goes to the service, not the loop: alone, and only with a service.
-  for (const PointWrite& w : writes)
-    if (w.id == PointId::kCommissionCommand) {
-      if (writes.size() > 1) return refuse(Refusal::kInvalidValue, quoted(w.id) + " is written alone");
-      if (!commission_) return refuse(Refusal::kNotWritable, quoted(w.id) + ": this appliance runs no commissioning service");
-      return {};
-    }
-  // 3. The commands, all of them or none.
-  out.tuning = tuning;
-  out.excitation = excitation;
-  out.control_word = control_word_;
-  out.record_select = record_select_;
-  out.records = records_;
-  // The record a start takes may come in the same group: selections and record edits first.
+  return {};
+}
+
+// A commissioning command is written alone, and only to a gate with a service behind it.
+GateResult WriteGate::check_commission_command(std::span<const PointWrite> writes) const {
+  const std::string point = quoted(PointId::kCommissionCommand);
+  if (writes.size() > 1) return refuse(Refusal::kInvalidValue, point + " is written alone");
+  if (!commission_) return refuse(Refusal::kNotWritable, point + ": this appliance runs no commissioning service");
+  return {};
+}
+
+// The record a start takes may come in the same group: selections and record edits first.
+GateResult WriteGate::edit_records(std::span<const PointWrite> writes, Decision& out) const {
   for (const PointWrite& w : writes) {
     if (w.id == PointId::kRecordSelect) out.record_select = static_cast<int>(w.value);
-    if (RecordField f; record_field(w.id, f)) {
-      if (f.kind == RecordField::kTarget && !(w.value >= loop_rules_.setpoint_min_mm && w.value <= loop_rules_.setpoint_max_mm))
-        return refuse(Refusal::kInvalidValue, quoted(w.id) + " " + core::format_number(w.value) + " mm is outside the setpoint range [" +
-                                                  core::format_number(loop_rules_.setpoint_min_mm) + ", " +
-                                                  core::format_number(loop_rules_.setpoint_max_mm) + "] mm");
-      if (f.kind == RecordField::kController && w.value != kKeepController && !(w.value >= 0 && w.value <= 3))
-        return refuse(Refusal::kInvalidValue, quoted(w.id) + " takes 0 pp, 1 pp-ngidz, 2 pp-ffidz, 3 pp-traj or 255 (the running law), not " +
-                                                  core::format_number(w.value));
-      set_record_value(out.records[f.record], f.kind, w.value);
+    RecordField f;
+    if (!record_field(w.id, f)) continue;
+    if (f.kind == RecordField::kTarget && !(w.value >= loop_rules_.setpoint_min_mm && w.value <= loop_rules_.setpoint_max_mm))
+      return refuse(Refusal::kInvalidValue, quoted(w.id) + " " + core::format_number(w.value) + " mm is outside the setpoint range [" +
+                                                core::format_number(loop_rules_.setpoint_min_mm) + ", " +
+                                                core::format_number(loop_rules_.setpoint_max_mm) + "] mm");
+    if (f.kind == RecordField::kController && w.value != kKeepController && !(w.value >= 0 && w.value <= 3))
+      return refuse(Refusal::kInvalidValue, quoted(w.id) + " takes 0 pp, 1 pp-ngidz, 2 pp-ffidz, 3 pp-traj or 255 (the running law), not " +
+                                                core::format_number(w.value));
+    set_record_value(out.records[f.record], f.kind, w.value);
+  }
+  return {};
+}
+
+// The control word `word` as a command; a start edge resolves the selected record (or the
+// setpoint, written in this group or standing) into the move it commands.
+runtime::Command WriteGate::control_command(std::uint16_t word, std::span<const PointWrite> writes, const runtime::Snapshot& snap,
+                                            Decision& out) {
+  runtime::Command c = runtime::control_command(word);
+  const std::uint16_t rising = word & static_cast<std::uint16_t>(~out.control_word);
+  out.control_word = word;
+  if (!(rising & runtime::kControlStart)) return c;
+  if (out.record_select == 0) {
+    c.value = snap.setpoint_mm;
+    for (const PointWrite& w : writes)
+      if (w.id == PointId::kSetpoint) c.value = w.value;
+    return c;
+  }
+  const PositionRecord& r = out.records[static_cast<std::size_t>(out.record_select - 1)];
+  c.value = r.target_mm;
+  c.speed_limit_mm_s = r.speed_mm_s;
+  c.window_mm = r.window_mm;
+  if (r.controller != kKeepController) {
+    c.start_controller = true;
+    c.controller = static_cast<control::ControllerKind>(r.controller);
+  }
+  return c;
+}
+
+// The command one write stands for, in `c`; refused when the point has none behind it. `tuning`
+// is the running tuning before the group's own tuning writes.
+GateResult WriteGate::command_for(const PointWrite& w, std::span<const PointWrite> writes, const runtime::Snapshot& snap,
+                                  const control::ControllerConfig& tuning, Decision& out, runtime::Command& c) const {
+  switch (w.id) {
+    case PointId::kSetpoint: c = runtime::setpoint_command(w.value); break;
+    case PointId::kMode: c = runtime::mode_command(static_cast<runtime::Mode>(static_cast<int>(w.value))); break;
+    case PointId::kController:
+      c = runtime::controller_command(static_cast<control::ControllerKind>(static_cast<int>(w.value)));
+      if (c.controller == control::ControllerKind::kPpTraj) {  // said here, not only by the loop after the answer
+        control::ControllerConfig traj = tuning;
+        traj.kind = control::ControllerKind::kPpTraj;
+        if (auto p = control::ControllerParams::make(traj); !p) return refuse(Refusal::kInvalidValue, quoted(w.id) + ": " + p.error().message);
+      }
+      break;
+    case PointId::kManualValve: c = runtime::manual_valve_command(w.value); break;
+    case PointId::kReset: c = runtime::reset_command(); break;
+    case PointId::kHeartbeat: c = runtime::heartbeat_command(static_cast<std::uint32_t>(w.value)); break;
+    case PointId::kRecord: c = runtime::record_command(w.value); break;
+    case PointId::kControlWord: c = control_command(static_cast<std::uint16_t>(w.value), writes, snap, out); break;
+    case PointId::kExciteSeed: out.excitation.seed = static_cast<std::uint32_t>(w.value); break;
+    case PointId::kExciteAmplitudeMin: out.excitation.amplitude_min_v = w.value; break;
+    case PointId::kExciteAmplitudeMax: out.excitation.amplitude_max_v = w.value; break;
+    case PointId::kExciteDuration: out.excitation.duration_s = w.value; break;
+    default: {
+      const int bit = control_bit(w.id);
+      if (bit < 0) return refuse(Refusal::kNotWritable, quoted(w.id) + " has no command behind it");
+      const auto mask = static_cast<std::uint16_t>(1u << bit);
+      c = control_command(static_cast<std::uint16_t>(w.value != 0.0 ? out.control_word | mask : out.control_word & ~mask), writes, snap, out);
+      break;
     }
   }
-  // A start resolves the selected record (or the setpoint) into the move it commands.
-  auto control = [&](std::uint16_t word, runtime::Command& c) {
-    c = runtime::control_command(word);
-    const std::uint16_t rising = word & static_cast<std::uint16_t>(~out.control_word);
-    out.control_word = word;
-    if (!(rising & runtime::kControlStart)) return;
-    if (out.record_select == 0) {
-      c.value = snap.setpoint_mm;
-      for (const PointWrite& w : writes)
-        if (w.id == PointId::kSetpoint) c.value = w.value;
-      return;
-    }
-    const PositionRecord& r = out.records[static_cast<std::size_t>(out.record_select - 1)];
-    c.value = r.target_mm;
-    c.speed_limit_mm_s = r.speed_mm_s;
-    c.window_mm = r.window_mm;
-    if (r.controller != kKeepController) {
-      c.start_controller = true;
-      c.controller = static_cast<control::ControllerKind>(r.controller);
-    }
-  };
+  return {};
+}
+
+// Each write's command, in the order the loop is to apply them: the excitation settings first,
+// then a mode change, the rest as written, the tuning last.
+GateResult WriteGate::add_commands(std::span<const PointWrite> writes, const runtime::Snapshot& snap,
+                                   const control::ControllerConfig& tuning, Decision& out) const {
   PointId first_tuning_point = PointId::kCount, first_excitation_point = PointId::kCount;
   for (const PointWrite& w : writes) {
+    if (w.id == PointId::kRecordSelect) continue;      // the gate's own: taken by edit_records
+    if (RecordField f; record_field(w.id, f)) continue;  // the same
     if (set_tuning_value(out.tuning, w.id, w.value, sensor_)) {
       if (first_tuning_point == PointId::kCount) first_tuning_point = w.id;
       continue;
     }
     runtime::Command c;
-    switch (w.id) {
-      case PointId::kSetpoint: c = runtime::setpoint_command(w.value); break;
-      case PointId::kMode: c = runtime::mode_command(static_cast<runtime::Mode>(static_cast<int>(w.value))); break;
-      case PointId::kController:
-        c = runtime::controller_command(static_cast<control::ControllerKind>(static_cast<int>(w.value)));
-        if (c.controller == control::ControllerKind::kPpTraj) {  // said here, not only by the loop after the answer
-          control::ControllerConfig traj = tuning;
-          traj.kind = control::ControllerKind::kPpTraj;
-          if (auto p = control::ControllerParams::make(traj); !p) return refuse(Refusal::kInvalidValue, quoted(w.id) + ": " + p.error().message);
-        }
-        break;
-      case PointId::kManualValve: c = runtime::manual_valve_command(w.value); break;
-      case PointId::kReset: c = runtime::reset_command(); break;
-      case PointId::kHeartbeat: c = runtime::heartbeat_command(static_cast<std::uint32_t>(w.value)); break;
-      case PointId::kRecord: c = runtime::record_command(w.value); break;
-      case PointId::kControlWord: control(static_cast<std::uint16_t>(w.value), c); break;
-      case PointId::kRecordSelect: continue;  // the gate's own: taken above
-      case PointId::kExciteSeed: out.excitation.seed = static_cast<std::uint32_t>(w.value); break;
-      case PointId::kExciteAmplitudeMin: out.excitation.amplitude_min_v = w.value; break;
-      case PointId::kExciteAmplitudeMax: out.excitation.amplitude_max_v = w.value; break;
-      case PointId::kExciteDuration: out.excitation.duration_s = w.value; break;
-      default: {
-        if (RecordField f; record_field(w.id, f)) continue;  // the gate's own: taken above
-        const int bit = control_bit(w.id);
-        if (bit < 0) return refuse(Refusal::kNotWritable, quoted(w.id) + " has no command behind it");
-        const auto mask = static_cast<std::uint16_t>(1u << bit);
-        control(static_cast<std::uint16_t>(w.value != 0.0 ? out.control_word | mask : out.control_word & ~mask), c);
-        break;
-      }
-    }
+    if (GateResult r = command_for(w, writes, snap, tuning, out, c); !r.accepted()) return r;
     if (excitation_point(w.id)) {
       if (first_excitation_point == PointId::kCount) first_excitation_point = w.id;
-      continue;
-    }
-    if (point(w.id).tuning()) {
-      if (first_tuning_point == PointId::kCount) first_tuning_point = w.id;
       continue;
     }
     out.commands.push_back(c);
     out.command_point.push_back(w.id);
   }
-  // A mode change goes first, so "enable and start" (or enable and a setpoint) in one write moves
-  // the axis: RUN entered holds, and the move comes after.
-  for (std::size_t i = 1; i < out.commands.size(); ++i)
-    if (out.commands[i].kind == runtime::CommandKind::kMode) {
-      std::rotate(out.commands.begin(), out.commands.begin() + static_cast<std::ptrdiff_t>(i), out.commands.begin() + static_cast<std::ptrdiff_t>(i) + 1);
-      std::rotate(out.command_point.begin(), out.command_point.begin() + static_cast<std::ptrdiff_t>(i),
-                  out.command_point.begin() + static_cast<std::ptrdiff_t>(i) + 1);
-    }
+  move_mode_first(out);
   if (first_tuning_point != PointId::kCount) {
     // Every tuning point of the group becomes one tuning command, validated whole (e.g. b_l > b_r
     // after this write is refused), last in the group.
@@ -302,15 +330,30 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
     out.commands.insert(out.commands.begin(), runtime::excitation_command(out.excitation));
     out.command_point.insert(out.command_point.begin(), first_excitation_point);
   }
-  // 4. The scan cycle's own rules, in the state it last published, carried through the group in
-  // the order the loop applies it (mode MANUAL then a manual valve command is one valid group).
+  return {};
+}
+
+// A mode change goes first, so "enable and start" (or enable and a setpoint) in one write moves
+// the axis: RUN entered holds, and the move comes after.
+void WriteGate::move_mode_first(Decision& out) {
+  for (std::size_t i = 1; i < out.commands.size(); ++i)
+    if (out.commands[i].kind == runtime::CommandKind::kMode) {
+      const auto at = static_cast<std::ptrdiff_t>(i);
+      std::rotate(out.commands.begin(), out.commands.begin() + at, out.commands.begin() + at + 1);
+      std::rotate(out.command_point.begin(), out.command_point.begin() + at, out.command_point.begin() + at + 1);
+    }
+}
+
+// The scan cycle's own rules, in the state it last published, carried through the group in the
+// order the loop applies it (mode MANUAL then a manual valve command is one valid group).
+GateResult WriteGate::check_loop_rules(const Decision& d, const runtime::Snapshot& snap, const runtime::ExcitationSettings& excitation) const {
   runtime::Mode mode = snap.mode;
   runtime::ExcitationSettings next_excitation = excitation;
   std::uint16_t word = control_word_;
-  for (std::size_t i = 0; i < out.commands.size(); ++i) {
-    const runtime::Command& c = out.commands[i];
+  for (std::size_t i = 0; i < d.commands.size(); ++i) {
+    const runtime::Command& c = d.commands[i];
     if (const auto r = runtime::check_command(c, mode, snap.position_mm, next_excitation, word, loop_rules_); r != runtime::CommandRefusal::kNone)
-      return refuse(gate_refusal(r), quoted(out.command_point[i]) + ": " + std::string(runtime::describe(r)));
+      return refuse(gate_refusal(r), quoted(d.command_point[i]) + ": " + std::string(runtime::describe(r)));
     if (c.kind == runtime::CommandKind::kControl) word = c.control_word;
     if (c.kind == runtime::CommandKind::kMode) mode = c.mode;
     if (c.kind == runtime::CommandKind::kExcitation) next_excitation = c.excitation;

@@ -106,6 +106,18 @@ class WriteGate {
   GateResult commission(std::span<const PointWrite> writes, const Requester& who);
   GateResult build(std::span<const PointWrite> writes, const Requester& who, const runtime::Snapshot& snap,
                    const control::ControllerConfig& tuning, const runtime::ExcitationSettings& excitation, Decision& out) const;
+  // build's steps, in its order.
+  GateResult check_values(std::span<const PointWrite> writes) const;
+  static GateResult check_rights(std::span<const PointWrite> writes, const Requester& who);
+  GateResult check_commission_command(std::span<const PointWrite> writes) const;
+  GateResult edit_records(std::span<const PointWrite> writes, Decision& out) const;
+  GateResult add_commands(std::span<const PointWrite> writes, const runtime::Snapshot& snap, const control::ControllerConfig& tuning,
+                          Decision& out) const;
+  GateResult command_for(const PointWrite& w, std::span<const PointWrite> writes, const runtime::Snapshot& snap,
+                         const control::ControllerConfig& tuning, Decision& out, runtime::Command& c) const;
+  static runtime::Command control_command(std::uint16_t word, std::span<const PointWrite> writes, const runtime::Snapshot& snap, Decision& out);
+  static void move_mode_first(Decision& out);
+  GateResult check_loop_rules(const Decision& d, const runtime::Snapshot& snap, const runtime::ExcitationSettings& excitation) const;
 
   // An accepted, audited write whose command the loop may still refuse.
   struct InFlight {
