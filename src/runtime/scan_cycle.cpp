@@ -11,7 +11,6 @@ namespace epa::runtime {
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kSpeedFilterS = 0.02;  // the measured speed's low-pass (a halt brakes from it)
-constexpr double kSoftLimitRecoverySlackMm = 1.0;  // outside the soft limits: how far back out a recovery may go (noise)
 
 MotionConfig motion_config(const RuntimeConfig& c) {
   return {.in_position_window_mm = c.in_position_window_mm, .in_position_time_s = c.in_position_time_s,
@@ -33,9 +32,9 @@ ScanCycle::ScanCycle(const RuntimeConfig& config, const Tuning& tuning, hal::Daq
       setpoint_mm_(config.start_setpoint_mm),
       manual_valve_v_(config.safe_valve_v),
       valve_v_(config.safe_valve_v),
+      detector_(config),
       excitation_settings_(config.excitation),
       moves_(ch.samples.capacity(), config.move_window_s, config.period_s, config.in_position_time_s),
-      following_(config.period_s),
       motion_(motion_config(config)) {
   if (config.start_fault != FaultCode::kNone) {
     mode_ = Mode::kFault;  // before any start mode: a fault found before the start is latched
@@ -90,7 +89,10 @@ void ScanCycle::apply(const Command& c, std::int64_t now_ns) noexcept {
             motion_.hold(position_mm_);
           }
           if (c.mode == Mode::kExcite) heartbeat_changed_ns_ = now_ns;  // the client gets a full timeout from here
-          soft_limit_recovery_mm_ = (c.mode == Mode::kRun || c.mode == Mode::kManual) && readings_ > 0 && outside_soft_limits() ? position_mm_ : kNaN;
+          if ((c.mode == Mode::kRun || c.mode == Mode::kManual) && readings_ > 0 && outside_soft_limits())
+            detector_.allow_recovery_from(position_mm_);
+          else
+            detector_.hold_soft_limits();
           if (mode_ == Mode::kManual) manual_valve_v_ = config_.safe_valve_v;  // it ends with MANUAL (read back so)
           mode_ = c.mode;
         }
@@ -170,10 +172,9 @@ void ScanCycle::enter_run(std::int64_t now_ns) noexcept {
   init_state_on_next_read_ = true;
   hold_on_enable_ = config_.enable_holds_position;  // until a move is started before the first reading
   heartbeat_changed_ns_ = now_ns;  // the client gets a full timeout from here
-  following_error_since_ns_ = -1;
-  following_error_shown_ = false;
+  detector_.restart_following_error();
   motion_.hold(position_mm_);
-  following_.follow_reference(position_mm_);
+  detector_.following().follow_reference(position_mm_);
 }
 
 void ScanCycle::use_profile_law(bool on) noexcept {
@@ -207,9 +208,7 @@ void ScanCycle::reset_fault() noexcept {
   if (mode_ != Mode::kFault) return;  // nothing latched: nothing to do, and that is fine
   mode_ = Mode::kStop;
   fault_ = FaultCode::kNone;
-  consecutive_read_errors_ = consecutive_write_errors_ = consecutive_overruns_ = 0;
-  following_error_since_ns_ = -1;
-  following_error_shown_ = false;
+  detector_.reset();
 }
 
 void ScanCycle::apply_control(const Command& c, std::int64_t now_ns) noexcept {
@@ -224,7 +223,7 @@ void ScanCycle::apply_control(const Command& c, std::int64_t now_ns) noexcept {
       // stands (track_move).
       use_profile_law(true);
       motion_.halt(position_mm_, plausible_speed_mm_s());
-      following_.follow_reference(position_mm_);
+      detector_.following().follow_reference(position_mm_);
       setpoint_mm_ = motion_.target_mm();  // the setpoint tells where the axis now stops
       hold_on_enable_ = false;
     } else if (jog_law_) {
@@ -247,7 +246,7 @@ void ScanCycle::apply_control(const Command& c, std::int64_t now_ns) noexcept {
       }
       manual_valve_v_ = config_.safe_valve_v;  // after the jog: the valve rests
       motion_.jog(direction, position_mm_, speed_mm_s_);
-      following_.follow_reference(position_mm_);
+      detector_.following().follow_reference(position_mm_);
     } else if (direction == 0 && jog_law_) {
       motion_.jog(0, position_mm_, speed_mm_s_);
     }
@@ -283,14 +282,14 @@ void ScanCycle::start_move(double target_mm, double speed_limit_mm_s, double win
   moves_.start(position_mm_, target_mm, law(), ch_.samples.written());
   motion_.move(target_mm, speed_limit_mm_s, window_mm, position_mm_, speed_mm_s_);
   if (speed_limit_mm_s > 0.0) {
-    following_.follow_reference(position_mm_);
+    detector_.following().follow_reference(position_mm_);
   } else {
     const auto& planned = tuning_.traj.trajectory().limits;  // sensor volts: in mm for the watch
     control::MotionLimits expected = planned;
     expected.speed_pos_v_s *= config_.mm_per_volt;
     expected.speed_neg_v_s *= config_.mm_per_volt;
     expected.accel_v_s2 *= config_.mm_per_volt;
-    following_.start_step(expected, tuning_.traj_available, position_mm_, plausible_speed_mm_s());
+    detector_.following().start_step(expected, tuning_.traj_available, position_mm_, plausible_speed_mm_s());
   }
 }
 
@@ -325,67 +324,12 @@ void ScanCycle::finish_move(MoveEnd end) noexcept {
   }
 }
 
-FaultCode ScanCycle::detect_fault(bool read_ok, std::int64_t now_ns) noexcept {
-  if (consecutive_read_errors_ >= config_.max_consecutive_io_errors ||
-      consecutive_write_errors_ >= config_.max_consecutive_io_errors)
-    return FaultCode::kIoErrors;
-  if (consecutive_overruns_ >= config_.max_consecutive_overruns) return FaultCode::kOverruns;
-  if (read_ok) {
-    if (!std::isfinite(sensor_v_)) return FaultCode::kSensorNotFinite;
-    if (sensor_v_ < config_.sensor_min_v || sensor_v_ > config_.sensor_max_v) return FaultCode::kSensorOutOfRange;
-  }
-  const bool moving = mode_ == Mode::kRun || mode_ == Mode::kManual || mode_ == Mode::kExcite;
-  if (!moving) return FaultCode::kNone;
-  if (read_ok && outside_soft_limits()) {
-    // Entered outside (a soft-limit fault, then reset): the axis may be brought back in, by a jog,
-    // the manual valve or a move; going 1 mm further out than the innermost point it reached since
-    // is the fault again. Crossing the limit from inside is the fault at once, as always.
-    if (std::isnan(soft_limit_recovery_mm_)) return FaultCode::kSoftLimit;
-    const bool above = position_mm_ > config_.soft_max_mm;
-    soft_limit_recovery_mm_ = above ? std::min(soft_limit_recovery_mm_, position_mm_) : std::max(soft_limit_recovery_mm_, position_mm_);
-    if (std::abs(position_mm_ - soft_limit_recovery_mm_) > kSoftLimitRecoverySlackMm) return FaultCode::kSoftLimit;
-  } else if (read_ok) {
-    soft_limit_recovery_mm_ = kNaN;  // inside: the limits hold from here
-  }
-  if (config_.heartbeat_timeout_s > 0.0 &&
-      static_cast<double>(now_ns - heartbeat_changed_ns_) > config_.heartbeat_timeout_s * 1e9)
-    return FaultCode::kHeartbeatLost;
-  if (read_ok && config_.sensor_frozen_time_s > 0.0) {
-    // valve_v_ is last cycle's command: the one the piston has been moving under since.
-    const bool driving = std::abs(valve_v_) > config_.sensor_frozen_drive_v &&
-                         position_mm_ > config_.setpoint_min_mm + 2.0 && position_mm_ < config_.setpoint_max_mm - 2.0;
-    if (driving && sensor_v_ == previous_sensor_v_) {
-      if (frozen_since_ns_ < 0) frozen_since_ns_ = now_ns;
-      if (static_cast<double>(now_ns - frozen_since_ns_) >= config_.sensor_frozen_time_s * 1e9) return FaultCode::kSensorFrozen;
-    } else {
-      frozen_since_ns_ = -1;
-    }
-  }
-  if (mode_ == Mode::kRun && read_ok && config_.following_error_time_s > 0.0) {
-    if (following_error_mm() > config_.following_error_mm) {
-      if (following_error_since_ns_ < 0) following_error_since_ns_ = now_ns;
-      const auto for_ns = static_cast<double>(now_ns - following_error_since_ns_);
-      following_error_shown_ = for_ns >= kFollowingErrorShownAfterS * 1e9;
-      if (for_ns > config_.following_error_time_s * 1e9) return FaultCode::kFollowingError;
-    } else {
-      following_error_since_ns_ = -1;
-      following_error_shown_ = false;
-    }
-  }
-  return FaultCode::kNone;
-}
-
-double ScanCycle::following_error_mm() noexcept {
-  const double position = readings_ >= 2 ? 0.5 * (position_mm_ + previous_position_mm_) : position_mm_;
-  return following_.step(motion_.reference_mm(), motion_.target_mm(), position);
-}
-
 void ScanCycle::enter_fault(FaultCode code) noexcept {
   // The cause, as it is before anything below changes it: a reset in the next cycle clears the
   // snapshot's fault, never this. A full ring drops it, counted.
   if (!ch_.fault_events.try_push({cycle_, static_cast<double>(cycle_) * config_.period_s, code, mode_, position_mm_,
-                                  setpoint_mm_, valve_v_, sensor_v_, consecutive_read_errors_, consecutive_write_errors_,
-                                  last_read_status_, last_write_status_}))
+                                  setpoint_mm_, valve_v_, sensor_v_, detector_.failed_reads(), detector_.failed_writes(),
+                                  detector_.last_read(), detector_.last_write()}))
     ++snap_.fault_events_dropped;
   if (moves_.active()) finish_move(MoveEnd::kFault);
   jog_law_ = profile_law_ = false;
@@ -398,55 +342,53 @@ void ScanCycle::enter_fault(FaultCode code) noexcept {
 
 void ScanCycle::cycle(std::int64_t now_ns) noexcept {
   apply_commands(now_ns);
+  const bool read_ok = read_sensor();
+  if (mode_ != Mode::kFault) check_faults(read_ok, now_ns);
+  command_valve(read_ok, now_ns);
+  write_valve(read_ok);
+  record_sample();
+  ++cycle_;
+  publish();
+}
 
+bool ScanCycle::read_sensor() noexcept {
   const hal::SensorReading reading = daq_.read_sensor();
-  last_read_status_ = reading.status;
-  const bool read_ok = reading.status == hal::IoStatus::kOk;
-  if (read_ok) {
-    previous_sensor_v_ = sensor_v_;
-    sensor_v_ = reading.sensor_v;
-    const double two_back_mm = previous_position_mm_;
-    previous_position_mm_ = position_mm_;
-    position_mm_ = (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain * config_.mm_per_volt;
-    // Over two samples: a plant ringing at the Nyquist rate (the paper's B under FF-IDZ) alternates
-    // its readings, which this difference cancels, so a halt brakes from the piston's real speed.
-    const double raw_speed = (position_mm_ - two_back_mm) / (2.0 * config_.period_s);
-    if (readings_ >= 2 && std::isfinite(raw_speed)) speed_mm_s_ += (raw_speed - speed_mm_s_) * (config_.period_s / (kSpeedFilterS + config_.period_s));
-    consecutive_read_errors_ = 0;
-    if (readings_ < 2) ++readings_;
-  } else {
-    ++consecutive_read_errors_;  // counted before the fault check: the N-th failure faults this cycle
-    ++io_errors_;
-  }
-  if (read_ok && init_state_on_next_read_ && readings_ == 1) {
-    // RUN from the start, with the first reading outside the soft limits: it may be brought back
-    // in, as when RUN is entered by command (detect_fault).
-    if (outside_soft_limits()) soft_limit_recovery_mm_ = position_mm_;
-  }
-  if (mode_ != Mode::kFault) {
-    if (const FaultCode f = detect_fault(read_ok, now_ns); f != FaultCode::kNone) enter_fault(f);
-  }
+  detector_.count_read(reading);  // before the checks: the N-th failure faults this cycle
+  if (reading.status != hal::IoStatus::kOk) return false;
+  take_reading(reading.sensor_v);
+  // RUN from the start, with the first reading outside the soft limits: it may be brought back
+  // in, as when RUN is entered by command.
+  if (init_state_on_next_read_ && readings_ == 1 && outside_soft_limits()) detector_.allow_recovery_from(position_mm_);
+  return true;
+}
 
+void ScanCycle::take_reading(double sensor_v) noexcept {
+  sensor_v_ = sensor_v;
+  const double two_back_mm = previous_position_mm_;
+  previous_position_mm_ = position_mm_;
+  position_mm_ = (sensor_v_ - config_.sensor_offset_v) * config_.sensor_gain * config_.mm_per_volt;
+  // Over two samples: a plant ringing at the Nyquist rate (the paper's B under FF-IDZ) alternates
+  // its readings, which this difference cancels, so a halt brakes from the piston's real speed.
+  const double raw_speed = (position_mm_ - two_back_mm) / (2.0 * config_.period_s);
+  if (readings_ >= 2 && std::isfinite(raw_speed)) speed_mm_s_ += (raw_speed - speed_mm_s_) * (config_.period_s / (kSpeedFilterS + config_.period_s));
+  if (readings_ < 2) ++readings_;
+}
+
+void ScanCycle::check_faults(bool read_ok, std::int64_t now_ns) noexcept {
+  const CycleView view{
+      .mode = mode_, .read_ok = read_ok, .sensor_v = sensor_v_, .position_mm = position_mm_, .valve_v = valve_v_,
+      .heartbeat_changed_ns = heartbeat_changed_ns_, .reference_mm = motion_.reference_mm(), .target_mm = motion_.target_mm(),
+      .following_position_mm = readings_ >= 2 ? 0.5 * (position_mm_ + previous_position_mm_) : position_mm_};
+  if (const FaultCode f = detector_.check(view, now_ns); f != FaultCode::kNone) enter_fault(f);
+}
+
+void ScanCycle::command_valve(bool read_ok, std::int64_t now_ns) noexcept {
   const double y_v = position_v();
   saturated_ = false;
   switch (mode_) {
     case Mode::kRun:
       if (!read_ok) break;  // hold the last command for a missed sample (counted below)
-      if (init_state_on_next_read_) {
-        // At rest at the current position: no error history, no controller output history.
-        profile_law_ = false;
-        control::controller_start(tuning_.for_kind(controller_), state_, y_v, 0.0);
-        init_state_on_next_read_ = false;
-        transfer_pending_ = false;  // RUN starts from the safe valve command, not from another law
-        if (hold_on_enable_) {      // enable holds: the setpoint follows the piston, nothing moves
-          setpoint_mm_ = position_mm_;
-          motion_.hold(position_mm_);
-          hold_on_enable_ = false;
-        } else if (!moves_.active()) {  // RUN drives to the setpoint (enable_holds_position off, or asked at start)
-          if (setpoint_mm_ != position_mm_) start_move(setpoint_mm_, 0.0, 0.0);
-          else motion_.hold(setpoint_mm_);
-        }
-      }
+      if (init_state_on_next_read_) start_run_at_first_reading();
       step_law(motion_.step(position_mm_), y_v);
       break;
     case Mode::kManual:
@@ -475,22 +417,34 @@ void ScanCycle::cycle(std::int64_t now_ns) noexcept {
     case Mode::kStop:
     case Mode::kFault: valve_v_ = config_.safe_valve_v; controller_v_ = 0.0; break;
   }
+}
 
-  last_write_status_ = daq_.write_valve(valve_v_);
-  const bool write_ok = last_write_status_ == hal::IoStatus::kOk;
-  io_ok_ = read_ok && write_ok;
-  if (write_ok) {
-    consecutive_write_errors_ = 0;
-  } else {
-    ++consecutive_write_errors_;  // a valve that cannot be written faults at the next cycle's check
-    ++io_errors_;
+void ScanCycle::start_run_at_first_reading() noexcept {
+  // At rest at the current position: no error history, no controller output history.
+  profile_law_ = false;
+  control::controller_start(tuning_.for_kind(controller_), state_, position_v(), 0.0);
+  init_state_on_next_read_ = false;
+  transfer_pending_ = false;  // RUN starts from the safe valve command, not from another law
+  if (hold_on_enable_) {      // enable holds: the setpoint follows the piston, nothing moves
+    setpoint_mm_ = position_mm_;
+    motion_.hold(position_mm_);
+    hold_on_enable_ = false;
+  } else if (!moves_.active()) {  // RUN drives to the setpoint (enable_holds_position off, or asked at start)
+    if (setpoint_mm_ != position_mm_) start_move(setpoint_mm_, 0.0, 0.0);
+    else motion_.hold(setpoint_mm_);
   }
+}
 
+void ScanCycle::write_valve(bool read_ok) noexcept {
+  const hal::IoStatus status = daq_.write_valve(valve_v_);
+  detector_.count_write(status);  // a valve that cannot be written faults at the next cycle's check
+  io_ok_ = read_ok && status == hal::IoStatus::kOk;
+}
+
+void ScanCycle::record_sample() noexcept {
   ch_.samples.push({static_cast<double>(cycle_) * config_.period_s, setpoint_mm_, position_mm_, valve_v_, controller_v_});
   if (mode_ == Mode::kRun) run_samples_end_ = ch_.samples.written();
   if (mode_ == Mode::kRun && moves_.active()) track_move();
-  ++cycle_;
-  publish();
 }
 
 void ScanCycle::step_law(double reference_mm, double y_v) noexcept {
@@ -529,7 +483,7 @@ void ScanCycle::publish(bool full_stats) noexcept {
   s.heartbeat = heartbeat_;
   s.moves = last_move_.number;
   s.faults = faults_;
-  s.io_errors = io_errors_;
+  s.io_errors = detector_.io_errors();
   s.commands_applied = applied_;
   s.commands_rejected = rejected_;
   s.last_refusal = last_refusal_;
@@ -542,7 +496,7 @@ void ScanCycle::publish(bool full_stats) noexcept {
   const MotionStatus motion = motion_.status();
   const bool axis_active = mode_ == Mode::kRun || (mode_ == Mode::kManual && jog_law_);
   s.axis = {axis_active && motion.moving, mode_ == Mode::kRun && motion.in_position, mode_ == Mode::kRun && motion.target_reached,
-            mode_ == Mode::kRun && following_error_shown_, (control_word_ & kControlStart) != 0, motion.halted, axis_active && motion.jogging,
+            mode_ == Mode::kRun && detector_.following_error_shown(), (control_word_ & kControlStart) != 0, motion.halted, axis_active && motion.jogging,
             control_word_, axis_active ? motion_.reference_mm() : position_mm_, speed_mm_s_, mode_ == Mode::kRun && motion.off_target};
   s.last_sequence = last_sequence_;
   if (cycle_ % 200 == 0 || full_stats) s.loop = stats_.view();  // percentiles scan the bins: a few times a second
@@ -572,12 +526,11 @@ void ScanCycle::run(const std::atomic<bool>& stop) noexcept {
     const std::int64_t done = clock_.now_ns();
     stats_.compute.add(done - wake);
     deadline += period_ns_;
-    if (done > deadline) {  // missed the next deadline: skip the lost periods, count an overrun
+    const bool missed = done > deadline;
+    detector_.count_deadline(missed);
+    if (missed) {  // missed the next deadline: skip the lost periods, count an overrun
       ++stats_.overruns;
-      ++consecutive_overruns_;
       while (deadline < done) deadline += period_ns_;
-    } else {
-      consecutive_overruns_ = 0;
     }
   }
   shut_down();

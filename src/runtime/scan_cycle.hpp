@@ -9,7 +9,6 @@
 // write, a run through the scan cycle reproduces `epa simulate` sample for sample.
 #include <atomic>
 #include <cstdint>
-#include <limits>
 #include <optional>
 
 #include "control/bumpless_transfer.hpp"
@@ -20,8 +19,8 @@
 #include "runtime/command.hpp"
 #include "runtime/command_rules.hpp"
 #include "runtime/excitation_run.hpp"
+#include "runtime/fault_detector.hpp"
 #include "runtime/fault_event.hpp"
-#include "runtime/following_watch.hpp"
 #include "runtime/loop_channels.hpp"
 #include "runtime/loop_stats.hpp"
 #include "runtime/move_tracker.hpp"
@@ -68,9 +67,7 @@ class ScanCycle {
   void step_law(double reference_mm, double y_v) noexcept;
   // The calibrated position in sensor volts from the last reading: what the control laws read.
   double position_v() const noexcept;
-  bool outside_soft_limits() const noexcept {  // the last reading
-    return position_mm_ < config_.soft_min_mm || position_mm_ > config_.soft_max_mm;
-  }
+  bool outside_soft_limits() const noexcept { return detector_.outside_soft_limits(position_mm_); }  // the last reading
   // Starts `law` on the piston where the last reading put it, at the speed of the last two readings.
   void start_law_at_the_piston(const control::ControllerParams& law) noexcept;
   void end_excitation(ExcitationEnd how) noexcept;
@@ -82,8 +79,15 @@ class ScanCycle {
   // after a halt, standing off target, or judged after move_window_s).
   void track_move() noexcept;
   void finish_move(MoveEnd end) noexcept;
-  double following_error_mm() noexcept;  // this cycle's, RUN (following_watch.hpp)
-  FaultCode detect_fault(bool read_ok, std::int64_t now_ns) noexcept;
+  // The steps of a cycle, in order.
+  bool read_sensor() noexcept;  // false: no reading this cycle (the last one stands)
+  void check_faults(bool read_ok, std::int64_t now_ns) noexcept;
+  void command_valve(bool read_ok, std::int64_t now_ns) noexcept;  // the mode's command, in valve_v_
+  void write_valve(bool read_ok) noexcept;
+  void record_sample() noexcept;
+
+  void take_reading(double sensor_v) noexcept;  // the position and the speed from a reading
+  void start_run_at_first_reading() noexcept;   // RUN entered: hold, or drive to the setpoint
   void enter_fault(FaultCode code) noexcept;
   void publish(bool full_stats = false) noexcept;
 
@@ -105,18 +109,10 @@ class ScanCycle {
   double setpoint_mm_ = 0.0, manual_valve_v_ = 0.0;
   double sensor_v_ = 0.0, position_mm_ = 0.0, valve_v_ = 0.0, controller_v_ = 0.0;
   bool saturated_ = false, io_ok_ = true;
-  int consecutive_read_errors_ = 0, consecutive_write_errors_ = 0, consecutive_overruns_ = 0;
-  hal::IoStatus last_read_status_ = hal::IoStatus::kOk, last_write_status_ = hal::IoStatus::kOk;  // for a fault's cause
-  std::int64_t following_error_since_ns_ = -1;  // beyond following_error_mm since then; -1: within
-  bool following_error_shown_ = false;          // ... for kFollowingErrorShownAfterS: the status bit
-  std::int64_t frozen_since_ns_ = -1;  // the reading has been bit-identical while driving since then
-  // RUN or MANUAL entered with the piston outside the soft limits (after a soft-limit fault and its
-  // reset): the innermost position reached since, so it can be brought back; NaN otherwise.
-  double soft_limit_recovery_mm_ = std::numeric_limits<double>::quiet_NaN();
-  double previous_sensor_v_ = 0.0;
+  FaultDetector detector_;  // the checks, and the I/O failures they count
   std::uint32_t heartbeat_ = 0;
   std::int64_t heartbeat_changed_ns_ = 0;
-  std::uint64_t cycle_ = 0, faults_ = 0, io_errors_ = 0, applied_ = 0, rejected_ = 0;
+  std::uint64_t cycle_ = 0, faults_ = 0, applied_ = 0, rejected_ = 0;
   CommandRefusal last_refusal_ = CommandRefusal::kNone;
   std::uint64_t run_samples_end_ = 0;  // one past the last sample a controller drove (RUN): labels recordings
 
@@ -125,7 +121,6 @@ class ScanCycle {
 
   MoveTracker moves_;
   MoveResult last_move_;
-  FollowingWatch following_;
 
   // The positioning interface: the task and its reference, the control word and its handshake.
   AxisMotion motion_;
