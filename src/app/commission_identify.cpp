@@ -4,12 +4,12 @@
 #include <cstdio>
 
 #include "app/identify_command.hpp"
-#include "app/identify_report.hpp"
 #include "core/units.hpp"
 #include "ident/arx_estimator.hpp"
 #include "ident/arx_metrics.hpp"
 #include "ident/hammerstein_identification.hpp"
 #include "ident/stick_slip_fit.hpp"
+#include "report/identify_report.hpp"
 
 namespace epa::app {
 
@@ -66,7 +66,7 @@ commission::Identify identify_for_commissioning(double mm_per_volt) {
     if (!identified) return identified.error();
     const core::HammersteinModel model = identified->model(Ts, mm_per_volt);
     if (auto s = model.validate(); !s) return core::numerical_error("the identified model is not valid: " + s.error().message);
-    const ModelFitSummary fits = summarise_fit(identified->fit, est, val, identified->selection.first);
+    const report::ModelFitSummary fits = report::summarise_fit(identified->fit, est, val, identified->selection.first);
 
     commission::IdentifiedModel out{model, fits.estimation.simulation_pct, fits.validation.simulation_pct, {}, {}};
     // The held-out run's free run, where its first segment lies (NaN elsewhere: end stops).
@@ -93,7 +93,7 @@ commission::Identify identify_for_commissioning(double mm_per_volt) {
     if (!stick) return core::numerical_error("the stick-slip model: " + stick.error().message);
     out.stick_slip = stick->fit.params;
     out.stick_slip_validation_fit_pct = stick->validation_pct;
-    out.axis_model = axis_model_verdict(*stick, fits);
+    out.axis_model = report::axis_model_verdict(*stick, fits);
     std::snprintf(buf, sizeof buf, "; stick-slip model: free-run fit %.1f %% on the held-out run%s", stick->validation_pct,
                   out.axis_model == core::AxisModel::kStickSlip ? " (describes the axis)" : "");
     out.summary += buf;

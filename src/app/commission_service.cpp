@@ -2,8 +2,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/commission_report.hpp"
 #include "commission/commission_spec.hpp"
+#include "report/commission_report.hpp"
 
 namespace epa::app {
 
@@ -39,7 +39,7 @@ points::CommissionStartResult CommissionService::start(const std::string& spec_j
   thread_ = std::thread([this, s = *spec] {
     const auto outcome = sequence_->run(s);
     auto json = commission::format_commission_json(outcome);
-    auto html = commission_report_html(outcome);
+    auto html = report::commission_report_html(outcome);
     std::lock_guard done(mutex_);
     result_json_ = std::move(json);
     report_html_ = std::move(html);

@@ -6,7 +6,6 @@
 #include <optional>
 
 #include "app/cli_checks.hpp"
-#include "app/diagnose_report.hpp"
 #include "app/output_file.hpp"
 #include "core/format.hpp"
 #include "core/model_file.hpp"
@@ -15,6 +14,7 @@
 #include "diag/gap_report.hpp"
 #include "diag/selection.hpp"
 #include "diag/windowed_gap.hpp"
+#include "report/diagnose_report.hpp"
 
 namespace epa::app {
 
@@ -113,7 +113,7 @@ int run_diagnose(const DiagnoseOptions& o, std::ostream& out, std::ostream& err)
     if (o.json_path != "-") out << "report written to " << o.json_path << "\n";
   }
   if (!o.report_path.empty()) {
-    if (auto s = write_output(o.report_path, render_diagnosis_html(report), out); !s) return fail(s.error().message);
+    if (auto s = write_output(o.report_path, report::render_diagnosis_html(report), out); !s) return fail(s.error().message);
     out << "HTML report written to " << o.report_path << "\n";
   }
   return 0;

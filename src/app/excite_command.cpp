@@ -6,13 +6,13 @@
 
 #include "app/cli_checks.hpp"
 #include "app/output_file.hpp"
-#include "app/svg_chart.hpp"
 #include "app/tuning_source.hpp"
 #include "core/format.hpp"
 #include "core/run_file.hpp"
 #include "ident/excitation.hpp"
 #include "plant/plant_adapter.hpp"
 #include "plant/pneumatic_params.hpp"
+#include "report/svg_chart.hpp"
 
 namespace epa::app {
 
@@ -48,19 +48,19 @@ namespace {
 // The whole run, then the ramps alone (where the piston starts to move shows the break points, as
 // in the paper's figure 6).
 std::string render_excitation_plot(const core::Run& run, double ramps_end_s, const std::string& title) {
-  Series y{"measured position", "#000000", run.t_s, run.y_mm, false};
-  Series u{"valve command", "#1f77b4", run.t_s, run.u_V, false};
-  Panel position{"position", "time (s)", "position (mm)", {y}, {}, {}, {}, 0.0, 500.0};
-  Panel valve{"valve command", "time (s)", "valve command (V)", {u}, {}, {}, {}, {}, {}};
-  std::vector<Panel> panels = {position, valve};
+  report::Series y{"measured position", "#000000", run.t_s, run.y_mm, false};
+  report::Series u{"valve command", "#1f77b4", run.t_s, run.u_V, false};
+  report::Panel position{"position", "time (s)", "position (mm)", {y}, {}, {}, {}, 0.0, 500.0};
+  report::Panel valve{"valve command", "time (s)", "valve command (V)", {u}, {}, {}, {}, {}, {}};
+  std::vector<report::Panel> panels = {position, valve};
   if (ramps_end_s > 0.0) {
-    Panel ramp_y{"ramps through the dead band: position", "time (s)", "position (mm)", {y}, {}, 0.0, ramps_end_s, {}, {}};
-    Panel ramp_u{"ramps through the dead band: valve command", "time (s)", "valve command (V)", {u}, {}, 0.0, ramps_end_s,
+    report::Panel ramp_y{"ramps through the dead band: position", "time (s)", "position (mm)", {y}, {}, 0.0, ramps_end_s, {}, {}};
+    report::Panel ramp_u{"ramps through the dead band: valve command", "time (s)", "valve command (V)", {u}, {}, 0.0, ramps_end_s,
                  {}, {}};
     panels.push_back(std::move(ramp_y));
     panels.push_back(std::move(ramp_u));
   }
-  return render_svg(title, panels, 1, 1100, 260);
+  return report::render_svg(title, panels, 1, 1100, 260);
 }
 
 constexpr std::uint64_t kNoiseStream = 0x6E6F697365ull;  // the noise's own stream: --noise does not change u

@@ -6,7 +6,6 @@
 #include <optional>
 
 #include "app/cli_checks.hpp"
-#include "app/identify_report.hpp"
 #include "app/output_file.hpp"
 #include "app/store_save.hpp"
 #include "core/format.hpp"
@@ -17,6 +16,7 @@
 #include "ident/order_selection.hpp"
 #include "ident/ramp_reading.hpp"
 #include "ident/stick_slip_fit.hpp"
+#include "report/identify_report.hpp"
 #include "store/store_file.hpp"
 
 namespace epa::app {
@@ -66,9 +66,9 @@ constexpr const char* kFormatHint =
     "epa identify reads epa-run/1 files: columns t_s, y_mm, u_V, uniformly sampled at Ts; see FORMATS.md";
 
 // Reads, splits at the end stops and checks one group of runs; the first run fixes Ts.
-core::Result<std::vector<IdentifiedRun>> load_runs(const std::vector<std::string>& paths, std::optional<double>& Ts,
+core::Result<std::vector<report::IdentifiedRun>> load_runs(const std::vector<std::string>& paths, std::optional<double>& Ts,
                                                    const IdentifyOptions& o, bool estimation, std::ostream& out) {
-  std::vector<IdentifiedRun> runs;
+  std::vector<report::IdentifiedRun> runs;
   for (const auto& path : paths) {
     auto run = core::read_run_file(path, Ts);
     if (!run) {
@@ -76,7 +76,7 @@ core::Result<std::vector<IdentifiedRun>> load_runs(const std::vector<std::string
       return core::Error{run.error().code, run.error().message + " (" + kFormatHint + same_Ts + ")"};
     }
     if (!Ts) Ts = run->Ts;
-    IdentifiedRun r{path, std::move(*run), {}};
+    report::IdentifiedRun r{path, std::move(*run), {}};
     ident::SegmentReport report;
     r.segments = ident::split_run(r.run, path, {.mm_per_volt = o.mm_per_volt, .stroke_mm = o.stroke_mm}, &report);
     const ident::ExcitationCheck check{.need_both_directions = estimation};
@@ -96,7 +96,7 @@ core::Result<std::vector<IdentifiedRun>> load_runs(const std::vector<std::string
   return runs;
 }
 
-std::vector<ident::Segment> all_segments(const std::vector<IdentifiedRun>& runs) {
+std::vector<ident::Segment> all_segments(const std::vector<report::IdentifiedRun>& runs) {
   std::vector<ident::Segment> s;
   for (const auto& r : runs) s.insert(s.end(), r.segments.begin(), r.segments.end());
   return s;
@@ -208,8 +208,8 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   const core::HammersteinModel model = fit.model(*Ts, o.mm_per_volt);
   if (auto s = model.validate(); !s) return fail("the identified model is not valid: " + s.error().message);
 
-  const ModelFitSummary summary = summarise_fit(fit, est_segments, val_segments, identified->selection.first);
-  print_identified_model(out, fit, model, summary, o.m_l);
+  const report::ModelFitSummary summary = report::summarise_fit(fit, est_segments, val_segments, identified->selection.first);
+  report::print_identified_model(out, fit, model, summary, o.m_l);
 
   std::optional<ident::StickSlipIdentification> stick_slip;
   std::optional<core::StickSlipParams> stick_slip_params;  // what the model file and the plot take
@@ -224,7 +224,7 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
     if (!fitted) return fail(fitted.error().message);
     stick_slip = *fitted;
     stick_slip_params = fitted->fit.params;
-    print_stick_slip(out, *stick_slip, summary);
+    report::print_stick_slip(out, *stick_slip, summary);
   }
 
   std::string runs_text;
@@ -239,7 +239,7 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
     std::snprintf(source + used, sizeof source - static_cast<std::size_t>(used), "; stick-slip model: %s free-run fit %.2f %%",
                   scored, summary.validated ? stick_slip->validation_pct : stick_slip->estimation_pct);
   if (!o.out_path.empty()) {
-    const auto axis = stick_slip ? axis_model_verdict(*stick_slip, summary) : core::AxisModel::kHammerstein;
+    const auto axis = stick_slip ? report::axis_model_verdict(*stick_slip, summary) : core::AxisModel::kHammerstein;
     if (auto s = core::write_model_file(o.out_path, {model, source, stick_slip_params, axis}); !s) return fail(s.error().message);
     out << "\nmodel written to " << o.out_path << "\n";
   }
@@ -251,7 +251,7 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
                                                           {"simulation_pct", summary.validation.simulation_pct}}
                                          : nlohmann::json(nullptr)},
         {"pso_seed", o.seed}, {"criterion", o.criterion},
-        {"stick_slip", stick_slip ? stick_slip_json(*stick_slip, summary.validated) : nlohmann::json(nullptr)}};
+        {"stick_slip", stick_slip ? report::stick_slip_json(*stick_slip, summary.validated) : nlohmann::json(nullptr)}};
     auto id = save_model(o.db_path, {.id = 0, .name = o.save_name, .created_ms = 0, .source = source, .model = model,
                                      .fit_json = fit_json.dump()});
     if (!id) return fail("--save: " + id.error().message);
@@ -259,7 +259,7 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   }
   if (!o.plot_path.empty()) {
     const auto& shown = val->empty() ? *est : *val;
-    if (auto s = write_output(o.plot_path, render_identification_plot(shown, fit, model, !val->empty(), stick_slip_params), out);
+    if (auto s = write_output(o.plot_path, report::render_identification_plot(shown, fit, model, !val->empty(), stick_slip_params), out);
         !s)
       return fail(s.error().message);
     out << "picture written to " << o.plot_path << "\n";

@@ -7,9 +7,6 @@
 
 #include "app/cli_checks.hpp"
 #include "app/output_file.hpp"
-#include "app/response_plot.hpp"
-#include "app/simulation_case.hpp"
-#include "app/table1_report.hpp"
 #include "app/tuning_source.hpp"
 #include "control/controller.hpp"
 #include "core/format.hpp"
@@ -19,6 +16,9 @@
 #include "plant/plant_adapter.hpp"
 #include "plant/pneumatic_params.hpp"
 #include "plant/stick_slip_model.hpp"
+#include "report/response_plot.hpp"
+#include "report/simulation_case.hpp"
+#include "report/table1_report.hpp"
 #include "store/trajectory_settings.hpp"
 #include "store/tuning_set.hpp"
 #include "sim/model_perturbation.hpp"
@@ -111,7 +111,7 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
   const auto coast = plant::sliding_arrival_coast_s(*model_file, trajectory.approach_speed_mm_s);
   if (!coast) return err << "epa simulate: " << coast.error().message << "\n", 1;
   trajectory.coast_s = *coast;
-  std::vector<SimulationCase> cases;
+  std::vector<report::SimulationCase> cases;
   for (auto kind : kinds) {
     store::TuningSet set;
     set.controller = kind, set.F = polynomials->F, set.G = polynomials->G, set.H = polynomials->H;
@@ -144,7 +144,7 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
       << ", from rest at " << format_number(o.start_mm) << " mm; gain x" << format_number(o.gain_factor) << ", dead band "
       << (o.break_point_error_v >= 0 ? "+" : "") << format_number(o.break_point_error_v) << " V each side, delay " << o.delay_samples
       << " samples, valve lag " << format_number(o.valve_lag_s) << " s\n\n";
-  print_table1_comparison(out, cases);
+  report::print_table1_comparison(out, cases);
 
   if (!o.out_dir.empty()) {
     std::error_code ec;
@@ -180,7 +180,7 @@ int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err)
 
   if (!o.plot_path.empty()) {
     const std::string title = "Closed-loop step responses (" + model_file->source + ", Ts = " + core::format_number(model.Ts) + " s)";
-    if (auto s = write_output(o.plot_path, render_response_plot(cases, model.dead_zone, o.plot_window_s, title), out); !s)
+    if (auto s = write_output(o.plot_path, report::render_response_plot(cases, model.dead_zone, o.plot_window_s, title), out); !s)
       return err << "epa simulate: " << s.error().message << "\n", 1;
     out << "picture written to " << o.plot_path << "\n";
   }

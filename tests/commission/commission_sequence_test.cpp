@@ -108,7 +108,7 @@ Identify with_fits(std::map<std::string, SplitFits> by_held_out_seed) {
     const SplitFits& f = by_held_out_seed.at(validation.meta("excitation_seed"));
     IdentifiedModel m{core::paper::model(), 90.0, f.hammerstein_pct, {}, "split held out " + validation.meta("excitation_seed")};
     if (f.has_stick_slip) m.stick_slip = core::StickSlipParams{}, m.stick_slip_validation_fit_pct = f.stick_slip_pct;
-    // As one split alone would judge it (app/identify_report.cpp):
+    // As one split alone would judge it (report/identify_report.cpp):
     m.axis_model = f.has_stick_slip && f.stick_slip_pct > f.hammerstein_pct ? core::AxisModel::kStickSlip : core::AxisModel::kHammerstein;
     return m;
   };

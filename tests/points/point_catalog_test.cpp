@@ -50,7 +50,7 @@ const std::map<std::string, std::string> kFormatFiles = {
     {"app/simulate_command.cpp", "epa-run/1 metadata"},
     {"ident/excitation.cpp", "epa-run/1 metadata"},
     {"sim/closed_loop.cpp", "epa-run/1 metadata"},
-    {"app/identify_report.cpp", "a report's row labels"},
+    {"report/identify_report.cpp", "a report's row labels"},
     {"commission/commission_spec.cpp", "the commissioning spec's keys"},
     {"commission/commission_sequence.cpp", "epa-commission/1 keys"},
     {"app/tuning_command.cpp", "epa tuning show's labels"},

@@ -4,10 +4,10 @@
 #include <ostream>
 #include <vector>
 
-#include "app/simulation_case.hpp"
+#include "report/simulation_case.hpp"
 
-namespace epa::app {
+namespace epa::report {
 
 void print_table1_comparison(std::ostream& out, const std::vector<SimulationCase>& cases);
 
-}  // namespace epa::app
+}  // namespace epa::report

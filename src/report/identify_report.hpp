@@ -16,7 +16,7 @@
 #include "ident/ident_data.hpp"
 #include "ident/stick_slip_fit.hpp"
 
-namespace epa::app {
+namespace epa::report {
 
 struct IdentifiedRun {
   std::string path;
@@ -62,4 +62,4 @@ core::AxisModel axis_model_verdict(const ident::StickSlipIdentification& r, cons
 // The same for the tuning store's fit figures (`--save`).
 nlohmann::json stick_slip_json(const ident::StickSlipIdentification& r, bool validated);
 
-}  // namespace epa::app
+}  // namespace epa::report

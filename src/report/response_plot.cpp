@@ -1,11 +1,11 @@
-#include "app/response_plot.hpp"
+#include "report/response_plot.hpp"
 
 #include <algorithm>
 #include <cstdio>
 
-#include "app/svg_chart.hpp"
+#include "report/svg_chart.hpp"
 
-namespace epa::app {
+namespace epa::report {
 
 namespace {
 
@@ -68,4 +68,4 @@ std::string render_response_plot(const std::vector<SimulationCase>& cases, const
   return render_svg(title, panels, 2);
 }
 
-}  // namespace epa::app
+}  // namespace epa::report

@@ -1,24 +1,13 @@
-#include "app/commission_report.hpp"
+#include "report/commission_report.hpp"
 
 #include <cstdio>
 
-#include "app/svg_chart.hpp"
+#include "report/html.hpp"
+#include "report/svg_chart.hpp"
 
-namespace epa::app {
+namespace epa::report {
 
 namespace {
-
-std::string escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '&') out += "&amp;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
-  }
-  return out;
-}
 
 std::string number(const std::optional<double>& v, const char* format = "%.3f") {
   if (!v) return "never";
@@ -39,7 +28,7 @@ std::string moves_table(const std::vector<commission::JudgedMove>& moves) {
     char buf[160];
     std::snprintf(buf, sizeof buf, "<tr><td>%.1f &rarr; %.1f</td><td>", m.from_mm, m.to_mm);
     h += buf + number(m.metrics.rise_s) + "</td><td>" + number(m.metrics.settling_s) + "</td><td>" + number(m.metrics.ess_mm) +
-         "</td><td>" + number(m.metrics.overshoot_pct, "%.1f") + "</td><td>" + (m.passed ? "pass" : escape(m.why)) + "</td></tr>";
+         "</td><td>" + number(m.metrics.overshoot_pct, "%.1f") + "</td><td>" + (m.passed ? "pass" : escape_html_attribute(m.why)) + "</td></tr>";
   }
   return h + "</table>";
 }
@@ -52,8 +41,8 @@ std::string commission_report_html(const commission::CommissionOutcome& o) {
                   "td,th{border:1px solid #bbb;padding:2px 8px;text-align:right}.verdict{font-size:1.3em;font-weight:bold}"
                   ".deployed{color:#176117}.rolled-back,.aborted{color:#a01818}svg{max-width:100%;height:auto}</style></head><body>";
   const std::string verdict(commission::to_string(o.verdict));
-  h += "<h1>Commissioning report</h1><p class=\"verdict " + verdict + "\">" + verdict + ": " + escape(o.reason) + "</p>";
-  h += "<p>previous tuning set: <b>" + escape(o.previous_set) + "</b>; new set: <b>" + (o.new_set.empty() ? "none stored" : escape(o.new_set)) +
+  h += "<h1>Commissioning report</h1><p class=\"verdict " + verdict + "\">" + verdict + ": " + escape_html_attribute(o.reason) + "</p>";
+  h += "<p>previous tuning set: <b>" + escape_html_attribute(o.previous_set) + "</b>; new set: <b>" + (o.new_set.empty() ? "none stored" : escape_html_attribute(o.new_set)) +
        "</b></p>";
 
   if (!o.experiment.empty()) {
@@ -83,7 +72,7 @@ std::string commission_report_html(const commission::CommissionOutcome& o) {
                   "free-run fit: estimation %.1f %%, held-out run %.1f %%</p>",
                   m.A.to_string().c_str(), m.B.to_string().c_str(), m.dead_zone.b_l, m.dead_zone.b_r, m.dead_zone.m_l, m.dead_zone.m_r,
                   o.identified->estimation_fit_pct, o.identified->validation_fit_pct);
-    h += buf + ("<p>" + escape(o.identified->summary) + "</p>");
+    h += buf + ("<p>" + escape_html_attribute(o.identified->summary) + "</p>");
   }
   if (o.design) {
     char buf[640];
@@ -97,7 +86,7 @@ std::string commission_report_html(const commission::CommissionOutcome& o) {
   }
   if (o.simulation) {
     h += "<h2>Verification</h2><h3>In simulation</h3>";
-    for (const auto& c : o.simulation->cases) h += "<p><b>" + escape(c.name) + "</b>: " + (c.passed ? "pass" : "FAIL") + "</p>" + moves_table(c.moves);
+    for (const auto& c : o.simulation->cases) h += "<p><b>" + escape_html_attribute(c.name) + "</b>: " + (c.passed ? "pass" : "FAIL") + "</p>" + moves_table(c.moves);
   }
   if (!o.verification.empty()) {
     h += "<h3>On the axis</h3>" + moves_table(o.verification);
@@ -118,8 +107,8 @@ std::string commission_report_html(const commission::CommissionOutcome& o) {
     h += render_svg("", panels, 2, 560, 260);
   }
   h += "<h2>Log</h2><pre>";
-  for (const auto& line : o.log) h += escape(line) + "\n";
+  for (const auto& line : o.log) h += escape_html_attribute(line) + "\n";
   return h + "</pre></body></html>\n";
 }
 
-}  // namespace epa::app
+}  // namespace epa::report

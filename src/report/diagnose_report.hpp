@@ -6,8 +6,8 @@
 
 #include "diag/gap_report.hpp"
 
-namespace epa::app {
+namespace epa::report {
 
 std::string render_diagnosis_html(const diag::GapReport& report);
 
-}  // namespace epa::app
+}  // namespace epa::report

@@ -1,22 +1,15 @@
-#include "app/diagnose_report.hpp"
+#include "report/diagnose_report.hpp"
 
 #include <algorithm>
 #include <cstdio>
 
-#include <cstdio>
+#include "report/effect_shapes.hpp"
+#include "report/html.hpp"
+#include "report/svg_chart.hpp"
 
-#include "app/effect_shapes.hpp"
-#include "app/svg_chart.hpp"
-
-namespace epa::app {
+namespace epa::report {
 
 namespace {
-
-std::string escape(const std::string& s) {
-  std::string o;
-  for (char c : s) o += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
-  return o;
-}
 
 std::string num(double v, const char* fmt = "%.3f") {
   char b[64];
@@ -38,12 +31,12 @@ std::string render_diagnosis_html(const diag::GapReport& r) {
                   "<style>body{font-family:sans-serif;max-width:1200px;margin:auto}table{border-collapse:collapse}"
                   "td,th{border:1px solid #bbb;padding:2px 8px;text-align:right}td:first-child{text-align:left}"
                   ".yes{background:#d8f0d8}</style></head><body>\n<h1>Sim-to-real gap</h1>\n";
-  h += "<p><b>" + escape(diag::verdict_text(r)) + "</b></p>\n";
+  h += "<p><b>" + escape_html(diag::verdict_text(r)) + "</b></p>\n";
   h += "<p>Gap: RMS of the windowed prediction error, restarting the model from the measured state every " +
        std::to_string(d.horizon) + " samples. " + (d.cross_validated ? "Cross-validated by run." : "Scored on held-out runs.") + "</p>\n";
   if (!r.hints.empty()) {
     h += "<h2>Pointers</h2><ul>";
-    for (const auto& s : r.hints) h += "<li>" + escape(s) + "</li>";
+    for (const auto& s : r.hints) h += "<li>" + escape_html(s) + "</li>";
     h += "</ul>\n";
   }
   // Recorded vs nominal vs augmented, on the first scored run.
@@ -72,7 +65,7 @@ std::string render_diagnosis_html(const diag::GapReport& r) {
     return std::string(b);
   };
   for (const auto& w : r.where)
-    h += "<tr><td>" + escape(w.before.dimension) + "</td><td>" + escape(w.before.regime) + "</td><td style=\"width:220px\">" +
+    h += "<tr><td>" + escape_html(w.before.dimension) + "</td><td>" + escape_html(w.before.regime) + "</td><td style=\"width:220px\">" +
          bar(w.before.time_share_pct, "#9e9e9e") + bar(w.before.gap_share_pct, "#d62728") + "</td><td>" +
          num(w.before.time_share_pct, "%.1f") + "</td><td>" + num(w.before.gap_share_pct, "%.1f") + "</td><td>" + num(w.before.gap_mm) +
          "</td><td>" + num(w.refit_gap_mm) + "</td><td>" + num(w.after_gap_mm) + "</td></tr>\n";
@@ -83,17 +76,17 @@ std::string render_diagnosis_html(const diag::GapReport& r) {
     plant::EffectSet one;
     one.set(c.kind, c.params);
     h += std::string("<tr") + (c.accepted ? " class=\"yes\"" : "") + "><td>" + std::string(plant::to_string(c.kind)) + "</td><td>" +
-         escape(one.describe()) + "</td><td>" + num(c.heldout_gap_mm) + "</td><td>" + num(c.reduction_pct, "%.1f") + "</td><td>" +
+         escape_html(one.describe()) + "</td><td>" + num(c.heldout_gap_mm) + "</td><td>" + num(c.reduction_pct, "%.1f") + "</td><td>" +
          num(c.reduction_vs_refit_pct, "%.1f") + "</td><td>" + num(c.threshold_pct, "%.1f") + "</td><td>" + (c.accepted ? "yes" : "") +
          "</td></tr>\n";
   }
   h += "</table>\n<h2>How far: per run</h2><table><tr><th>run</th><th>set</th><th>nominal mm</th><th>re-fit mm</th><th>with effects mm</th></tr>\n";
   for (const auto& p : r.per_run)
-    h += "<tr><td>" + escape(p.name) + "</td><td>" + p.set + "</td><td>" + num(p.before_mm) + "</td><td>" + num(p.refit_mm) + "</td><td>" +
+    h += "<tr><td>" + escape_html(p.name) + "</td><td>" + p.set + "</td><td>" + num(p.before_mm) + "</td><td>" + num(p.refit_mm) + "</td><td>" +
          num(p.after_mm) + "</td></tr>\n";
-  h += "</table>\n<p>Final model: " + escape(d.final_model.effects.describe()) + ". Noise floor " + num(d.noise_floor_mm) +
+  h += "</table>\n<p>Final model: " + escape_html(d.final_model.effects.describe()) + ". Noise floor " + num(d.noise_floor_mm) +
        " mm (sensor noise " + num(d.noise_std_mm) + " mm).</p>\n</body></html>\n";
   return h;
 }
 
-}  // namespace epa::app
+}  // namespace epa::report

@@ -1,15 +1,15 @@
-#include "app/identify_report.hpp"
+#include "report/identify_report.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
 
-#include "app/svg_chart.hpp"
 #include "core/format.hpp"
 #include "core/paper_reference.hpp"
+#include "report/svg_chart.hpp"
 
-namespace epa::app {
+namespace epa::report {
 
 ModelFitSummary summarise_fit(const ident::HammersteinFit& fit, const std::vector<ident::Segment>& est,
                               const std::vector<ident::Segment>& val, std::size_t first_sample) {
@@ -207,4 +207,4 @@ nlohmann::json stick_slip_json(const ident::StickSlipIdentification& r, bool val
           {"validation_simulation_pct", validated ? nlohmann::json(r.validation_pct) : nlohmann::json(nullptr)}};
 }
 
-}  // namespace epa::app
+}  // namespace epa::report

@@ -1,4 +1,4 @@
-#include "app/svg_chart.hpp"
+#include "report/svg_chart.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace epa::app {
+namespace epa::report {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -283,4 +283,4 @@ TEST(RenderSvg, PointsOutsideTheXLimitsAreClipped) {
 }
 
 }  // namespace
-}  // namespace epa::app
+}  // namespace epa::report

@@ -1,4 +1,4 @@
-#include "app/svg_chart.hpp"
+#include "report/svg_chart.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <tuple>
 #include <utility>
 
-namespace epa::app {
+namespace epa::report {
 
 namespace {
 
@@ -399,4 +399,4 @@ std::string render_svg(const std::string& title, const std::vector<Panel>& panel
   return out;
 }
 
-}  // namespace epa::app
+}  // namespace epa::report

@@ -1,4 +1,4 @@
-#include "app/effect_shapes.hpp"
+#include "report/effect_shapes.hpp"
 
 #include <algorithm>
 #include <initializer_list>
@@ -7,7 +7,7 @@
 #include "plant/effects.hpp"
 #include "plant/force_path.hpp"
 
-namespace epa::app {
+namespace epa::report {
 
 namespace {
 
@@ -114,4 +114,4 @@ std::vector<Panel> effect_shape_panels(const diag::Diagnosis& d) {
   return panels;
 }
 
-}  // namespace epa::app
+}  // namespace epa::report

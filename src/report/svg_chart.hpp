@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace epa::app {
+namespace epa::report {
 
 struct Series {
   std::string label;         // legend text; empty = no legend entry
@@ -48,4 +48,4 @@ struct PlotRect {
 PlotRect plot_rect(int index, int columns, int panel_count, int panel_width = 560,
                    int panel_height = 300);
 
-}  // namespace epa::app
+}  // namespace epa::report

@@ -3,7 +3,7 @@
 #include "control/controller_kind.hpp"
 #include "sim/closed_loop.hpp"
 
-namespace epa::app {
+namespace epa::report {
 
 struct SimulationCase {
   control::ControllerKind kind;
@@ -11,4 +11,4 @@ struct SimulationCase {
   sim::StepRun result;
 };
 
-}  // namespace epa::app
+}  // namespace epa::report

@@ -6,8 +6,8 @@
 
 #include "commission/commission_sequence.hpp"
 
-namespace epa::app {
+namespace epa::report {
 
 std::string commission_report_html(const commission::CommissionOutcome& outcome);
 
-}  // namespace epa::app
+}  // namespace epa::report

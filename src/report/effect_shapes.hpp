@@ -4,13 +4,13 @@
 // step response, the dead zone moved), not only its parameters.
 #include <vector>
 
-#include "app/svg_chart.hpp"
 #include "diag/selection.hpp"
+#include "report/svg_chart.hpp"
 
-namespace epa::app {
+namespace epa::report {
 
 // One panel per named effect that has a shape (sensor_quantization has none worth drawing),
 // from the diagnosis's final model against the nominal one.
 std::vector<Panel> effect_shape_panels(const diag::Diagnosis& diagnosis);
 
-}  // namespace epa::app
+}  // namespace epa::report

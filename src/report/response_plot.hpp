@@ -5,12 +5,12 @@
 #include <string>
 #include <vector>
 
-#include "app/simulation_case.hpp"
 #include "core/dead_zone.hpp"
+#include "report/simulation_case.hpp"
 
-namespace epa::app {
+namespace epa::report {
 
 std::string render_response_plot(const std::vector<SimulationCase>& cases, const core::DeadZone& dead_zone,
                                   double window_s, const std::string& title);
 
-}  // namespace epa::app
+}  // namespace epa::report

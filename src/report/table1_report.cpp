@@ -1,4 +1,4 @@
-#include "app/table1_report.hpp"
+#include "report/table1_report.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "core/paper_reference.hpp"
 
-namespace epa::app {
+namespace epa::report {
 
 namespace {
 
@@ -104,4 +104,4 @@ void print_table1_comparison(std::ostream& out, const std::vector<SimulationCase
          "reached 90 % of its final value or never settled; \"-\": not applicable (the piston never moved).\n";
 }
 
-}  // namespace epa::app
+}  // namespace epa::report
