@@ -56,6 +56,8 @@ class ModbusServer {
   struct Impl;
   explicit ModbusServer(std::unique_ptr<Impl> impl);
   void serve();
+  void answer_frames(std::size_t client, std::int64_t now_ns);
+  void publish_counts(std::int64_t now_ns);
 
   std::unique_ptr<Impl> impl_;
   int port_ = 0;
