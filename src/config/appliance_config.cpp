@@ -117,6 +117,8 @@ class TableReader {
     used_.insert(key);
     return table_ ? (*table_)[key].as_table() : nullptr;
   }
+  // The reader of the table `key` inside this one ([hal] -> [hal.sim]); its errors go where ours do.
+  TableReader section(const char* key) { return TableReader(subtable(key), key_path(key), file_, error_); }
   // Every key the reader asked for is a known one; the message lists them (core/toml_keys.hpp).
   void refuse_unknown_keys() {
     if (!table_ || error_) return;
@@ -197,9 +199,8 @@ core::Result<hal::AnalogReference> parse_aref(std::string_view s) {
   return core::invalid_argument("'" + std::string(s) + "' is not one of ground, common, diff, other");
 }
 
-void read_analog_point(TableReader& parent, const char* key, hal::AnalogPoint& p, const std::string& file,
-                       std::optional<core::Error>& error) {
-  TableReader t(parent.subtable(key), parent.key_path(key), file, error);
+void read_analog_point(TableReader& parent, const char* key, hal::AnalogPoint& p) {
+  TableReader t = parent.section(key);
   t.choice<hal::RegisterTable>("table", p.table, parse_table);
   t.integer("address", p.address, 0, hal::kMaxRegisterAddress);
   t.choice<hal::AnalogEncoding>("encoding", p.encoding, parse_encoding);
@@ -211,15 +212,237 @@ void read_analog_point(TableReader& parent, const char* key, hal::AnalogPoint& p
   t.refuse_unknown_keys();
 }
 
-void read_comedi_channel(TableReader& parent, const char* key, hal::ComediChannel& c, const std::string& file,
-                         std::optional<core::Error>& error) {
-  TableReader t(parent.subtable(key), parent.key_path(key), file, error);
+void read_comedi_channel(TableReader& parent, const char* key, hal::ComediChannel& c) {
+  TableReader t = parent.section(key);
   t.integer("subdevice", c.subdevice, -1, 255);
   t.integer("channel", c.channel, 0, 4095);
   t.number("range_min_v", c.range_min_v, closed(-100, 100, "V"));
   t.number("range_max_v", c.range_max_v, closed(-100, 100, "V"));
   t.choice<hal::AnalogReference>("aref", c.aref, parse_aref);
   t.refuse_unknown_keys();
+}
+
+// [startup] mode: the loop comes up stopped or running; manual and excite are entered by command.
+core::Result<runtime::Mode> start_mode(std::string_view v) {
+  auto m = runtime::parse_mode(v);
+  if (m && (*m == runtime::Mode::kStop || *m == runtime::Mode::kRun)) return m;
+  return core::invalid_argument("'" + std::string(v) + "' is not a start mode: stop or run (manual and excite are entered by command)");
+}
+
+// [modbus] unlock_key: "" never unlocks.
+core::Result<std::optional<std::uint64_t>> unlock_key(std::string_view v) {
+  if (v.empty()) return std::optional<std::uint64_t>{};
+  auto key = modbus::parse_unlock_key(v);
+  if (!key) return key.error();
+  return std::optional<std::uint64_t>{*key};
+}
+
+core::Result<std::string> sim_plant(std::string_view v) {
+  if (v == "hammerstein" || v == "physics") return std::string(v);
+  return core::invalid_argument("'" + std::string(v) + "' is not hammerstein or physics");
+}
+
+// One function per section of the file: its keys, their bounds, and no key it does not know.
+
+void read_loop(TableReader& top, ApplianceConfig& c) {
+  TableReader loop = top.section("loop");
+  loop.number("period_s", c.runtime.period_s, closed(0.0001, 1.0, "s"));
+  loop.integer("realtime_priority", c.realtime.fifo_priority, 0, 99);
+  loop.boolean("lock_memory", c.realtime.lock_memory);
+  loop.integer("cpu_dma_latency_us", c.realtime.cpu_dma_latency_us, -1, 100000);
+  loop.integer("max_consecutive_overruns", c.runtime.max_consecutive_overruns, 1, 1000000);
+  loop.refuse_unknown_keys();
+}
+
+void read_controller(TableReader& top, ApplianceConfig& c) {
+  TableReader ctl = top.section("controller");
+  ctl.choice<control::ControllerKind>("kind", c.runtime.controller, control::parse_controller_kind);
+  ctl.text("model", c.model_path);
+  ctl.text("design", c.design_path);
+  ctl.number("lc_mm", c.lc_mm, closed(0, 100, "mm"));
+  ctl.number("valve_limit_v", c.valve_limit_v, closed(0.1, 10, "V"));
+  ctl.refuse_unknown_keys();
+}
+
+void read_limits(TableReader& top, ApplianceConfig& c) {
+  auto& r = c.runtime;
+  TableReader lim = top.section("limits");
+  lim.number("sensor_min_v", r.sensor_min_v, closed(-100, 100, "V"));
+  lim.number("sensor_max_v", r.sensor_max_v, closed(-100, 100, "V"));
+  lim.number("soft_min_mm", r.soft_min_mm, closed(-10000, 10000, "mm"));
+  lim.number("soft_max_mm", r.soft_max_mm, closed(-10000, 10000, "mm"));
+  lim.number("setpoint_min_mm", r.setpoint_min_mm, closed(-10000, 10000, "mm"));
+  lim.number("setpoint_max_mm", r.setpoint_max_mm, closed(-10000, 10000, "mm"));
+  lim.number("manual_valve_limit_v", r.manual_valve_limit_v, closed(0.1, 10, "V"));
+  lim.number("safe_valve_v", r.safe_valve_v, closed(-10, 10, "V"));
+  lim.number("following_error_mm", r.following_error_mm, closed(0.5, 10000, "mm"));
+  lim.number("following_error_time_s", r.following_error_time_s, zero_or(0.01, 3600, "s"));
+  lim.integer("max_consecutive_io_errors", r.max_consecutive_io_errors, 1, 1000000);
+  lim.number("heartbeat_timeout_s", r.heartbeat_timeout_s, zero_or(0.05, 3600, "s"));
+  lim.number("sensor_frozen_time_s", r.sensor_frozen_time_s, zero_or(0.05, 3600, "s"));
+  lim.number("sensor_frozen_drive_v", r.sensor_frozen_drive_v, closed(0.1, 10, "V"));
+  lim.refuse_unknown_keys();
+}
+
+void read_calibration(TableReader& top, ApplianceConfig& c) {
+  TableReader cal = top.section("calibration");
+  cal.number("sensor_offset_v", c.runtime.sensor_offset_v, closed(-100, 100, "V"));
+  cal.number("sensor_gain", c.runtime.sensor_gain, closed(0.1, 10, "(model volts per sensor volt)"));
+  cal.refuse_unknown_keys();
+}
+
+void read_startup(TableReader& top, ApplianceConfig& c) {
+  TableReader start = top.section("startup");
+  start.choice<runtime::Mode>("mode", c.runtime.start_mode, start_mode);
+  start.number("setpoint_mm", c.runtime.start_setpoint_mm, closed(-10000, 10000, "mm"));
+  start.refuse_unknown_keys();
+}
+
+void read_recorder(TableReader& top, ApplianceConfig& c) {
+  TableReader rec = top.section("recorder");
+  rec.text("directory", c.record_directory);
+  rec.boolean("per_move", c.record_per_move);
+  rec.number("buffer_s", c.runtime.record_buffer_s, closed(1, 600, "s"));
+  rec.number("move_window_s", c.runtime.move_window_s, closed(0.1, 600, "s"));
+  rec.number("min_interval_s", c.runtime.record_min_interval_s, closed(0.1, 3600, "s"));
+  rec.number("quota_mb", c.record_quota_mb, closed(0.01, 1e7, "MiB"));  // tiny: only the newest file kept
+  rec.number("move_files_per_minute", c.record_move_files_per_minute, closed(1, 12000, "files a minute"));
+  rec.refuse_unknown_keys();
+}
+
+void read_motion(TableReader& top, ApplianceConfig& c) {
+  auto& r = c.runtime;
+  TableReader mo = top.section("motion");
+  mo.number("in_position_window_mm", r.in_position_window_mm, closed(0.01, 100, "mm"));
+  mo.number("in_position_time_s", r.in_position_time_s, closed(0, 60, "s"));
+  mo.number("standstill_time_s", r.standstill_time_s, closed(0.05, 60, "s"));
+  mo.number("halt_decel_mm_s2", r.halt_decel_mm_s2, closed(100, 1e6, "mm/s^2"));
+  mo.number("jog_speed_mm_s", r.jog_speed_mm_s, closed(0.1, 10000, "mm/s"));
+  mo.number("jog_accel_mm_s2", r.jog_accel_mm_s2, closed(100, 1e6, "mm/s^2"));
+  mo.number("jog_keepalive_s", r.jog_keepalive_s, zero_or(0.05, 3600, "s"));
+  mo.boolean("enable_holds_position", r.enable_holds_position);
+  mo.refuse_unknown_keys();
+}
+
+void read_excite(TableReader& top, ApplianceConfig& c) {
+  auto& x = c.runtime.excitation;
+  TableReader ex = top.section("excite");
+  ex.integer("seed", x.seed, 0, 4294967295);
+  ex.number("amplitude_min_v", x.amplitude_min_v, closed(0.05, 10, "V"));
+  ex.number("amplitude_max_v", x.amplitude_max_v, closed(0.05, 10, "V"));
+  ex.number("duration_s", x.duration_s, closed(1, 600, "s"));
+  ex.number("guard_mm", x.guard_mm, closed(1, 10000, "mm"));
+  ex.boolean("sweep", x.sweep);
+  ex.refuse_unknown_keys();
+}
+
+void read_store(TableReader& top, ApplianceConfig& c) {
+  TableReader st = top.section("store");
+  st.text("path", c.store_path);
+  st.number("min_free_mb", c.store_min_free_mb, closed(1, 1e7, "MiB"));
+  st.integer("audit_max_rows", c.audit_max_rows, core::kAuditMinRows, std::int64_t{1'000'000'000});
+  st.refuse_unknown_keys();
+}
+
+void read_log(TableReader& top, ApplianceConfig& c) {
+  TableReader log = top.section("log");
+  log.number("status_interval_s", c.status_interval_s, zero_or(1, kDay_s, "s"));
+  log.refuse_unknown_keys();
+}
+
+void read_modbus(TableReader& top, ApplianceConfig& c) {
+  auto& m = c.modbus;
+  TableReader mbs = top.section("modbus");
+  mbs.boolean("enabled", c.modbus_enabled);
+  mbs.choice<std::string>("address", m.address, listen_address);
+  mbs.integer("port", m.port, 0, 65535);
+  mbs.integer("unit_id", m.unit_id, 0, 247);
+  mbs.integer_list("alias_unit_ids", m.alias_unit_ids, 0, 255);
+  mbs.integer("max_clients", m.max_clients, 1, 1000);
+  mbs.integer("max_clients_per_address", m.max_clients_per_address, 1, 1000);
+  mbs.number("idle_timeout_s", m.idle_timeout_s, closed(1, kDay_s, "s"));
+  mbs.number("frame_timeout_s", m.frame_timeout_s, closed(0.1, 60, "s"));
+  mbs.text("register_map", c.register_map_path);
+  mbs.boolean("read_only", m.policy.read_only);
+  mbs.choice<std::optional<std::uint64_t>>("unlock_key", m.policy.unlock_key, unlock_key);
+  mbs.number("unlock_timeout_s", m.policy.unlock_timeout_s, closed(1, kDay_s, "s"));
+  mbs.text_list("write_clients", m.policy.write_clients);
+  mbs.refuse_unknown_keys();
+}
+
+void read_web(TableReader& top, ApplianceConfig& c) {
+  TableReader web = top.section("web");
+  web.boolean("enabled", c.web_enabled);
+  web.choice<std::string>("address", c.web.address, listen_address);
+  web.integer("port", c.web.port, 0, 65535);
+  web.choice<std::string>("token", c.web.token, web_token);
+  web.text("static_dir", c.web.static_dir);
+  web.integer("max_connections_per_address", c.web.max_connections_per_address, 1, 4096);
+  web.text_list("host_names", c.web.host_names);
+  web.refuse_unknown_keys();
+}
+
+void read_hal_sim(TableReader& hal, ApplianceConfig& c) {
+  TableReader sim = hal.section("sim");
+  sim.number("initial_position_mm", c.sim.initial_position_mm, closed(-10000, 10000, "mm"));
+  sim.number("noise_mm", c.sim.noise_std_mm, closed(0, 100, "mm"));
+  int seed = static_cast<int>(c.sim.seed);
+  sim.integer("seed", seed, 0, 2147483647);
+  c.sim.seed = static_cast<std::uint64_t>(seed);
+  sim.choice<std::string>("plant", c.sim_plant, sim_plant);
+  sim.text("physics_config", c.physics_config);
+  sim.integer("sensor_bits", c.sim_sensor_bits, 0, 24);
+  sim.number("initial_pressure_bar", c.sim_initial_pressure_bar, closed(0, 100, "bar"));
+  sim.text_list("effects", c.sim_effects);
+  sim.refuse_unknown_keys();
+}
+
+void read_hal_modbus_io(TableReader& hal, ApplianceConfig& c) {
+  TableReader mb = hal.section("modbus_io");
+  mb.choice<std::string>("host", c.modbus_io.host, module_host);
+  mb.integer("port", c.modbus_io.port, 1, 65535);
+  mb.integer("unit_id", c.modbus_io.unit_id, 0, 247);
+  mb.integer("response_timeout_ms", c.modbus_io.response_timeout_ms, 1, 1000);
+  read_analog_point(mb, "sensor", c.modbus_io.layout.sensor);
+  read_analog_point(mb, "valve", c.modbus_io.layout.valve);
+  mb.refuse_unknown_keys();
+}
+
+void read_hal_comedi(TableReader& hal, ApplianceConfig& c) {
+  TableReader cm = hal.section("comedi");
+  cm.text("device", c.comedi.device);
+  read_comedi_channel(cm, "sensor", c.comedi.sensor);
+  read_comedi_channel(cm, "valve", c.comedi.valve);
+  cm.refuse_unknown_keys();
+}
+
+void read_hal(TableReader& top, ApplianceConfig& c) {
+  TableReader hal = top.section("hal");
+  hal.choice<HalBackend>("backend", c.backend, parse_backend);
+  read_hal_sim(hal, c);
+  read_hal_modbus_io(hal, c);
+  read_hal_comedi(hal, c);
+  hal.refuse_unknown_keys();
+}
+
+// Rules across keys and sections, in the runtime's and backends' own validators; write_clients
+// are rewritten into the form a peer's address is compared in.
+core::Status check_across_sections(ApplianceConfig& c, const std::string& file) {
+  if (!c.sim_effects.empty()) {
+    if (c.sim_plant != "hammerstein") return core::invalid_argument(file + ": [hal.sim] effects apply to the hammerstein plant only");
+    if (auto e = plant::parse_effect_specs(c.sim_effects); !e) return core::invalid_argument(file + ": [hal.sim] effects: " + e.error().message);
+  }
+  for (std::string& client : c.modbus.policy.write_clients) {
+    auto ip = core::parse_ip_address(client, 0);
+    if (!ip) return core::invalid_argument(file + ": [modbus] write_clients: " + ip.error().message);
+    client = core::ip_text(ip->storage);  // ::0:1 is ::1
+  }
+  if (auto s = runtime::validate(c.runtime); !s) return core::invalid_argument(file + ": " + s.error().message);
+  if (c.backend == HalBackend::kModbusIo)
+    if (auto s = hal::validate(c.modbus_io); !s) return core::invalid_argument(file + ": [hal.modbus_io] " + s.error().message);
+  if (c.backend == HalBackend::kComedi)
+    if (auto s = hal::validate(c.comedi); !s) return core::invalid_argument(file + ": [hal.comedi] " + s.error().message);
+  return core::ok();
 }
 
 }  // namespace
@@ -246,181 +469,26 @@ std::string any_address_notice(const ApplianceConfig& c) {
 core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, const std::string& file) {
   auto document = core::parse_toml(text, file);
   if (!document) return document.error();
-  const toml::table& root = *document;
   ApplianceConfig c;
-  auto& r = c.runtime;
   std::optional<core::Error> error;
-  TableReader top(&root, "", file, error);
-
-  TableReader loop(top.subtable("loop"), "loop", file, error);
-  loop.number("period_s", r.period_s, closed(0.0001, 1.0, "s"));
-  loop.integer("realtime_priority", c.realtime.fifo_priority, 0, 99);
-  loop.boolean("lock_memory", c.realtime.lock_memory);
-  loop.integer("cpu_dma_latency_us", c.realtime.cpu_dma_latency_us, -1, 100000);
-  loop.integer("max_consecutive_overruns", r.max_consecutive_overruns, 1, 1000000);
-  loop.refuse_unknown_keys();
-
-  TableReader ctl(top.subtable("controller"), "controller", file, error);
-  ctl.choice<control::ControllerKind>("kind", r.controller, control::parse_controller_kind);
-  ctl.text("model", c.model_path);
-  ctl.text("design", c.design_path);
-  ctl.number("lc_mm", c.lc_mm, closed(0, 100, "mm"));
-  ctl.number("valve_limit_v", c.valve_limit_v, closed(0.1, 10, "V"));
-  ctl.refuse_unknown_keys();
-
-  TableReader lim(top.subtable("limits"), "limits", file, error);
-  lim.number("sensor_min_v", r.sensor_min_v, closed(-100, 100, "V"));
-  lim.number("sensor_max_v", r.sensor_max_v, closed(-100, 100, "V"));
-  lim.number("soft_min_mm", r.soft_min_mm, closed(-10000, 10000, "mm"));
-  lim.number("soft_max_mm", r.soft_max_mm, closed(-10000, 10000, "mm"));
-  lim.number("setpoint_min_mm", r.setpoint_min_mm, closed(-10000, 10000, "mm"));
-  lim.number("setpoint_max_mm", r.setpoint_max_mm, closed(-10000, 10000, "mm"));
-  lim.number("manual_valve_limit_v", r.manual_valve_limit_v, closed(0.1, 10, "V"));
-  lim.number("safe_valve_v", r.safe_valve_v, closed(-10, 10, "V"));
-  lim.number("following_error_mm", r.following_error_mm, closed(0.5, 10000, "mm"));
-  lim.number("following_error_time_s", r.following_error_time_s, zero_or(0.01, 3600, "s"));
-  lim.integer("max_consecutive_io_errors", r.max_consecutive_io_errors, 1, 1000000);
-  lim.number("heartbeat_timeout_s", r.heartbeat_timeout_s, zero_or(0.05, 3600, "s"));
-  lim.number("sensor_frozen_time_s", r.sensor_frozen_time_s, zero_or(0.05, 3600, "s"));
-  lim.number("sensor_frozen_drive_v", r.sensor_frozen_drive_v, closed(0.1, 10, "V"));
-  lim.refuse_unknown_keys();
-
-  TableReader cal(top.subtable("calibration"), "calibration", file, error);
-  cal.number("sensor_offset_v", r.sensor_offset_v, closed(-100, 100, "V"));
-  cal.number("sensor_gain", r.sensor_gain, closed(0.1, 10, "(model volts per sensor volt)"));
-  cal.refuse_unknown_keys();
-
-  TableReader start(top.subtable("startup"), "startup", file, error);
-  start.choice<runtime::Mode>("mode", r.start_mode, [](std::string_view v) -> core::Result<runtime::Mode> {
-    auto m = runtime::parse_mode(v);
-    if (m && (*m == runtime::Mode::kStop || *m == runtime::Mode::kRun)) return m;
-    return core::invalid_argument("'" + std::string(v) + "' is not a start mode: stop or run (manual and excite are entered by command)");
-  });
-  start.number("setpoint_mm", r.start_setpoint_mm, closed(-10000, 10000, "mm"));
-  start.refuse_unknown_keys();
-
-  TableReader rec(top.subtable("recorder"), "recorder", file, error);
-  rec.text("directory", c.record_directory);
-  rec.boolean("per_move", c.record_per_move);
-  rec.number("buffer_s", r.record_buffer_s, closed(1, 600, "s"));
-  rec.number("move_window_s", r.move_window_s, closed(0.1, 600, "s"));
-  rec.number("min_interval_s", r.record_min_interval_s, closed(0.1, 3600, "s"));
-  rec.number("quota_mb", c.record_quota_mb, closed(0.01, 1e7, "MiB"));  // tiny: only the newest file kept
-  rec.number("move_files_per_minute", c.record_move_files_per_minute, closed(1, 12000, "files a minute"));
-  rec.refuse_unknown_keys();
-
-  TableReader mo(top.subtable("motion"), "motion", file, error);
-  mo.number("in_position_window_mm", r.in_position_window_mm, closed(0.01, 100, "mm"));
-  mo.number("in_position_time_s", r.in_position_time_s, closed(0, 60, "s"));
-  mo.number("standstill_time_s", r.standstill_time_s, closed(0.05, 60, "s"));
-  mo.number("halt_decel_mm_s2", r.halt_decel_mm_s2, closed(100, 1e6, "mm/s^2"));
-  mo.number("jog_speed_mm_s", r.jog_speed_mm_s, closed(0.1, 10000, "mm/s"));
-  mo.number("jog_accel_mm_s2", r.jog_accel_mm_s2, closed(100, 1e6, "mm/s^2"));
-  mo.number("jog_keepalive_s", r.jog_keepalive_s, zero_or(0.05, 3600, "s"));
-  mo.boolean("enable_holds_position", r.enable_holds_position);
-  mo.refuse_unknown_keys();
-
-  TableReader ex(top.subtable("excite"), "excite", file, error);
-  ex.integer("seed", r.excitation.seed, 0, 4294967295);
-  ex.number("amplitude_min_v", r.excitation.amplitude_min_v, closed(0.05, 10, "V"));
-  ex.number("amplitude_max_v", r.excitation.amplitude_max_v, closed(0.05, 10, "V"));
-  ex.number("duration_s", r.excitation.duration_s, closed(1, 600, "s"));
-  ex.number("guard_mm", r.excitation.guard_mm, closed(1, 10000, "mm"));
-  ex.boolean("sweep", r.excitation.sweep);
-  ex.refuse_unknown_keys();
-
-  TableReader st(top.subtable("store"), "store", file, error);
-  st.text("path", c.store_path);
-  st.number("min_free_mb", c.store_min_free_mb, closed(1, 1e7, "MiB"));
-  st.integer("audit_max_rows", c.audit_max_rows, core::kAuditMinRows, std::int64_t{1'000'000'000});
-  st.refuse_unknown_keys();
-
-  TableReader log(top.subtable("log"), "log", file, error);
-  log.number("status_interval_s", c.status_interval_s, zero_or(1, kDay_s, "s"));
-  log.refuse_unknown_keys();
-
-  TableReader mbs(top.subtable("modbus"), "modbus", file, error);
-  mbs.boolean("enabled", c.modbus_enabled);
-  mbs.choice<std::string>("address", c.modbus.address, listen_address);
-  mbs.integer("port", c.modbus.port, 0, 65535);
-  mbs.integer("unit_id", c.modbus.unit_id, 0, 247);
-  mbs.integer_list("alias_unit_ids", c.modbus.alias_unit_ids, 0, 255);
-  mbs.integer("max_clients", c.modbus.max_clients, 1, 1000);
-  mbs.integer("max_clients_per_address", c.modbus.max_clients_per_address, 1, 1000);
-  mbs.number("idle_timeout_s", c.modbus.idle_timeout_s, closed(1, kDay_s, "s"));
-  mbs.number("frame_timeout_s", c.modbus.frame_timeout_s, closed(0.1, 60, "s"));
-  mbs.text("register_map", c.register_map_path);
-  mbs.boolean("read_only", c.modbus.policy.read_only);
-  mbs.choice<std::optional<std::uint64_t>>("unlock_key", c.modbus.policy.unlock_key,
-                                            [](std::string_view v) -> core::Result<std::optional<std::uint64_t>> {
-                                              if (v.empty()) return std::optional<std::uint64_t>{};  // never unlocks
-                                              auto key = modbus::parse_unlock_key(v);
-                                              if (!key) return key.error();
-                                              return std::optional<std::uint64_t>{*key};
-                                            });
-  mbs.number("unlock_timeout_s", c.modbus.policy.unlock_timeout_s, closed(1, kDay_s, "s"));
-  mbs.text_list("write_clients", c.modbus.policy.write_clients);
-  mbs.refuse_unknown_keys();
-
-  TableReader web(top.subtable("web"), "web", file, error);
-  web.boolean("enabled", c.web_enabled);
-  web.choice<std::string>("address", c.web.address, listen_address);
-  web.integer("port", c.web.port, 0, 65535);
-  web.choice<std::string>("token", c.web.token, web_token);
-  web.text("static_dir", c.web.static_dir);
-  web.integer("max_connections_per_address", c.web.max_connections_per_address, 1, 4096);
-  web.text_list("host_names", c.web.host_names);
-  web.refuse_unknown_keys();
-
-  TableReader hal_table(top.subtable("hal"), "hal", file, error);
-  hal_table.choice<HalBackend>("backend", c.backend, parse_backend);
-  TableReader sim(hal_table.subtable("sim"), "hal.sim", file, error);
-  sim.number("initial_position_mm", c.sim.initial_position_mm, closed(-10000, 10000, "mm"));
-  sim.number("noise_mm", c.sim.noise_std_mm, closed(0, 100, "mm"));
-  int seed = static_cast<int>(c.sim.seed);
-  sim.integer("seed", seed, 0, 2147483647);
-  c.sim.seed = static_cast<std::uint64_t>(seed);
-  sim.choice<std::string>("plant", c.sim_plant, [](std::string_view v) -> core::Result<std::string> {
-    if (v == "hammerstein" || v == "physics") return std::string(v);
-    return core::invalid_argument("'" + std::string(v) + "' is not hammerstein or physics");
-  });
-  sim.text("physics_config", c.physics_config);
-  sim.integer("sensor_bits", c.sim_sensor_bits, 0, 24);
-  sim.number("initial_pressure_bar", c.sim_initial_pressure_bar, closed(0, 100, "bar"));
-  sim.text_list("effects", c.sim_effects);
-  sim.refuse_unknown_keys();
-  TableReader mb(hal_table.subtable("modbus_io"), "hal.modbus_io", file, error);
-  mb.choice<std::string>("host", c.modbus_io.host, module_host);
-  mb.integer("port", c.modbus_io.port, 1, 65535);
-  mb.integer("unit_id", c.modbus_io.unit_id, 0, 247);
-  mb.integer("response_timeout_ms", c.modbus_io.response_timeout_ms, 1, 1000);
-  read_analog_point(mb, "sensor", c.modbus_io.layout.sensor, file, error);
-  read_analog_point(mb, "valve", c.modbus_io.layout.valve, file, error);
-  mb.refuse_unknown_keys();
-  TableReader cm(hal_table.subtable("comedi"), "hal.comedi", file, error);
-  cm.text("device", c.comedi.device);
-  read_comedi_channel(cm, "sensor", c.comedi.sensor, file, error);
-  read_comedi_channel(cm, "valve", c.comedi.valve, file, error);
-  cm.refuse_unknown_keys();
-  hal_table.refuse_unknown_keys();
+  // In the file's order of concerns; the first error wins, so the order is the order of the messages.
+  TableReader top(&*document, "", file, error);
+  read_loop(top, c);
+  read_controller(top, c);
+  read_limits(top, c);
+  read_calibration(top, c);
+  read_startup(top, c);
+  read_recorder(top, c);
+  read_motion(top, c);
+  read_excite(top, c);
+  read_store(top, c);
+  read_log(top, c);
+  read_modbus(top, c);
+  read_web(top, c);
+  read_hal(top, c);
   top.refuse_unknown_keys();
   if (error) return *error;
-
-  // Cross-field rules, in the runtime's and backends' own validators.
-  if (!c.sim_effects.empty()) {
-    if (c.sim_plant != "hammerstein") return core::invalid_argument(file + ": [hal.sim] effects apply to the hammerstein plant only");
-    if (auto e = plant::parse_effect_specs(c.sim_effects); !e) return core::invalid_argument(file + ": [hal.sim] effects: " + e.error().message);
-  }
-  for (std::string& client : c.modbus.policy.write_clients) {
-    auto ip = core::parse_ip_address(client, 0);
-    if (!ip) return core::invalid_argument(file + ": [modbus] write_clients: " + ip.error().message);
-    client = core::ip_text(ip->storage);  // the form a peer's address is compared in: ::0:1 is ::1
-  }
-  if (auto s = runtime::validate(r); !s) return core::invalid_argument(file + ": " + s.error().message);
-  if (c.backend == HalBackend::kModbusIo)
-    if (auto s = hal::validate(c.modbus_io); !s) return core::invalid_argument(file + ": [hal.modbus_io] " + s.error().message);
-  if (c.backend == HalBackend::kComedi)
-    if (auto s = hal::validate(c.comedi); !s) return core::invalid_argument(file + ": [hal.comedi] " + s.error().message);
+  if (auto s = check_across_sections(c, file); !s) return s.error();
   return c;
 }
 
