@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "app/output_file.hpp"
-#include "app/store_save.hpp"
-#include "app/tuning_source.hpp"
+#include "appliance/store_save.hpp"
+#include "appliance/tuning_source.hpp"
 #include "control/branch_stability.hpp"
 #include "control/diophantine.hpp"
 #include "control/pole_placement_design.hpp"
@@ -94,7 +94,7 @@ void explain_conditioning(std::ostream& out, double cond, int decimals, const Po
 }  // namespace
 
 int run_design(const DesignOptions& o, std::ostream& out, std::ostream& err) {
-  auto model_file = load_model(o.model_path);
+  auto model_file = appliance::load_model(o.model_path);
   if (!model_file) return err << "epa design: " << model_file.error().message << "\n", 1;
   const core::HammersteinModel& m = model_file->model;
   const bool paper_model = o.model_path.empty();
@@ -120,7 +120,7 @@ int run_design(const DesignOptions& o, std::ostream& out, std::ostream& err) {
     cond = d->condition_number;
     solved = true;
   } else {
-    auto p = load_controller_polynomials(o.design_path);
+    auto p = appliance::load_controller_polynomials(o.design_path);
     if (!p) return err << "epa design: " << p.error().message << "\n", 1;
     F = p->F;
     G = p->G;
@@ -212,7 +212,7 @@ int run_design(const DesignOptions& o, std::ostream& out, std::ostream& err) {
     if (set.trajectory.coast_s > 0.0)
       out << "pp-traj in this set arrives while sliding (the model file's axis_model is stick-slip): coast "
           << core::format_number(1e3 * set.trajectory.coast_s) << " ms at " << set.trajectory.approach_speed_mm_s << " mm/s\n";
-    auto id = save_tuning_set(o.db_path, model, set);
+    auto id = appliance::save_tuning_set(o.db_path, model, set);
     if (!id) return err << "epa design: --save: " << id.error().message << "\n", 1;
     out << "saved as tuning set '" << o.save_name << "' (id " << *id << ") in " << o.db_path
         << "; epa tuning activate " << *id << " makes it active\n";

@@ -6,7 +6,7 @@
 
 #include "app/cli_checks.hpp"
 #include "app/output_file.hpp"
-#include "app/tuning_source.hpp"
+#include "appliance/tuning_source.hpp"
 #include "core/format.hpp"
 #include "core/run_file.hpp"
 #include "ident/excitation.hpp"
@@ -101,7 +101,7 @@ core::Result<ExcitedRun> excite_physics(const ExciteOptions& o, ident::Excitatio
 }
 
 core::Result<ExcitedRun> excite_model(const ExciteOptions& o, const ident::ExcitationOptions& eo) {
-  auto model_file = load_model(o.model_path);
+  auto model_file = appliance::load_model(o.model_path);
   if (!model_file) return model_file.error();
   ExcitedRun r;
   r.source = model_file->source;

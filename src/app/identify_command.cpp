@@ -7,7 +7,7 @@
 
 #include "app/cli_checks.hpp"
 #include "app/output_file.hpp"
-#include "app/store_save.hpp"
+#include "appliance/store_save.hpp"
 #include "core/format.hpp"
 #include "core/model_file.hpp"
 #include "core/paper_reference.hpp"
@@ -252,7 +252,7 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
                                          : nlohmann::json(nullptr)},
         {"pso_seed", o.seed}, {"criterion", o.criterion},
         {"stick_slip", stick_slip ? report::stick_slip_json(*stick_slip, summary.validated) : nlohmann::json(nullptr)}};
-    auto id = save_model(o.db_path, {.id = 0, .name = o.save_name, .created_ms = 0, .source = source, .model = model,
+    auto id = appliance::save_model(o.db_path, {.id = 0, .name = o.save_name, .created_ms = 0, .source = source, .model = model,
                                      .fit_json = fit_json.dump()});
     if (!id) return fail("--save: " + id.error().message);
     out << "model saved as '" << o.save_name << "' (id " << *id << ") in " << o.db_path << "\n";

@@ -10,9 +10,9 @@
 #include <ostream>
 
 #include "app/cli_checks.hpp"
-#include "app/daq_factory.hpp"
+#include "appliance/daq_factory.hpp"
 #include "app/module_fault_control.hpp"
-#include "app/tuning_source.hpp"
+#include "appliance/tuning_source.hpp"
 #include "core/format.hpp"
 #include "plant/plant_adapter.hpp"
 #include "rig/remote_io_simulator.hpp"
@@ -93,7 +93,7 @@ class BlockedStopSignals {
 }  // namespace
 
 int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostream& err) {
-  auto model_file = load_model(o.model_path);
+  auto model_file = appliance::load_model(o.model_path);
   if (!model_file) return err << "epa plant-server: " << model_file.error().message << "\n", 1;
   rig::RemoteIoSimulatorConfig config;
   config.address = o.address;
@@ -114,7 +114,7 @@ int run_plant_server(const PlantServerOptions& o, std::ostream& out, std::ostrea
   if (o.plant == "physics" && !o.effects.empty())
     return err << "epa plant-server: --effect applies to the hammerstein plant only\n", 1;
   if (o.plant == "physics") {
-    auto plant = make_physics_plant(o.physics_config, {.initial_position_mm = o.initial_position_mm, .initial_pressure_bar = 3.0,
+    auto plant = appliance::make_physics_plant(o.physics_config, {.initial_position_mm = o.initial_position_mm, .initial_pressure_bar = 3.0,
                                                         .noise_std_mm = o.noise_mm, .seed = o.seed,
                                                         .sensor_bits = o.sensor_bits, .Ts = config.model.Ts});
     if (!plant) return err << "epa plant-server: " << plant.error().message << "\n", 1;

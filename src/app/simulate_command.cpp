@@ -7,7 +7,7 @@
 
 #include "app/cli_checks.hpp"
 #include "app/output_file.hpp"
-#include "app/tuning_source.hpp"
+#include "appliance/tuning_source.hpp"
 #include "control/controller.hpp"
 #include "core/format.hpp"
 #include "core/paper_reference.hpp"
@@ -63,11 +63,11 @@ nlohmann::json optional_json(std::optional<double> v) { return v ? nlohmann::jso
 }  // namespace
 
 int run_simulate(const SimulateOptions& o, std::ostream& out, std::ostream& err) {
-  auto model_file = load_model(o.model_path);
+  auto model_file = appliance::load_model(o.model_path);
   if (!model_file) return err << "epa simulate: " << model_file.error().message << "\n", 1;
   core::HammersteinModel model = model_file->model;
   if (o.Ts > 0.0) model.Ts = o.Ts;
-  auto polynomials = load_controller_polynomials(o.design_path);
+  auto polynomials = appliance::load_controller_polynomials(o.design_path);
   if (!polynomials) return err << "epa simulate: " << polynomials.error().message << "\n", 1;
 
   std::vector<control::ControllerKind> kinds;

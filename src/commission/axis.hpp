@@ -1,6 +1,6 @@
 #pragma once
 // What the commissioning sequence needs of the axis it commissions: the appliance's loop, store
-// and recorder behind one interface (app/appliance_axis.*), or a simulated axis in the tests.
+// and recorder behind one interface (appliance/commissioning_axis.*), or a simulated axis in the tests.
 // Every call blocks until it is done or `abort` is set; none of them runs on the scan cycle.
 #include <atomic>
 #include <cstdint>

@@ -1,5 +1,5 @@
 #pragma once
-// The appliance's commissioning service as the interfaces see it (app/commission_service.*
+// The appliance's commissioning service as the interfaces see it (appliance/commissioning_service.*
 // implements it): Modbus starts and aborts it through the write gate's commission_command point
 // and reads its state points; the status page starts it with a spec and shows its progress.
 #include <cstdint>

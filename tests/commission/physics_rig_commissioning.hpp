@@ -8,7 +8,7 @@
 // the real appliance identifies on that rig). About 5 s a run; no real time.
 #include <atomic>
 
-#include "app/commission_identify.hpp"
+#include "app/commissioning_identification.hpp"
 #include "commission/commission_sequence.hpp"
 #include "commission/commission_spec.hpp"
 #include "core/paper_reference.hpp"

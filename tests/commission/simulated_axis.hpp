@@ -1,7 +1,7 @@
 #pragma once
 // Simulated axes for the commissioning tests: a plant stepped in the calling thread (no real time),
 // tuning sets kept in memory, every switch recorded for the assertions. The experiment runs as the
-// appliance's EXCITE mode does (app/appliance_axis.cpp, runtime/excitation_run.cpp): a piston
+// appliance's EXCITE mode does (appliance/commissioning_axis.cpp, runtime/excitation_run.cpp): a piston
 // outside the guard lines is first moved to the middle with the set that runs and held 3 s; the
 // generator's defaults over the soft limits' span (-2..502 mm), 100 mm guards.
 #include <algorithm>

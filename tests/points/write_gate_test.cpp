@@ -179,7 +179,7 @@ TEST(WriteGate, CommissionCommandIsUnlockProtectedWrittenAloneAndGoesToTheServic
   ASSERT_TRUE(gate.submit({&abort, 1}, kOperator).accepted());
   EXPECT_EQ(gate.submit({&abort, 1}, kOperator).refusal, Refusal::kConflict);  // nothing to abort
   // The service audits a start and an abort, each under its own source, for every interface
-  // (app/commission_service.cpp); the gate adds no second entry.
+  // (appliance/commissioning_service.cpp); the gate adds no second entry.
   EXPECT_TRUE(sink.entries.empty());
 }
 

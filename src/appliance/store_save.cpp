@@ -1,4 +1,4 @@
-#include "app/store_save.hpp"
+#include "appliance/store_save.hpp"
 
 #include <cmath>
 
@@ -8,7 +8,7 @@
 #include "store/transaction.hpp"
 #include "store/tuning_set_table.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
 core::Result<std::int64_t> save_model(const std::string& db_path, store::ModelRecord model) {
   auto db = store::open_existing_store(db_path);
@@ -42,4 +42,4 @@ core::Result<std::int64_t> save_tuning_set(const std::string& db_path, store::Mo
   return id;
 }
 
-}  // namespace epa::app
+}  // namespace epa::appliance

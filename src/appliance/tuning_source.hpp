@@ -7,7 +7,7 @@
 #include "core/polynomial.hpp"
 #include "core/result.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
 struct ControllerPolynomials {
   core::Polynomial F, G, H;
@@ -20,4 +20,4 @@ core::Result<core::ModelFile> load_model(const std::string& path);
 // The paper's F, G (eq 12-13, H = G) when path is empty, else F, G, H of an epa-design/1 file.
 core::Result<ControllerPolynomials> load_controller_polynomials(const std::string& design_json_path);
 
-}  // namespace epa::app
+}  // namespace epa::appliance

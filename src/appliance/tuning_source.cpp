@@ -1,4 +1,4 @@
-#include "app/tuning_source.hpp"
+#include "appliance/tuning_source.hpp"
 
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -8,7 +8,7 @@
 #include "core/strict_json.hpp"
 #include "core/text_file.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
 core::Result<core::ModelFile> load_model(const std::string& path) {
   if (path.empty()) return core::ModelFile{core::paper::model(), "paper eq 9-10"};
@@ -43,4 +43,4 @@ core::Result<ControllerPolynomials> load_controller_polynomials(const std::strin
   return p;
 }
 
-}  // namespace epa::app
+}  // namespace epa::appliance

@@ -15,22 +15,24 @@
 #include "commission/commission_spec.hpp"
 #include "web/commission_port.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
-class CommissionService final : public web::CommissionPort {
+class CommissioningService final : public web::CommissionPort {
  public:
   using Log = std::function<void(const std::string&)>;
   // The axis for a run started by `source` (its commands are audited as coming from it).
   using AxisFactory = std::function<std::unique_ptr<commission::Axis>(const std::string& source)>;
+  // The HTML report of an outcome: drawn by the caller's report writer, so this service knows no charts.
+  using RenderReport = std::function<std::string(const commission::CommissionOutcome&)>;
 
   // `bounds`: what this appliance can run; a spec beyond them is refused before the axis is touched.
   // `audit`: where a start and an abort are audited, each under the source that asked for it,
   // whichever interface it came through.
-  CommissionService(AxisFactory make_axis, commission::Identify identify, commission::ApplianceBounds bounds, Log log,
-                    core::AuditSink* audit = nullptr);
-  ~CommissionService() override;  // aborts a run under way and waits for it (the valve safe)
-  CommissionService(const CommissionService&) = delete;
-  CommissionService& operator=(const CommissionService&) = delete;
+  CommissioningService(AxisFactory make_axis, commission::Identify identify, RenderReport render_report,
+                       commission::ApplianceBounds bounds, Log log, core::AuditSink* audit = nullptr);
+  ~CommissioningService() override;  // aborts a run under way and waits for it (the valve safe)
+  CommissioningService(const CommissioningService&) = delete;
+  CommissioningService& operator=(const CommissioningService&) = delete;
 
   points::CommissionStartResult start(const std::string& spec_json, const std::string& source) override;
   bool abort(const std::string& source) override;
@@ -45,6 +47,7 @@ class CommissionService final : public web::CommissionPort {
  private:
   AxisFactory make_axis_;
   commission::Identify identify_;
+  RenderReport render_report_;
   commission::ApplianceBounds bounds_;
   Log log_;
   core::AuditSink* audit_;
@@ -58,4 +61,4 @@ class CommissionService final : public web::CommissionPort {
   commission::Progress last_progress_;
 };
 
-}  // namespace epa::app
+}  // namespace epa::appliance

@@ -9,7 +9,7 @@
 #include "core/audit.hpp"
 #include "core/log_throttle.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
 class LogAuditSink final : public core::AuditSink {
 public:
@@ -36,4 +36,4 @@ private:
   core::AuditSink *next_;
 };
 
-} // namespace epa::app
+} // namespace epa::appliance

@@ -4,18 +4,18 @@
 // recorder, tuning sets from and into the store.
 #include <string>
 
-#include "app/recorded_runs.hpp"
+#include "appliance/recorded_runs.hpp"
 #include "commission/axis.hpp"
 #include "points/write_gate.hpp"
 #include "runtime/runtime_config.hpp"
 #include "runtime/scan_cycle.hpp"
 #include "store/store_writer.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
-class ApplianceAxis final : public commission::Axis {
+class CommissioningAxis final : public commission::Axis {
  public:
-  ApplianceAxis(const runtime::RuntimeConfig& rules, runtime::LoopChannels& channels, points::WriteGate& gate,
+  CommissioningAxis(const runtime::RuntimeConfig& rules, runtime::LoopChannels& channels, points::WriteGate& gate,
                 store::StoreWriter& store, std::string db_path, RecordedRuns& runs, points::Requester who)
       : rules_(rules), channels_(channels), gate_(gate), store_(store), db_path_(std::move(db_path)), runs_(runs), who_(std::move(who)) {}
 
@@ -41,4 +41,4 @@ class ApplianceAxis final : public commission::Axis {
   points::Requester who_;
 };
 
-}  // namespace epa::app
+}  // namespace epa::appliance

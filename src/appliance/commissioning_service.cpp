@@ -1,21 +1,25 @@
-#include "app/commission_service.hpp"
+#include "appliance/commissioning_service.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include "commission/commission_spec.hpp"
-#include "report/commission_report.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
-CommissionService::CommissionService(AxisFactory make_axis, commission::Identify identify, commission::ApplianceBounds bounds, Log log,
-                                     core::AuditSink* audit)
-    : make_axis_(std::move(make_axis)), identify_(std::move(identify)), bounds_(std::move(bounds)), log_(std::move(log)), audit_(audit) {}
+CommissioningService::CommissioningService(AxisFactory make_axis, commission::Identify identify, RenderReport render_report,
+                                           commission::ApplianceBounds bounds, Log log, core::AuditSink* audit)
+    : make_axis_(std::move(make_axis)),
+      identify_(std::move(identify)),
+      render_report_(std::move(render_report)),
+      bounds_(std::move(bounds)),
+      log_(std::move(log)),
+      audit_(audit) {}
 
-void CommissionService::audit(const std::string& source, double command) const {
+void CommissioningService::audit(const std::string& source, double command) const {
   if (audit_) audit_->record({{core::unix_time_ms(), source, std::string(points::name(points::PointId::kCommissionCommand)), 0.0, command}});
 }
 
-CommissionService::~CommissionService() {
+CommissioningService::~CommissioningService() {
   {
     std::lock_guard lock(mutex_);
     if (sequence_) sequence_->abort();
@@ -23,7 +27,7 @@ CommissionService::~CommissionService() {
   if (thread_.joinable()) thread_.join();
 }
 
-points::CommissionStartResult CommissionService::start(const std::string& spec_json, const std::string& source) {
+points::CommissionStartResult CommissioningService::start(const std::string& spec_json, const std::string& source) {
   auto spec = spec_json.find_first_not_of(" \t\r\n") == std::string::npos ? core::Result<commission::CommissionSpec>(commission::CommissionSpec{})
                                                                           : commission::parse_commission_spec(spec_json);
   if (!spec) return {points::CommissionStart::kBadSpec, spec.error().message};
@@ -39,7 +43,7 @@ points::CommissionStartResult CommissionService::start(const std::string& spec_j
   thread_ = std::thread([this, s = *spec] {
     const auto outcome = sequence_->run(s);
     auto json = commission::format_commission_json(outcome);
-    auto html = report::commission_report_html(outcome);
+    auto html = render_report_(outcome);
     std::lock_guard done(mutex_);
     result_json_ = std::move(json);
     report_html_ = std::move(html);
@@ -49,7 +53,7 @@ points::CommissionStartResult CommissionService::start(const std::string& spec_j
   return {};
 }
 
-bool CommissionService::abort(const std::string& source) {
+bool CommissioningService::abort(const std::string& source) {
   std::lock_guard lock(mutex_);
   if (!running_) return false;
   if (log_) log_("commission: abort requested by " + source);
@@ -58,23 +62,23 @@ bool CommissionService::abort(const std::string& source) {
   return true;
 }
 
-bool CommissionService::running() const {
+bool CommissioningService::running() const {
   std::lock_guard lock(mutex_);
   return running_;
 }
 
-commission::Progress CommissionService::progress() const {
+commission::Progress CommissioningService::progress() const {
   std::lock_guard lock(mutex_);
   return running_ ? sequence_->progress() : last_progress_;
 }
 
-points::CommissionView CommissionService::view() const {
+points::CommissionView CommissioningService::view() const {
   std::lock_guard lock(mutex_);
   const auto p = running_ ? sequence_->progress() : last_progress_;
   return {true, running_, static_cast<int>(p.stage), static_cast<int>(p.verdict), p.percent};
 }
 
-std::string CommissionService::status_json() const {
+std::string CommissioningService::status_json() const {
   bool is_running;
   commission::Progress p;
   {
@@ -90,14 +94,14 @@ std::string CommissionService::status_json() const {
   return j.dump();
 }
 
-std::optional<std::string> CommissionService::result_json() const {
+std::optional<std::string> CommissioningService::result_json() const {
   std::lock_guard lock(mutex_);
   return result_json_;
 }
 
-std::optional<std::string> CommissionService::report_html() const {
+std::optional<std::string> CommissioningService::report_html() const {
   std::lock_guard lock(mutex_);
   return report_html_;
 }
 
-}  // namespace epa::app
+}  // namespace epa::appliance

@@ -1,4 +1,4 @@
-#include "app/store_setup.hpp"
+#include "appliance/store_setup.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -9,7 +9,7 @@
 #include "store/retained_points.hpp"
 #include "store/schema.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
 store::StoreSeed make_seed(const std::string& name, const core::ModelFile& model, const ControllerPolynomials& polynomials,
                            control::ControllerKind controller, double lc_mm, double valve_limit_v) {
@@ -74,4 +74,4 @@ core::Result<StoreStartup> open_tuning_store(const std::string& path, const stor
   return out;
 }
 
-}  // namespace epa::app
+}  // namespace epa::appliance

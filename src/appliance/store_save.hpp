@@ -8,7 +8,7 @@
 #include "store/model_record.hpp"
 #include "store/tuning_set.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
 // The model, reusing a stored model with the same dynamics. Returns its id.
 core::Result<std::int64_t> save_model(const std::string& db_path, store::ModelRecord model);
@@ -19,4 +19,4 @@ core::Result<std::int64_t> save_model(const std::string& db_path, store::ModelRe
 core::Result<std::int64_t> save_tuning_set(const std::string& db_path, store::ModelRecord model, store::TuningSet set,
                                            const std::string& source = "cli");
 
-}  // namespace epa::app
+}  // namespace epa::appliance

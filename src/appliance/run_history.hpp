@@ -6,8 +6,8 @@
 #include "core/run.hpp"
 #include "store/run_record.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
 store::RunRecord to_run_record(const std::string& path, const core::Run& run);
 
-}  // namespace epa::app
+}  // namespace epa::appliance

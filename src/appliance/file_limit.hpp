@@ -5,9 +5,9 @@
 // without privilege (the unit sets both with LimitNOFILE), so serve does that at start.
 #include <string>
 
-namespace epa::app {
+namespace epa::appliance {
 
 // Raises RLIMIT_NOFILE's soft limit to its hard limit; returns the line to log (what it is now).
 std::string raise_file_limit();
 
-}  // namespace epa::app
+}  // namespace epa::appliance

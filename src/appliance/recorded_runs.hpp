@@ -12,7 +12,7 @@
 
 #include "core/run.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
 class RecordedRuns {
  public:
@@ -55,4 +55,4 @@ class RecordedRuns {
   std::deque<Entry> recent_;
 };
 
-}  // namespace epa::app
+}  // namespace epa::appliance

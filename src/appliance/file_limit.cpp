@@ -1,11 +1,11 @@
-#include "app/file_limit.hpp"
+#include "appliance/file_limit.hpp"
 
 #include <sys/resource.h>
 
 #include <cerrno>
 #include <cstring>
 
-namespace epa::app {
+namespace epa::appliance {
 
 namespace {
 std::string text(rlim_t v) { return v == RLIM_INFINITY ? "unlimited" : std::to_string(v); }
@@ -22,4 +22,4 @@ std::string raise_file_limit() {
   return "open files limit raised from " + text(was) + " to the hard limit " + text(r.rlim_max);
 }
 
-}  // namespace epa::app
+}  // namespace epa::appliance

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "app/tuning_source.hpp"
+#include "appliance/tuning_source.hpp"
 #include "core/model_file.hpp"
 #include "runtime/fault_history.hpp"
 #include "runtime/mode.hpp"
@@ -20,7 +20,7 @@
 #include "store/store_writer.hpp"
 #include "store/tuning_set.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
 struct StoreStartup {
   std::unique_ptr<store::StoreWriter> writer;
@@ -44,4 +44,4 @@ store::StoreSeed make_seed(const std::string& name, const core::ModelFile& model
 core::Result<StoreStartup> open_tuning_store(const std::string& path, const store::StoreSeed& seed,
                                              std::set<points::PointId> persisted_points, double loop_period_s);
 
-}  // namespace epa::app
+}  // namespace epa::appliance

@@ -1,17 +1,17 @@
-#include "app/appliance_axis.hpp"
+#include "appliance/commissioning_axis.hpp"
 
 #include <chrono>
 #include <thread>
 #include <vector>
 
-#include "app/store_save.hpp"
+#include "appliance/store_save.hpp"
 #include "core/format.hpp"
 #include "core/units.hpp"
 #include "runtime/excitation_settings.hpp"
 #include "store/set_activation.hpp"
 #include "store/store_file.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
 namespace {
 
@@ -30,14 +30,14 @@ std::string fault_text(const runtime::Snapshot& s) {
 
 }  // namespace
 
-core::Status ApplianceAxis::write(std::initializer_list<points::PointWrite> writes) {
+core::Status CommissioningAxis::write(std::initializer_list<points::PointWrite> writes) {
   const std::vector<points::PointWrite> w(writes);
   const auto r = gate_.submit(w, who_);
   if (!r.accepted()) return core::invalid_argument(r.reason);
   return core::ok();
 }
 
-core::Result<core::Run> ApplianceAxis::excite(const commission::ExcitationRequest& request, const std::atomic<bool>& abort) {
+core::Result<core::Run> CommissioningAxis::excite(const commission::ExcitationRequest& request, const std::atomic<bool>& abort) {
   // The experiment starts only between its guard lines (its ramps need room both ways): a piston
   // left elsewhere (a verification move to the end, an operator) is first brought to the middle of
   // the soft limits with the set that runs now.
@@ -91,7 +91,7 @@ core::Result<core::Run> ApplianceAxis::excite(const commission::ExcitationReques
   return *run;
 }
 
-core::Result<commission::RunningTuning> ApplianceAxis::running() {
+core::Result<commission::RunningTuning> CommissioningAxis::running() {
   const auto set = store_.running_set();
   auto db = store::open_existing_store(db_path_);
   if (!db) return db.error();
@@ -101,11 +101,11 @@ core::Result<commission::RunningTuning> ApplianceAxis::running() {
   return commission::RunningTuning{loaded->set, loaded->model};
 }
 
-core::Result<std::int64_t> ApplianceAxis::save(const store::ModelRecord& model, const store::TuningSet& set) {
+core::Result<std::int64_t> CommissioningAxis::save(const store::ModelRecord& model, const store::TuningSet& set) {
   return save_tuning_set(db_path_, model, set, who_.source);
 }
 
-core::Status ApplianceAxis::use_set(std::int64_t set_id, bool persist, const std::string& reason) {
+core::Status CommissioningAxis::use_set(std::int64_t set_id, bool persist, const std::string& reason) {
   auto db = store::open_existing_store(db_path_);
   if (!db) return db.error();
   auto loaded = store::find_set_with_model(*db, std::to_string(set_id));
@@ -123,7 +123,7 @@ core::Status ApplianceAxis::use_set(std::int64_t set_id, bool persist, const std
   return core::ok();
 }
 
-core::Result<core::Run> ApplianceAxis::move(double target_mm, double hold_s, const std::atomic<bool>& abort) {
+core::Result<core::Run> CommissioningAxis::move(double target_mm, double hold_s, const std::atomic<bool>& abort) {
   if (auto s = write({{PointId::kSetpoint, target_mm}, {PointId::kMode, mode_value(runtime::Mode::kRun)}}); !s) return s.error();
   core::Run run;
   runtime::Snapshot s = channels_.snapshot.read();
@@ -154,6 +154,6 @@ core::Result<core::Run> ApplianceAxis::move(double target_mm, double hold_s, con
   return run;
 }
 
-void ApplianceAxis::stop() { (void)write({{PointId::kMode, mode_value(runtime::Mode::kStop)}}); }
+void CommissioningAxis::stop() { (void)write({{PointId::kMode, mode_value(runtime::Mode::kStop)}}); }
 
-}  // namespace epa::app
+}  // namespace epa::appliance

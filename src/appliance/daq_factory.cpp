@@ -1,4 +1,4 @@
-#include "app/daq_factory.hpp"
+#include "appliance/daq_factory.hpp"
 
 #include "hal/comedi_daq.hpp"
 #include "hal/modbus_io_daq.hpp"
@@ -6,7 +6,7 @@
 #include "plant/plant_adapter.hpp"
 #include "plant/pneumatic_params.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
 core::Result<std::unique_ptr<plant::PlantSimulator>> make_physics_plant(const std::string& params_path, const PhysicsPlantOptions& o) {
   plant::PneumaticParams params;  // the defaults, sized like the paper's rig
@@ -59,4 +59,4 @@ core::Result<std::unique_ptr<hal::Daq>> make_daq(const config::ApplianceConfig& 
   return core::invalid_argument("unknown DAQ backend");
 }
 
-}  // namespace epa::app
+}  // namespace epa::appliance

@@ -1,4 +1,4 @@
-#include "app/run_history.hpp"
+#include "appliance/run_history.hpp"
 
 #include <cmath>
 
@@ -6,7 +6,7 @@
 #include "core/move_metrics.hpp"
 #include "core/run_file.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
 namespace {
 std::optional<double> finite(double v) { return std::isfinite(v) ? std::optional(v) : std::nullopt; }
@@ -36,4 +36,4 @@ store::RunRecord to_run_record(const std::string& path, const core::Run& run) {
   return r;
 }
 
-}  // namespace epa::app
+}  // namespace epa::appliance

@@ -9,7 +9,7 @@
 #include "hal/daq.hpp"
 #include "plant/plant_simulator.hpp"
 
-namespace epa::app {
+namespace epa::appliance {
 
 struct PhysicsPlantOptions {
   double initial_position_mm = 0.0;
@@ -26,4 +26,4 @@ core::Result<std::unique_ptr<plant::PlantSimulator>> make_physics_plant(const st
 
 core::Result<std::unique_ptr<hal::Daq>> make_daq(const config::ApplianceConfig& appliance, const core::HammersteinModel& model);
 
-}  // namespace epa::app
+}  // namespace epa::appliance

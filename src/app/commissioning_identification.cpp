@@ -1,4 +1,4 @@
-#include "app/commission_identify.hpp"
+#include "app/commissioning_identification.hpp"
 
 #include <cmath>
 #include <cstdio>

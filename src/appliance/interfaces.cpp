@@ -1,0 +1,74 @@
+#include "appliance/interfaces.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <string>
+
+namespace epa::appliance {
+
+namespace {
+
+// `status_page_url`: the status page's address (FC43's VendorUrl), "" with none.
+core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const config::ApplianceConfig& c, const modbus::RegisterMap& map,
+                                                                 Axis& axis, std::string status_page_url) {
+  modbus::ServerConfig mc = c.modbus;
+  mc.status_page_url = std::move(status_page_url);
+  auto server = modbus::ModbusServer::start(mc, map, axis.gate(), axis.channels(), [](const std::string& line) { spdlog::info("{}", line); });
+  if (!server) return server.error();
+  const auto& p = c.modbus.policy;
+  std::string aliases;
+  for (const int id : c.modbus.alias_unit_ids) aliases += (aliases.empty() ? ", also " : " and ") + std::to_string(id);
+  spdlog::info("modbus: listening on {} (unit {}{}, map {}, {} points, {})", (*server)->bound_address(),
+               c.modbus.unit_id, aliases, c.register_map_path, map.entries().size(),
+               p.read_only ? "read-only" : p.unlock_key ? "tuning locked until unlocked" : "tuning locked (no unlock key)");
+  if (const std::string notice = config::any_address_notice(c); !notice.empty()) spdlog::warn("{}", notice);
+  return server;
+}
+
+// `modbus`: the Modbus server once it has started, null while it has not or without one.
+core::Result<std::unique_ptr<web::WebServer>> start_web(const config::ApplianceConfig& c, Axis& axis, web::RecentAudit& audit,
+                                                        const std::atomic<const modbus::ModbusServer*>& modbus,
+                                                        const store::StoreWriter& store) {
+  auto modbus_stats = [&modbus, any_address = config::any_address_may_command(c)] {
+    const modbus::ModbusServer* mb = modbus.load();
+    return mb ? web::ModbusStats{true, mb->clients(), mb->requests(), mb->exceptions(), any_address} : web::ModbusStats{};
+  };
+  auto store_stats = [&store] {
+    const auto counters = store.counters();
+    const auto health = store.health();
+    return web::StoreStats{true, health.ok, counters.accepted, counters.saved, health.last_error, store.running_set().name,
+                           counters.disk_low};
+  };
+  web::WebConfig web_config = c.web;
+  web_config.log = [](const std::string& line) { spdlog::warn("{}", line); };
+  auto server = web::WebServer::start(web_config, axis.channels(), &axis.gate(), &audit, modbus_stats, store_stats, &axis.commissioning());
+  if (!server) return server.error();
+  spdlog::info("web: listening on {} (static files {}, commands {})", (*server)->bound_address(), c.web.static_dir,
+               c.web.token.empty() ? "disabled: no token configured" : "enabled with the token");
+  return server;
+}
+
+}  // namespace
+
+core::Status Interfaces::start(const config::ApplianceConfig& c, const std::optional<modbus::RegisterMap>& map, Axis& axis,
+                               web::RecentAudit& audit, const store::StoreWriter& store) {
+  if (c.web_enabled) {
+    auto server = start_web(c, axis, audit, modbus_for_web_, store);
+    if (!server) return server.error();
+    web_ = std::move(*server);
+  }
+  if (map) {
+    auto server = start_modbus(c, *map, axis, web_ ? modbus::status_page_url(web_->port()) : std::string());
+    if (!server) return server.error();
+    modbus_ = std::move(*server);
+    modbus_for_web_ = modbus_.get();
+  }
+  return core::ok();
+}
+
+void Interfaces::stop() {
+  if (web_) web_->stop();
+  if (modbus_) modbus_->stop();
+}
+
+}  // namespace epa::appliance
