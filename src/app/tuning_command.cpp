@@ -128,7 +128,13 @@ std::string unstable_branches_of(const store::TuningFile& file) {
 
 std::string number_or_dash(const std::optional<double>& v) { return v ? core::format_number(*v) : "-"; }
 
-int list(store::Database& db, std::ostream& out) {
+int tuning_failed(std::ostream& err, const std::string& message) { return err << "epa tuning: " << message << "\n", 1; }
+
+// One subcommand: the store, the options, where it prints. Errors it returns print as
+// "epa tuning: ..." with exit 1; a store error it cannot return is thrown.
+using Subcommand = int (*)(store::Database& db, const TuningOptions& o, std::ostream& out, std::ostream& err);
+
+int list_subcommand(store::Database& db, const TuningOptions&, std::ostream& out, std::ostream&) {
   auto sets = store::TuningSetTable(db).all();
   if (!sets) throw std::runtime_error(sets.error().message);
   auto active = store::TuningSetTable(db).active_id();
@@ -144,145 +150,164 @@ int list(store::Database& db, std::ostream& out) {
   return 0;
 }
 
+int show_subcommand(store::Database& db, const TuningOptions& o, std::ostream& out, std::ostream& err) {
+  auto s = store::find_set_with_model(db, o.set);
+  if (!s) return tuning_failed(err, s.error().message);
+  auto active = store::TuningSetTable(db).active_id();
+  out << "tuning set " << s->set.id << (active && *active && **active == s->set.id ? " (active)" : "") << "\n";
+  for (const auto& [k, v] : fields(s->set, s->model)) out << "  " << k << ": " << v << "\n";
+  return 0;
+}
+
+int diff_subcommand(store::Database& db, const TuningOptions& o, std::ostream& out, std::ostream& err) {
+  auto a = store::find_set_with_model(db, o.set);
+  if (!a) return tuning_failed(err, a.error().message);
+  auto b = store::find_set_with_model(db, o.other);
+  if (!b) return tuning_failed(err, b.error().message);
+  const auto fa = fields(a->set, a->model), fb = fields(b->set, b->model);
+  int differences = 0;
+  for (std::size_t i = 0; i < fa.size(); ++i) {
+    const std::string& key = fa[i].first;  // identity and history are not values
+    if (key == "name" || key == "source" || key == "created" || key == "modified" || fa[i].second == fb[i].second) continue;
+    out << fa[i].first << ":\n  " << a->set.name << ": " << fa[i].second << "\n  " << b->set.name << ": " << fb[i].second << "\n";
+    ++differences;
+  }
+  if (differences == 0) out << "'" << a->set.name << "' and '" << b->set.name << "' have the same values\n";
+  return 0;
+}
+
+int activate_subcommand(store::Database& db, const TuningOptions& o, std::ostream& out, std::ostream& err) {
+  auto s = store::find_set_with_model(db, o.set);
+  if (!s) return tuning_failed(err, s.error().message);
+  auto tx = store::Transaction::begin(db);
+  if (!tx) return tuning_failed(err, tx.error().message);
+  if (auto st = store::activate_audited(db, s->set.id, "cli"); !st) return tuning_failed(err, st.error().message);
+  if (auto st = tx->commit(); !st) return tuning_failed(err, st.error().message);
+  out << "tuning set '" << s->set.name << "' (id " << s->set.id << ") is active: a running appliance uses it from its next start\n";
+  return 0;
+}
+
+int export_set_subcommand(store::Database& db, const TuningOptions& o, std::ostream& out, std::ostream& err) {
+  auto s = store::find_set_with_model(db, o.set);
+  if (!s) return tuning_failed(err, s.error().message);
+  if (auto st = write_output(o.file, store::format_tuning_toml(s->set, s->model), out); !st) return tuning_failed(err, st.error().message);
+  if (o.file != "-") out << "tuning set '" << s->set.name << "' written to " << o.file << "\n";
+  return 0;
+}
+
+// The file's set with its model (reused when already stored), audited, in the transaction of the
+// caller; activated when asked. Returns the set's id.
+core::Result<std::int64_t> insert_imported(store::Database& db, store::TuningFile& file, const TuningOptions& o) {
+  file.model.created_ms = core::unix_time_ms();
+  auto model_id = store::ModelTable(db).find_or_insert(file.model);
+  if (!model_id) return model_id.error();
+  file.set.model_id = *model_id;
+  file.set.created_ms = file.set.modified_ms = core::unix_time_ms();
+  file.set.source = "imported from " + o.file + (file.set.source.empty() ? "" : " (" + file.set.source + ")");
+  auto id = store::TuningSetTable(db).insert(file.set);
+  if (!id) return core::Error{id.error().code, id.error().message + (o.name.empty() ? " (give another with --name)" : "")};
+  if (auto st = store::AuditLog(db).append({core::unix_time_ms(), "cli", "import_tuning_set", std::nan(""), static_cast<double>(*id)}); !st)
+    return st.error();
+  if (o.activate)
+    if (auto st = store::activate_audited(db, *id, "cli"); !st) return st.error();
+  return id;
+}
+
+int import_set_subcommand(store::Database& db, const TuningOptions& o, std::ostream& out, std::ostream& err) {
+  auto text = core::read_text_file(o.file, "tuning file", core::kSmallFileCapBytes);
+  if (!text) return tuning_failed(err, text.error().message);
+  auto file = store::parse_tuning_toml(*text, o.file);
+  if (!file) return tuning_failed(err, file.error().message);
+  if (!o.name.empty()) file->set.name = o.name;
+  if (auto st = core::check_printable_name(file->set.name, "--name"); !st) return tuning_failed(err, st.error().message);
+  // The set runs on the axis once active: it passes the same Jury test as `epa design --save`.
+  if (const auto unstable = unstable_branches_of(*file); !unstable.empty()) {
+    err << "epa tuning: import refused: tuning set '" << file->set.name << "' of " << o.file
+        << " is UNSTABLE: the closed loop is unstable on " << unstable
+        << "; a controller with this set does not hold the axis there (epa design shows each branch's Jury table)\n";
+    return 3;
+  }
+  auto tx = store::Transaction::begin(db);
+  if (!tx) return tuning_failed(err, tx.error().message);
+  auto id = insert_imported(db, *file, o);
+  if (!id) return tuning_failed(err, id.error().message);
+  if (auto st = tx->commit(); !st) return tuning_failed(err, st.error().message);
+  out << "imported tuning set '" << file->set.name << "' (id " << *id << ")" << (o.activate ? ", active from the appliance's next start" : "") << "\n";
+  return 0;
+}
+
+core::Result<store::AuditFilter> audit_filter(const TuningOptions& o) {
+  store::AuditFilter f;
+  if (!o.since.empty()) {
+    auto t = parse_time(o.since, "--since");
+    if (!t) return t.error();
+    f.since_ms = *t;
+  }
+  if (!o.until.empty()) {
+    auto t = parse_time(o.until, "--until");
+    if (!t) return t.error();
+    f.until_ms = *t;
+  }
+  f.source = o.source;
+  f.point = o.point;
+  f.limit = o.limit;
+  return f;
+}
+
+void print_audit_row(const store::AuditRecord& r, bool json, std::ostream& out) {
+  const auto& e = r.entry;
+  if (json) {
+    auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+    out << nlohmann::json{{"id", r.id}, {"time", iso_time(e.unix_time_ms)}, {"unix_time_ms", e.unix_time_ms},
+                          {"source", e.source}, {"point", e.point}, {"old", num(e.old_value)}, {"new", num(e.new_value)}}
+               .dump()
+        << "\n";
+  } else {
+    out << iso_time(e.unix_time_ms) << "  " << e.source << "  " << e.point << "  "
+        << (core::is_audit_event(e) ? "nothing changed"
+                                    : core::audit_value_text(e.old_value) + " -> " + core::audit_value_text(e.new_value))
+        << "\n";
+  }
+}
+
+int audit_subcommand(store::Database& db, const TuningOptions& o, std::ostream& out, std::ostream& err) {
+  auto f = audit_filter(o);
+  if (!f) return tuning_failed(err, f.error().message);
+  auto rows = store::AuditLog(db).query(*f);
+  if (!rows) return tuning_failed(err, rows.error().message);
+  for (const auto& r : *rows) print_audit_row(r, o.json, out);
+  if (!o.json && rows->empty()) out << "no audit entries match\n";
+  return 0;
+}
+
+int runs_subcommand(store::Database& db, const TuningOptions& o, std::ostream& out, std::ostream& err) {
+  auto recent = store::RunTable(db).recent(o.limit);
+  if (!recent) return tuning_failed(err, recent.error().message);
+  for (const auto& r : *recent)
+    out << iso_time(r.recorded_ms) << "  " << r.controller << "  " << number_or_dash(r.from_mm) << " -> "
+        << number_or_dash(r.to_mm) << " mm  rise " << number_or_dash(r.rise_s) << " s  settling "
+        << number_or_dash(r.settling_s) << " s  e_ss " << number_or_dash(r.ess_mm) << " mm  overshoot "
+        << number_or_dash(r.overshoot_pct) << " %  " << r.path << "\n";
+  if (recent->empty()) out << "no runs recorded\n";
+  return 0;
+}
+
 }  // namespace
 
 int run_tuning(CLI::App& app, const TuningOptions& o, std::ostream& out, std::ostream& err) {
-  auto fail = [&err](const std::string& message) { return err << "epa tuning: " << message << "\n", 1; };
+  const std::pair<const char*, Subcommand> subcommands[] = {{"list", list_subcommand},         {"show", show_subcommand},     {"diff", diff_subcommand},
+                                                            {"activate", activate_subcommand}, {"export", export_set_subcommand}, {"import", import_set_subcommand},
+                                                            {"audit", audit_subcommand},       {"runs", runs_subcommand}};
   auto* cmd = app.get_subcommand("tuning");
   auto db = store::open_existing_store(o.db_path);
-  if (!db) return fail(db.error().message);
+  if (!db) return tuning_failed(err, db.error().message);
   try {
-    if (cmd->got_subcommand("list")) return list(*db, out);
-
-    if (cmd->got_subcommand("show")) {
-      auto s = store::find_set_with_model(*db, o.set);
-      if (!s) return fail(s.error().message);
-      auto active = store::TuningSetTable(*db).active_id();
-      out << "tuning set " << s->set.id << (active && *active && **active == s->set.id ? " (active)" : "") << "\n";
-      for (const auto& [k, v] : fields(s->set, s->model)) out << "  " << k << ": " << v << "\n";
-      return 0;
-    }
-
-    if (cmd->got_subcommand("diff")) {
-      auto a = store::find_set_with_model(*db, o.set);
-      if (!a) return fail(a.error().message);
-      auto b = store::find_set_with_model(*db, o.other);
-      if (!b) return fail(b.error().message);
-      const auto fa = fields(a->set, a->model), fb = fields(b->set, b->model);
-      int differences = 0;
-      for (std::size_t i = 0; i < fa.size(); ++i) {
-        const std::string& key = fa[i].first;  // identity and history are not values
-        if (key == "name" || key == "source" || key == "created" || key == "modified" || fa[i].second == fb[i].second) continue;
-        out << fa[i].first << ":\n  " << a->set.name << ": " << fa[i].second << "\n  " << b->set.name << ": " << fb[i].second << "\n";
-        ++differences;
-      }
-      if (differences == 0) out << "'" << a->set.name << "' and '" << b->set.name << "' have the same values\n";
-      return 0;
-    }
-
-    if (cmd->got_subcommand("activate")) {
-      auto s = store::find_set_with_model(*db, o.set);
-      if (!s) return fail(s.error().message);
-      auto tx = store::Transaction::begin(*db);
-      if (!tx) return fail(tx.error().message);
-      if (auto st = store::activate_audited(*db, s->set.id, "cli"); !st) return fail(st.error().message);
-      if (auto st = tx->commit(); !st) return fail(st.error().message);
-      out << "tuning set '" << s->set.name << "' (id " << s->set.id << ") is active: a running appliance uses it from its next start\n";
-      return 0;
-    }
-
-    if (cmd->got_subcommand("export")) {
-      auto s = store::find_set_with_model(*db, o.set);
-      if (!s) return fail(s.error().message);
-      if (auto st = write_output(o.file, store::format_tuning_toml(s->set, s->model), out); !st) return fail(st.error().message);
-      if (o.file != "-") out << "tuning set '" << s->set.name << "' written to " << o.file << "\n";
-      return 0;
-    }
-
-    if (cmd->got_subcommand("import")) {
-      auto text = core::read_text_file(o.file, "tuning file", core::kSmallFileCapBytes);
-      if (!text) return fail(text.error().message);
-      auto file = store::parse_tuning_toml(*text, o.file);
-      if (!file) return fail(file.error().message);
-      if (!o.name.empty()) file->set.name = o.name;
-      if (auto st = core::check_printable_name(file->set.name, "--name"); !st) return fail(st.error().message);
-      // The set runs on the axis once active: it passes the same Jury test as `epa design --save`.
-      if (const auto unstable = unstable_branches_of(*file); !unstable.empty()) {
-        err << "epa tuning: import refused: tuning set '" << file->set.name << "' of " << o.file
-            << " is UNSTABLE: the closed loop is unstable on " << unstable
-            << "; a controller with this set does not hold the axis there (epa design shows each branch's Jury table)\n";
-        return 3;
-      }
-      auto tx = store::Transaction::begin(*db);
-      if (!tx) return fail(tx.error().message);
-      file->model.created_ms = core::unix_time_ms();
-      auto model_id = store::ModelTable(*db).find_or_insert(file->model);
-      if (!model_id) return fail(model_id.error().message);
-      file->set.model_id = *model_id;
-      file->set.created_ms = file->set.modified_ms = core::unix_time_ms();
-      file->set.source = "imported from " + o.file + (file->set.source.empty() ? "" : " (" + file->set.source + ")");
-      auto id = store::TuningSetTable(*db).insert(file->set);
-      if (!id) return fail(id.error().message + (o.name.empty() ? " (give another with --name)" : ""));
-      if (auto st = store::AuditLog(*db).append({core::unix_time_ms(), "cli", "import_tuning_set", std::nan(""), static_cast<double>(*id)}); !st)
-        return fail(st.error().message);
-      if (o.activate)
-        if (auto st = store::activate_audited(*db, *id, "cli"); !st) return fail(st.error().message);
-      if (auto st = tx->commit(); !st) return fail(st.error().message);
-      out << "imported tuning set '" << file->set.name << "' (id " << *id << ")" << (o.activate ? ", active from the appliance's next start" : "") << "\n";
-      return 0;
-    }
-
-    if (cmd->got_subcommand("audit")) {
-      store::AuditFilter f;
-      if (!o.since.empty()) {
-        auto t = parse_time(o.since, "--since");
-        if (!t) return fail(t.error().message);
-        f.since_ms = *t;
-      }
-      if (!o.until.empty()) {
-        auto t = parse_time(o.until, "--until");
-        if (!t) return fail(t.error().message);
-        f.until_ms = *t;
-      }
-      f.source = o.source;
-      f.point = o.point;
-      f.limit = o.limit;
-      auto rows = store::AuditLog(*db).query(f);
-      if (!rows) return fail(rows.error().message);
-      for (const auto& r : *rows) {
-        const auto& e = r.entry;
-        if (o.json) {
-          auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
-          out << nlohmann::json{{"id", r.id}, {"time", iso_time(e.unix_time_ms)}, {"unix_time_ms", e.unix_time_ms},
-                                {"source", e.source}, {"point", e.point}, {"old", num(e.old_value)}, {"new", num(e.new_value)}}
-                     .dump()
-              << "\n";
-        } else {
-          out << iso_time(e.unix_time_ms) << "  " << e.source << "  " << e.point << "  "
-              << (core::is_audit_event(e) ? "nothing changed"
-                                          : core::audit_value_text(e.old_value) + " -> " + core::audit_value_text(e.new_value))
-              << "\n";
-        }
-      }
-      if (!o.json && rows->empty()) out << "no audit entries match\n";
-      return 0;
-    }
-
-    if (cmd->got_subcommand("runs")) {
-      auto runs = store::RunTable(*db).recent(o.limit);
-      if (!runs) return fail(runs.error().message);
-      for (const auto& r : *runs)
-        out << iso_time(r.recorded_ms) << "  " << r.controller << "  " << number_or_dash(r.from_mm) << " -> "
-            << number_or_dash(r.to_mm) << " mm  rise " << number_or_dash(r.rise_s) << " s  settling "
-            << number_or_dash(r.settling_s) << " s  e_ss " << number_or_dash(r.ess_mm) << " mm  overshoot "
-            << number_or_dash(r.overshoot_pct) << " %  " << r.path << "\n";
-      if (runs->empty()) out << "no runs recorded\n";
-      return 0;
-    }
+    for (const auto& [name, run] : subcommands)
+      if (cmd->got_subcommand(name)) return run(*db, o, out, err);
   } catch (const std::exception& e) {
-    return fail(e.what());
+    return tuning_failed(err, e.what());
   }
-  return fail("unknown subcommand");
+  return tuning_failed(err, "unknown subcommand");
 }
 
 }  // namespace epa::app
