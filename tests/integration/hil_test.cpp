@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "../support/temp_path.hpp"
+#include "../support/wait_until.hpp"
 #include "child_process.hpp"
 #include "core/move_metrics.hpp"
 #include "core/run_file.hpp"
@@ -87,13 +88,10 @@ TEST(HardwareInTheLoop, PlantServerAndServeCompleteAFiftyMillimetreMove) {
   ASSERT_GT(serve.pid(), 0);
 
   // The move is recorded when it ends (in position, or judged 5 s after its target); allow for a slow machine.
+  // The .csv appears by a rename of the finished file (core::write_file_atomically), so once it is
+  // there it is whole.
   std::optional<fs::path> run_file;
-  const auto until = std::chrono::steady_clock::now() + 20s;
-  while (!run_file && serve.running() && std::chrono::steady_clock::now() < until) {
-    std::this_thread::sleep_for(100ms);
-    run_file = first_file_in(dir / "runs");
-  }
-  std::this_thread::sleep_for(200ms);  // let the writer finish the rename it just made
+  test::wait_until([&] { return (run_file = first_file_in(dir / "runs")).has_value() || !serve.running(); }, 20s, 10ms);
   const int serve_exit = serve.stop(SIGTERM);
   const int plant_exit = plant.stop(SIGTERM);
   ASSERT_TRUE(run_file.has_value()) << "no run file recorded\nserve log:\n" << serve.log() << "\nplant log:\n" << plant.log();

@@ -20,6 +20,7 @@
 #include "control/paper_controller.hpp"
 #include "core/version.hpp"
 #include "core/word_order.hpp"
+#include "../support/wait_until.hpp"
 
 namespace epa::modbus {
 namespace {
@@ -251,7 +252,7 @@ TEST_F(Server, DeviceIdentificationIsAnsweredBehindTheRequestsMbapHeader) {
   ASSERT_EQ(send(fd, missing, sizeof missing, 0), static_cast<ssize_t>(sizeof missing));
   EXPECT_EQ(read_adu(fd), (std::vector<std::uint8_t>{0x12, 0x36, 0x00, 0x00, 0x00, 0x03, 0x01, 0xAB, 0x02}));
   // The server counts after it sent the answer: wait for it, bounded.
-  for (const auto until = Clock::now() + 1s; server_->exceptions() < 1 && Clock::now() < until;) std::this_thread::sleep_for(1ms);
+  epa::test::wait_until([&] { return server_->exceptions() >= 1; }, 1s);
   EXPECT_EQ(server_->requests(), 3u);
   EXPECT_EQ(server_->exceptions(), 1u);
 }
@@ -263,7 +264,8 @@ TEST_F(Server, ANewClientOverTheCapEvictsTheYoungestClientNotTheEstablishedOnes)
   modbus_t* b = client();
   std::uint16_t r[2];
   for (auto* ctx : {a, b}) ASSERT_EQ(modbus_read_input_registers(ctx, 0, 2, r), 2);
-  std::this_thread::sleep_for(20ms);  // c is accepted after a and b, on a later tick
+  // c is accepted after a and b, on a later pass of the server's loop (a later accept time): a and
+  // b were accepted on a pass before the one that answered them, and c connects after the answers.
   modbus_t* c = client();
   ASSERT_EQ(modbus_read_input_registers(c, 0, 2, r), 2);  // c is now the youngest, though a is idle the longest
   modbus_t* d = client();
@@ -317,14 +319,13 @@ TEST_F(Server, ANewcomerAboveItsAddressShareReplacesItsOwnAddressesClientWhenFul
   ASSERT_TRUE(served(other));
   const int first = from("127.0.0.1");
   ASSERT_TRUE(served(first));
-  std::this_thread::sleep_for(20ms);
+  // Each newcomer is accepted on a later pass of the server's loop than the one before it (a later
+  // accept time, which orders "youngest"): it connects after the one before was answered.
   const int second = from("127.0.0.1");
   ASSERT_TRUE(served(second));
-  std::this_thread::sleep_for(20ms);
   const int third = from("127.0.0.1");  // the address's third: above its share, but the server has room
   EXPECT_TRUE(served(third));
   EXPECT_TRUE(served(second));
-  std::this_thread::sleep_for(20ms);
   const int fourth = from("127.0.0.1");  // the server is full: the address gives up its own
   EXPECT_TRUE(served(fourth));
   EXPECT_FALSE(served(third));   // its own address's youngest made room
@@ -339,7 +340,9 @@ TEST_F(Server, FreshIdleSocketsAreEvictedBeforeAWorkingClient) {
   std::uint16_t r[2];
   ASSERT_EQ(modbus_read_input_registers(hmi, 0, 2, r), 2);
   for (int i = 0; i < 10; ++i) raw_socket();  // a crowd that connects and says nothing, after the HMI
-  std::this_thread::sleep_for(100ms);
+  // The server has accepted them all (each newcomer evicts as it is accepted): its listening
+  // socket's accept queue is empty (bounded).
+  epa::test::wait_until([&] { return epa::test::accept_queue_length(server_->port()) == 0; });
   EXPECT_EQ(modbus_read_input_registers(hmi, 0, 2, r), 2);  // still connected: the silent ones made room
   EXPECT_EQ(server_->clients(), 3);
 }
@@ -398,7 +401,7 @@ TEST_F(Server, AFrameNotCompletedWithinTheFrameTimeoutIsClosedEvenIfBytesKeepCom
     if (send(slow, frame + i, 1, MSG_NOSIGNAL) != 1) closed = true;
     std::uint8_t byte = 0;
     if (recv(slow, &byte, 1, MSG_DONTWAIT) == 0) closed = true;
-    std::this_thread::sleep_for(100ms);
+    std::this_thread::sleep_for(100ms);  // the stimulus: a client that sends one byte every 100 ms
   }
   EXPECT_TRUE(closed) << "a one-byte-a-tick client was served after all";
   EXPECT_LT(Clock::now() - t0, 1s);

@@ -28,6 +28,7 @@
 #include <fstream>
 
 #include "../support/temp_path.hpp"
+#include "../support/wait_until.hpp"
 #include "web/commission_port.hpp"
 #include "web/recent_audit.hpp"
 
@@ -214,7 +215,8 @@ TEST_F(WebServerTest, StatusNamesALatchedFaultInWords) {
 
 TEST_F(WebServerTest, TrendMovesTuningAndAuditHaveTheirShapes) {
   start();
-  std::this_thread::sleep_for(200ms);  // the sampler takes a point every 50 ms
+  // The sampler takes a point every 50 ms: wait for two (bounded), then judge a fresh answer.
+  epa::test::wait_until([&] { return get_json("/api/trend")["t_s"].size() >= 2; });
   const json t = get_json("/api/trend");
   ASSERT_GE(t["t_s"].size(), 2u);
   EXPECT_EQ(t["t_s"].size(), t["position_mm"].size());
@@ -232,7 +234,7 @@ TEST_F(WebServerTest, TrendMovesTuningAndAuditHaveTheirShapes) {
   EXPECT_TRUE(m["moves"][0]["settling_s"].is_null());
   snap_.last_move.number = 4;
   channels_.snapshot.publish(snap_);
-  std::this_thread::sleep_for(200ms);
+  epa::test::wait_until([&] { return get_json("/api/moves")["moves"].size() >= 2; });  // the sampler's next point
   const json m2 = get_json("/api/moves");
   ASSERT_EQ(m2["moves"].size(), 2u);
   EXPECT_EQ(m2["moves"][0]["number"], 4);  // newest first
@@ -816,7 +818,8 @@ TEST_F(WebServerTest, FiftyIdleConnectionsDoNotStopANormalRequest) {
     }
     idle.push_back(fd);
   }
-  std::this_thread::sleep_for(100ms);  // let the server accept them all
+  // The server has accepted them all: its listening socket's accept queue is empty (bounded).
+  epa::test::wait_until([&] { return epa::test::accept_queue_length(server_->port()) == 0; });
   const auto t0 = std::chrono::steady_clock::now();
   auto res = client_->Get("/api/status");
   const auto took = std::chrono::steady_clock::now() - t0;
@@ -1009,7 +1012,7 @@ TEST_F(WebServerTest, AnAddressPastItsConnectionCapIsRefusedAtOnce) {
     ASSERT_GE(fd, 0);
     held.push_back(fd);
   }
-  std::this_thread::sleep_for(100ms);  // accepted
+  epa::test::wait_until([&] { return epa::test::accept_queue_length(server_->port()) == 0; });  // accepted
   const auto t0 = std::chrono::steady_clock::now();
   const std::string refused = raw_answer(server_->port(), "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n");
   EXPECT_LT(std::chrono::steady_clock::now() - t0, 500ms);
