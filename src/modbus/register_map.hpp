@@ -75,6 +75,8 @@ class RegisterMap {
   static constexpr int kBitBlock = 16;
 
  private:
+  std::string add(RegisterEntry e);  // what is wrong with where it goes (an overlap), "" when nothing
+
   std::string source_;
   std::vector<RegisterEntry> entries_;
   std::array<std::vector<std::int32_t>, 4> index_;  // per table: address -> entry index, -1 unmapped
