@@ -1,38 +1,49 @@
 #pragma once
-// Which effect explains the gap, and how far it shrinks: the diagnosis.
+// Which effect explains the gap, and how far it shrinks: the diagnosis. Its steps, as diagnose()
+// takes them (selection.cpp numbers its step functions the same):
 //
-//  1. Baseline: the nominal model's held-out windowed gap.
-//  2. Re-fit: the nominal model's own parameters (drive gain, its steady speed within the printed
-//     B's precision, both break points) fitted on the training runs and scored held out; they stay free in every later fit, since on a rig much of
-//     a gap is parameters that are off, and an effect fitted on wrong parameters is biased.
-//  3. Candidates: every structural effect (delay, lag, friction, ceiling, position dependence,
-//     quantisation) fitted with the nominal parameters on the training runs, scored held out.
-//  4. Forward selection: add the effect with the largest held-out reduction while that reduction
-//     beats its chance threshold (the reduction fitting that effect gives on effect-free data:
-//     chance_threshold.hpp) and the gap before it lies above the noise floor (below it a fit
-//     only takes noise away), re-fitting on top of what is accepted; at most max_effects.
-//     input_delay and valve_lag explain much the same; when the runner-up comes within
-//     confusable_ratio of the winner's reduction, the pair is reported as confusable.
-//  5. Pairs: the best pair_pool first-round candidates fitted two at a time, jointly (from the
+//  1. measure_baseline: the nominal model's held-out windowed gap (and the training gap).
+//  2. refit_nominal_parameters: the nominal model's own parameters (drive gain, its steady speed
+//     within the printed B's precision, both break points) fitted on the training runs and scored
+//     held out; they stay free in every later fit, since on a rig much of a gap is parameters that
+//     are off, and an effect fitted on wrong parameters is biased.
+//  3. estimate_noise_floor: the gap that sensor noise alone gives a perfect model, estimated from
+//     the runs at rest, and never below min_floor_mm.
+//  4. select_forward: every structural effect (delay, lag, friction, ceiling, position dependence,
+//     quantisation) fitted with the nominal parameters on the training runs and scored held out
+//     (the first round: the candidate table); then the effect with the largest held-out reduction
+//     is added while that reduction beats its chance threshold (the reduction fitting that effect
+//     gives on effect-free data: chance_threshold.hpp) and the gap before it lies above the noise
+//     floor (below it a fit only takes noise away), re-fitting on top of what is accepted; at most
+//     max_effects. input_delay and valve_lag explain much the same; when the runner-up comes
+//     within confusable_ratio of the winner's reduction, the pair is reported as confusable.
+//  5. try_pairs: the best pair_pool first-round candidates fitted two at a time, jointly (from the
 //     better one fitted alone, the other added afresh, so no pair leaves more than it); a pair
 //     replaces the forward set when it leaves a smaller gap and each of its effects beats its own
 //     chance threshold on top of the other (two effects that each explain little alone).
-//  6. The accepted set re-fitted jointly (all free at once, from where the selection left them and
-//     from neutral), then a backward check: an effect stays only while removing it (the rest
-//     re-fitted from where they stand) costs more than its chance threshold.
-//  7. gain_change and deadzone_shift are named when their parameters, fitted with the accepted
-//     effects, lie beyond tolerances calibrated on effect-free data from slightly perturbed models
-//     and holding them nominal costs more than their chance threshold of the baseline gap (a
-//     parameter that only absorbs the residue of an effect's imperfect form is not a finding).
-//     Beside a position dependence a gain that holds is that dependence's level (the runs
-//     cannot tell the two apart): it is said, not named; a gain that drifts is named.
-//  8. Unexplained: a held-out gap left above unexplained_factor times the noise floor (the gap
-//     that sensor noise alone gives a perfect model, estimated from the runs at rest, and never
-//     below min_floor_mm) and, when
-//     effects are named, above unexplained_share of the baseline gap: a rig's effect never has
-//     the library's exact form, and the residue of the named effects' forms is theirs. Also when
-//     the readings move while the valve rests inside the dead band (rest_drift.hpp): no effect
-//     of the vocabulary moves a piston there, and the windowed gap is blind to a slow drift.
+//  6. refit_jointly_then_check_backward: the accepted set re-fitted jointly (all free at once, from
+//     where the selection left them and from neutral), then a backward check: an effect stays only
+//     while removing it (the rest re-fitted from where they stand) costs more than its chance
+//     threshold.
+//  7. drop_effects_that_do_nothing: an effect fitted to its neutral values, or whose switching off
+//     moves the held-out gap by less than half a percent, is not named.
+//  8. fit_gain_drift_last: a gain that drifts during each run (a sagging supply), fitted last beside
+//     the accepted effects, kept when it beats the gain's chance threshold.
+//  9. name_nominal_parameters: gain_change and deadzone_shift are named when their parameters,
+//     fitted with the accepted effects, lie beyond tolerances calibrated on effect-free data from
+//     slightly perturbed models and holding them nominal costs more than their chance threshold
+//     of the baseline gap (a parameter that only absorbs the residue of an effect's imperfect form
+//     is not a finding). Beside a position dependence a gain that holds is that dependence's level
+//     (the runs cannot tell the two apart): it is said, not named; a gain that drifts is named.
+// 10. complete_candidate_table: the nominal parameters scored alone beside the first round.
+// 11. check_rest_drift: readings that move while the valve rests inside the dead band
+//     (rest_drift.hpp) leave the gap unexplained: no effect of the vocabulary moves a piston
+//     there, and the windowed gap is blind to a slow drift. Otherwise the gap is unexplained when
+//     it lies above unexplained_factor times the noise floor and, when effects are named, above
+//     unexplained_share of the baseline gap: a rig's effect never has the library's exact form,
+//     and the residue of the named effects' forms is theirs.
+// 12. account_for_sensor_resolution: readings on a grid coarser than the noise name
+//     sensor_quantization and raise the noise floor to what the rounding leaves.
 // Without held-out runs, folds leave one training run out each (cross-validation by run).
 #include <functional>
 #include <string>
