@@ -1,7 +1,7 @@
 #include "commission/commission_sequence.hpp"
 
 #include <chrono>
-#include <cstdio>
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "control/controller.hpp"
@@ -54,13 +54,10 @@ IdentifiedModel keep_cross_validated(std::vector<IdentifiedModel> candidates) {
   const std::size_t splits = candidates.size();
   IdentifiedModel kept = std::move(candidates[stick_slip ? best_stick_slip : best_hammerstein]);
   kept.axis_model = stick_slip ? core::AxisModel::kStickSlip : core::AxisModel::kHammerstein;
-  if (splits > 1 && every_split_has_stick_slip) {
-    char buf[200];
-    std::snprintf(buf, sizeof buf, "; over the %zu splits the %s model describes the axis (best held-out fit %.1f %%, the %s model's %.1f %%)",
-                  splits, stick_slip ? "stick-slip" : "Hammerstein", stick_slip ? stick_slip_pct : hammerstein_pct,
-                  stick_slip ? "Hammerstein" : "stick-slip", stick_slip ? hammerstein_pct : stick_slip_pct);
-    kept.summary += buf;
-  }
+  if (splits > 1 && every_split_has_stick_slip)
+    kept.summary += fmt::format("; over the {} splits the {} model describes the axis (best held-out fit {:.1f} %, the {} model's {:.1f} %)",
+                                splits, stick_slip ? "stick-slip" : "Hammerstein", stick_slip ? stick_slip_pct : hammerstein_pct,
+                                stick_slip ? "Hammerstein" : "stick-slip", stick_slip ? hammerstein_pct : stick_slip_pct);
   return kept;
 }
 
@@ -144,45 +141,63 @@ CommissionOutcome& CommissionSequence::finish(Verdict verdict, const std::string
 CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
   CommissionOutcome out;
   out.spec = spec_in;
-  CommissionSpec& spec = out.spec;
+  const CommissionSpec& spec = start(out);
+  if (auto s = spec.validate(axis_.setpoint_min_mm(), axis_.setpoint_max_mm()); !s) return finish(Verdict::kRolledBack, s.error().message, out);
+  auto previous = axis_.running();
+  if (!previous) return finish(Verdict::kRolledBack, "the running tuning set: " + previous.error().message, out);
+  out.previous_set = previous->set.name;
+  out.previous_set_id = previous->set.id;
+
+  if (!excite_the_axis(spec, out)) return out;
+  const auto identified = identify_cross_validated(previous->model.model.Ts, out);
+  if (!identified) return out;
+  auto set = design_tuning_set(*identified, previous->set, spec, out);
+  if (!set) return out;
+  if (!verify_by_simulation(*set, *identified, spec, out)) return out;
+  const auto set_id = save_and_run(*set, *identified, out);
+  if (!set_id) return out;
+  if (!verify_on_the_axis(spec, out)) return out;
+  return keep(*set_id, set->name, out);
+}
+
+const CommissionSpec& CommissionSequence::start(CommissionOutcome& out) {
   abort_ = false;
   new_set_running_ = false;
   {
     std::lock_guard lock(mutex_);
     progress_ = {};
   }
+  CommissionSpec& spec = out.spec;
   if (spec.name.empty()) spec.name = "commissioned-" + core::utc_stamp(core::unix_time_ms());
-  const double total_s = spec.excitation_runs * spec.excitation_s + kIdentifyWeightS +
-                         static_cast<double>(spec.moves_mm.size()) * spec.move_hold_s;
-  double done_s = 0.0;
-  auto pct = [&] { return 100.0 * done_s / total_s; };
+  total_s_ = spec.excitation_runs * spec.excitation_s + kIdentifyWeightS + static_cast<double>(spec.moves_mm.size()) * spec.move_hold_s;
+  done_s_ = 0.0;
+  return spec;
+}
 
-  if (auto s = spec.validate(axis_.setpoint_min_mm(), axis_.setpoint_max_mm()); !s) return finish(Verdict::kRolledBack, s.error().message, out);
-  auto previous = axis_.running();
-  if (!previous) return finish(Verdict::kRolledBack, "the running tuning set: " + previous.error().message, out);
-  out.previous_set = previous->set.name;
-  out.previous_set_id = previous->set.id;
-  const core::HammersteinModel& old_model = previous->model.model;
+double CommissionSequence::percent_done() const { return 100.0 * done_s_ / total_s_; }
 
-  // 1. The experiment.
+// 1. The experiment: the excitation runs, one seed each.
+bool CommissionSequence::excite_the_axis(const CommissionSpec& spec, CommissionOutcome& out) {
   for (int i = 0; i < spec.excitation_runs; ++i) {
-    char buf[128];
-    std::snprintf(buf, sizeof buf, "excitation run %d of %d (%.0f s, seed %llu)", i + 1, spec.excitation_runs, spec.excitation_s,
-                  static_cast<unsigned long long>(spec.seed + static_cast<std::uint64_t>(i)));
-    step(Stage::kExciting, pct(), buf, out);
-    auto run = axis_.excite({spec.excitation_s, spec.seed + static_cast<std::uint64_t>(i), spec.amplitude_max_v}, abort_);
-    if (aborted(out)) return out;
-    if (!run) return finish(Verdict::kRolledBack, std::string(buf) + ": " + run.error().message, out);
+    const std::uint64_t seed = spec.seed + static_cast<std::uint64_t>(i);
+    const std::string what = fmt::format("excitation run {} of {} ({:.0f} s, seed {})", i + 1, spec.excitation_runs, spec.excitation_s, seed);
+    step(Stage::kExciting, percent_done(), what, out);
+    auto run = axis_.excite({spec.excitation_s, seed, spec.amplitude_max_v}, abort_);
+    if (aborted(out)) return false;
+    if (!run) return finish(Verdict::kRolledBack, what + ": " + run.error().message, out), false;
     out.experiment.push_back(std::move(*run));
-    done_s += spec.excitation_s;
+    done_s_ += spec.excitation_s;
   }
+  return true;
+}
 
-  // 2. Identification, cross-validated: each run is held out once while the others estimate, and
-  // the model that predicts its held-out run best is kept (keep_cross_validated: of the kind that
-  // describes the axis). One short run can leave the search in a model that fits it and nothing
-  // else (held-out fits of 24 % and 88 % were seen on the same rig); trying each split costs
-  // seconds of computation, not another experiment.
-  step(Stage::kIdentifying, pct(), "identifying the Hammerstein model", out);
+// 2. Identification, cross-validated: each run is held out once while the others estimate, and
+// the model that predicts its held-out run best is kept (keep_cross_validated: of the kind that
+// describes the axis). One short run can leave the search in a model that fits it and nothing
+// else (held-out fits of 24 % and 88 % were seen on the same rig); trying each split costs
+// seconds of computation, not another experiment.
+std::optional<IdentifiedModel> CommissionSequence::identify_cross_validated(double loop_period_s, CommissionOutcome& out) {
+  step(Stage::kIdentifying, percent_done(), "identifying the Hammerstein model", out);
   std::vector<IdentifiedModel> candidates;
   std::string first_error;
   for (std::size_t held = out.experiment.size(); held-- > 0;) {
@@ -190,7 +205,7 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
     for (std::size_t i = 0; i < out.experiment.size(); ++i)
       if (i != held) estimation.push_back(out.experiment[i]);
     auto candidate = identify_(estimation, out.experiment[held]);
-    if (aborted(out)) return out;
+    if (aborted(out)) return std::nullopt;
     const std::string which = "run " + std::to_string(held + 1) + " held out: ";
     if (!candidate) {
       out.log.push_back("identification, " + which + candidate.error().message);
@@ -202,24 +217,29 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
     if (log_) log_("commission: identified, " + which + candidate->summary);
     candidates.push_back(std::move(*candidate));
   }
-  if (candidates.empty()) return finish(Verdict::kRolledBack, "identification: " + first_error, out);
-  std::optional<IdentifiedModel> identified = keep_cross_validated(std::move(candidates));
-  identified->model.Ts = old_model.Ts;  // the runs were recorded by this loop, at its period
-  out.identified = *identified;
-  out.log.push_back("identified: " + identified->summary);
-  if (log_) log_("commission: identified: " + identified->summary);
+  if (candidates.empty()) return finish(Verdict::kRolledBack, "identification: " + first_error, out), std::nullopt;
+  IdentifiedModel identified = keep_cross_validated(std::move(candidates));
+  identified.model.Ts = loop_period_s;  // the runs were recorded by this loop, at its period
+  out.identified = identified;
+  out.log.push_back("identified: " + identified.summary);
+  if (log_) log_("commission: identified: " + identified.summary);
+  return identified;
+}
 
-  // 3. Design.
-  step(Stage::kDesigning, pct(), "pole placement from the spec", out);
-  auto design = control::design_from_spec(identified->model, {spec.overshoot_pct, spec.settling_s, identified->model.Ts, spec.observer_pole});
-  if (!design) return finish(Verdict::kRolledBack, "design: " + design.error().message, out);
+// 3. Design: the previous set with the new law, dead zone and arrival; l_c and the valve limit
+// carry over.
+std::optional<store::TuningSet> CommissionSequence::design_tuning_set(const IdentifiedModel& identified, const store::TuningSet& previous,
+                                                                      const CommissionSpec& spec, CommissionOutcome& out) {
+  step(Stage::kDesigning, percent_done(), "pole placement from the spec", out);
+  auto design = control::design_from_spec(identified.model, {spec.overshoot_pct, spec.settling_s, identified.model.Ts, spec.observer_pole});
+  if (!design) return finish(Verdict::kRolledBack, "design: " + design.error().message, out), std::nullopt;
   out.design = *design;
-  store::TuningSet set = previous->set;  // l_c and the valve limit carry over
+  store::TuningSet set = previous;
   set.id = 0;
   set.name = spec.name;
   set.controller = spec.controller;
   set.F = design->F, set.G = design->G, set.H = design->H;
-  set.dead_zone = identified->model.dead_zone;
+  set.dead_zone = identified.model.dead_zone;
   // pp-traj arrives while sliding on an axis that a stick-slip model describes (its coast from it),
   // and approaches again when a stop is further off than 3/4 of the verification's e_ss limit: a
   // stop it accepts passes with a quarter of the limit to spare, and it does not back off for
@@ -229,63 +249,75 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
   // last approach fell into the metrics' window, and rolled back 12 runs of 80 that 3/4 deploys
   // (tests/commission/commission_physics_sweep.cpp, README "Commissioning").
   const auto coast = plant::sliding_arrival_coast_s(
-      core::ModelFile{identified->model, "", identified->stick_slip, identified->axis_model}, set.trajectory.approach_speed_mm_s);
-  if (!coast) return finish(Verdict::kRolledBack, "design: " + coast.error().message, out);
+      core::ModelFile{identified.model, "", identified.stick_slip, identified.axis_model}, set.trajectory.approach_speed_mm_s);
+  if (!coast) return finish(Verdict::kRolledBack, "design: " + coast.error().message, out), std::nullopt;
   set.trajectory.coast_s = *coast;
   set.trajectory.retry_band_mm = 0.75 * spec.limits.ess_mm;
   set.model_id = 0;
-  set.source = "epa commission: " + identified->summary;
+  set.source = "epa commission: " + identified.summary;
   set.design_json = format_commission_spec(spec);
-  if (auto s = store::validate(set, identified->model); !s) return finish(Verdict::kRolledBack, "design: " + s.error().message, out);
+  if (auto s = store::validate(set, identified.model); !s) return finish(Verdict::kRolledBack, "design: " + s.error().message, out), std::nullopt;
+  return set;
+}
 
-  // 4. Simulation on the identified model and its perturbations.
-  step(Stage::kSimulating, pct(), "verification moves in simulation (identified model and robustness cases)", out);
-  auto config = store::controller_config(set, identified->model, 0.0);
+// 4. The verification moves in simulation, on the identified model and its perturbations.
+bool CommissionSequence::verify_by_simulation(const store::TuningSet& set, const IdentifiedModel& identified, const CommissionSpec& spec,
+                                              CommissionOutcome& out) {
+  step(Stage::kSimulating, percent_done(), "verification moves in simulation (identified model and robustness cases)", out);
+  auto config = store::controller_config(set, identified.model, 0.0);
   auto params = control::ControllerParams::make(config);
-  if (!params) return finish(Verdict::kRolledBack, "design: " + params.error().message, out);
-  const auto axis_model = identified->axis_model == core::AxisModel::kStickSlip ? identified->stick_slip : std::nullopt;
-  out.simulation = verify_in_simulation(identified->model, axis_model, *params, spec, axis_.position_mm());
-  if (!out.simulation->passed) return finish(Verdict::kRolledBack, out.simulation->why, out);
-  done_s += kIdentifyWeightS;
-  if (aborted(out)) return out;
+  if (!params) return finish(Verdict::kRolledBack, "design: " + params.error().message, out), false;
+  const auto axis_model = identified.axis_model == core::AxisModel::kStickSlip ? identified.stick_slip : std::nullopt;
+  out.simulation = verify_in_simulation(identified.model, axis_model, *params, spec, axis_.position_mm());
+  if (!out.simulation->passed) return finish(Verdict::kRolledBack, out.simulation->why, out), false;
+  done_s_ += kIdentifyWeightS;
+  return !aborted(out);
+}
 
-  // 5. Store the set (not active), then run it.
-  step(Stage::kSaving, pct(), "saving tuning set '" + set.name + "'", out);
+// 5. The set stored (not active), then run by the loop: its id.
+std::optional<std::int64_t> CommissionSequence::save_and_run(const store::TuningSet& set, const IdentifiedModel& identified,
+                                                             CommissionOutcome& out) {
+  step(Stage::kSaving, percent_done(), "saving tuning set '" + set.name + "'", out);
   store::ModelRecord model{.id = 0, .name = set.name, .created_ms = 0, .source = "identified by epa commission",
-                           .model = identified->model, .fit_json = {}};
-  nlohmann::json fit = {{"estimation_fit_pct", identified->estimation_fit_pct}, {"validation_fit_pct", identified->validation_fit_pct}};
+                           .model = identified.model, .fit_json = {}};
+  nlohmann::json fit = {{"estimation_fit_pct", identified.estimation_fit_pct}, {"validation_fit_pct", identified.validation_fit_pct}};
   model.fit_json = fit.dump();
   auto id = axis_.save(model, set);
-  if (!id) return finish(Verdict::kRolledBack, "saving the set: " + id.error().message, out);
+  if (!id) return finish(Verdict::kRolledBack, "saving the set: " + id.error().message, out), std::nullopt;
   out.new_set = set.name;
   out.new_set_id = *id;
   new_set_running_ = true;  // from here on a failure switches back, even if use_set failed half-way
   if (auto s = axis_.use_set(*id, false, "commissioning: verifying '" + set.name + "'"); !s)
-    return finish(Verdict::kRolledBack, "switching to the new set: " + s.error().message, out);
+    return finish(Verdict::kRolledBack, "switching to the new set: " + s.error().message, out), std::nullopt;
+  return *id;
+}
 
-  // 6. Verification on the axis.
-  double from = axis_.position_mm();
-  for (double to : spec.moves_mm) {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "verification move %.1f -> %.1f mm", from, to);
-    step(Stage::kVerifying, pct(), buf, out);
-    auto run = axis_.move(to, spec.move_hold_s, abort_);
-    if (aborted(out)) return out;
-    if (!run) return finish(Verdict::kRolledBack, std::string(buf) + ": " + run.error().message, out);
-    const auto metrics = core::step_metrics(run->y_mm, to, {.Ts = run->Ts});
-    out.verification.push_back(judge_move(from, to, metrics, spec.limits));
+// 6. The verification moves on the axis, each judged against the spec's limits.
+bool CommissionSequence::verify_on_the_axis(const CommissionSpec& spec, CommissionOutcome& out) {
+  double from_mm = axis_.position_mm();
+  for (double to_mm : spec.moves_mm) {
+    const std::string what = fmt::format("verification move {:.1f} -> {:.1f} mm", from_mm, to_mm);
+    step(Stage::kVerifying, percent_done(), what, out);
+    auto run = axis_.move(to_mm, spec.move_hold_s, abort_);
+    if (aborted(out)) return false;
+    if (!run) return finish(Verdict::kRolledBack, what + ": " + run.error().message, out), false;
+    const auto metrics = core::step_metrics(run->y_mm, to_mm, {.Ts = run->Ts});
+    out.verification.push_back(judge_move(from_mm, to_mm, metrics, spec.limits));
     out.measured_moves.push_back(std::move(*run));
-    done_s += spec.move_hold_s;
-    if (!out.verification.back().passed) return finish(Verdict::kRolledBack, "on the axis: " + out.verification.back().why, out);
-    from = to;
+    done_s_ += spec.move_hold_s;
+    if (!out.verification.back().passed) return finish(Verdict::kRolledBack, "on the axis: " + out.verification.back().why, out), false;
+    from_mm = to_mm;
   }
+  return true;
+}
 
-  // 7. Keep it.
+// 7. Keep it: the store's active set, what a restart loads.
+CommissionOutcome& CommissionSequence::keep(std::int64_t set_id, const std::string& set_name, CommissionOutcome& out) {
   axis_.stop();
-  if (auto s = axis_.use_set(*id, true, "commissioning: '" + set.name + "' passed its verification"); !s)
+  if (auto s = axis_.use_set(set_id, true, "commissioning: '" + set_name + "' passed its verification"); !s)
     return finish(Verdict::kRolledBack, "making the new set active in the store: " + s.error().message, out);
   new_set_running_ = false;
-  return finish(Verdict::kDeployed, "'" + set.name + "' passed every verification move and is the active set", out);
+  return finish(Verdict::kDeployed, "'" + set_name + "' passed every verification move and is the active set", out);
 }
 
 std::string format_commission_json(const CommissionOutcome& o) {

@@ -1,5 +1,5 @@
 #pragma once
-// The commissioning sequence (issue 19): excite -> identify -> design -> verify in simulation ->
+// The commissioning sequence: excite -> identify -> design -> verify in simulation ->
 // save -> use -> verify on the axis -> keep, or roll back to the previous set at once.
 //
 // Nothing is left half-done. The new set is stored but the store's active set changes only when the
@@ -82,6 +82,20 @@ class CommissionSequence {
   Progress progress() const;
 
  private:
+  // run()'s phases, in order. Each that fails or is aborted finishes the outcome (finish()) and
+  // returns false or nothing.
+  const CommissionSpec& start(CommissionOutcome& out);  // the spec as run: named, and the progress reset
+  bool excite_the_axis(const CommissionSpec& spec, CommissionOutcome& out);
+  std::optional<IdentifiedModel> identify_cross_validated(double loop_period_s, CommissionOutcome& out);
+  std::optional<store::TuningSet> design_tuning_set(const IdentifiedModel& identified, const store::TuningSet& previous,
+                                                    const CommissionSpec& spec, CommissionOutcome& out);
+  bool verify_by_simulation(const store::TuningSet& set, const IdentifiedModel& identified, const CommissionSpec& spec,
+                            CommissionOutcome& out);
+  std::optional<std::int64_t> save_and_run(const store::TuningSet& set, const IdentifiedModel& identified, CommissionOutcome& out);
+  bool verify_on_the_axis(const CommissionSpec& spec, CommissionOutcome& out);
+  CommissionOutcome& keep(std::int64_t set_id, const std::string& set_name, CommissionOutcome& out);
+
+  double percent_done() const;  // of the whole sequence, by its expected duration
   void step(Stage stage, double percent, const std::string& message, CommissionOutcome& out);
   CommissionOutcome& finish(Verdict verdict, const std::string& reason, CommissionOutcome& out);
   bool aborted(CommissionOutcome& out);
@@ -93,6 +107,7 @@ class CommissionSequence {
   mutable std::mutex mutex_;
   Progress progress_;
   bool new_set_running_ = false;
+  double total_s_ = 1.0, done_s_ = 0.0;  // the sequence's expected duration (identification weighed as seconds), and what is done
 };
 
 // epa-commission/1: the outcome as JSON (verdict, sets, fit figures, design, simulated and measured
