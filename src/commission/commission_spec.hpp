@@ -9,7 +9,7 @@
 //    "moves_mm": [150, 350, 250], "move_hold_s": 4,
 //    "limits": {"ess_mm": 1, "overshoot_pct": 5, "overshoot_mm": 0, "settling_s": 3},
 //    "robust_gain": 0.2, "robust_breakpoint_v": 0.1,
-//    "robust_limits": {"ess_mm": 15, "overshoot_pct": 100, "settling_s": 0}, "name": "axis-2026-11-24"}
+//    "robust_limits": {"ess_mm": 15, "overshoot_pct": 100, "settling_s": 0}, "name": "axis-2-new-valve"}
 #include <cstdint>
 #include <string>
 #include <vector>

@@ -147,7 +147,7 @@ std::string to_json(const GapReport& r) {
   verdict["text"] = verdict_text(r);
   j["verdict"] = verdict;
 
-  // Beyond FORMATS.md's keys: the re-fit, per-run gaps, the selection steps, residual statistics.
+  // Beyond the keys docs/formats.md gives: the re-fit, per-run gaps, the selection steps, residual statistics.
   ordered_json refit_params = ordered_json::object();
   for (auto k : d.refit.effects.kinds()) refit_params[std::string(plant::to_string(k))] = params_json(d.refit.effects, k, Ts);
   j["refit"] = {{"params", refit_params}, {"heldout_gap_mm", round_to(d.refit_gap_mm, 4)}};

@@ -1,5 +1,5 @@
 #pragma once
-// The diagnosis as a report: the epa-gap-report/1 JSON (FORMATS.md, keys exactly as given there;
+// The diagnosis as a report: the epa-gap-report/1 JSON (docs/formats.md, keys exactly as given there;
 // extra keys only added beside them) and the numbers the HTML report draws.
 #include <string>
 #include <vector>
