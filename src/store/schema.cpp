@@ -98,7 +98,7 @@ INSERT INTO tuning_sets_v3 (id, name, created_ms, modified_ms, source, model_id,
 DROP TABLE tuning_sets;
 ALTER TABLE tuning_sets_v3 RENAME TO tuning_sets;
 )sql",
-    // 4: the fault history (issue 16): each fault the loop latched, with its cause; the store thread
+    // 4: the fault history: each fault the loop latched, with its cause; the store thread
     // keeps the newest 64 (store/fault_table.hpp). AUTOINCREMENT: an id is never reused, so the
     // newest id is the number of faults since the store was created.
     R"sql(

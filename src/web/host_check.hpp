@@ -2,8 +2,8 @@
 // The Host header check against DNS rebinding: a hostile page whose name is made to resolve to the
 // appliance reaches it from an operator's browser, and the browser lets the page read the answers
 // because the name is the page's own. The request still carries that name as its Host, so only
-// names the appliance knows as its own are served: an IP literal of this machine (or any loopback
-// address), "localhost", the machine's host name, and the names listed in [web] host_names.
+// names the appliance knows as its own are served: an IP literal of the appliance's host (or any
+// loopback address), "localhost", the host's name, and the names listed in [web] host_names.
 #include <chrono>
 #include <mutex>
 #include <set>
@@ -26,7 +26,7 @@ class HostCheck {
 
   std::set<std::string> names_;  // lower case, without a trailing dot
   std::mutex mutex_;
-  std::set<std::string> addresses_;  // this machine's, refreshed now and then (DHCP may change them)
+  std::set<std::string> addresses_;  // the host's, refreshed now and then (DHCP may change them)
   std::chrono::steady_clock::time_point refreshed_{};
 };
 

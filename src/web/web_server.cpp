@@ -217,7 +217,7 @@ struct WebServer::Impl {
     res.set_content(R"({"accepted":true})", kJson);
   }
 
-  // Commissioning (issue 19): starting and aborting need the token; progress, result and report
+  // Commissioning: starting and aborting need the token; progress, result and report
   // are read like the status.
   void commission_routes() {
     auto& s = server;

@@ -29,7 +29,7 @@ struct WebConfig {
   std::size_t max_body_bytes = 4096;
   int request_deadline_ms = 2000;    // a request's head and body arrive within this of its first byte, or 408
   int max_connections_per_address = 32;  // more from one client address are closed at once (503)
-  // Names (or addresses) besides this machine's own addresses, "localhost" and its host name that a
+  // Names (or addresses) besides the host's own addresses, "localhost" and its host name that a
   // request's Host may carry; any other is refused 421 (a DNS-rebinding page carries its own name).
   std::vector<std::string> host_names;
   std::function<void(const std::string&)> log;  // token lock-outs; may be empty
