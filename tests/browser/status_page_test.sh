@@ -65,8 +65,10 @@ soft_max_mm = 300
 setpoint_max_mm = 300" --mode run --setpoint 50
 modbus_port=$port
 
-# Let the piston reach 50 mm so that the trend has a story to show.
-sleep 2
+# Let the piston reach 50 mm so that the trend has a story to show (bounded; (1) judges the page).
+status_field() { http_get "${url}api/status" | grep -o "\"$1\":[^,}]*" | head -1 | sed 's/.*://; s/"//g'; }
+at_50() { awk -v p="$(status_field position_mm)" 'BEGIN { exit !(p != "" && p > 48 && p < 52) }'; }
+wait_until 10000 at_50 || true
 
 # ---- (1) the page draws the trend and shows the position ----
 dom=$(dump_dom)
@@ -115,7 +117,8 @@ grep -q 'id="fault-history" data-count="0"' <<<"$(dump_dom)" && pass "(3) the Fa
   || fail "(3) the Fault history card should read data-count=\"0\" before any fault"
 out=$(mbpoll -m tcp -a 1 -p "$modbus_port" -0 -1 -o 1 -r 2 "$host" 2 2>&1)  # mode 2: MANUAL
 grep -q "Written 1 references" <<<"$out" || fail "(3) writing mode 2 (MANUAL) over Modbus: $out"
-sleep 0.2
+in_manual() { [ "$(status_field mode)" = manual ]; }
+wait_until 5000 in_manual || true  # the scan cycle has taken the mode (the fault check below judges)
 out=$(mbpoll -m tcp -a 1 -p "$modbus_port" -0 -1 -o 1 -t 4:float -B -r 4 "$host" 1.5 2>&1)  # manual_valve_v: up towards 300 mm
 grep -q "Written 1 references" <<<"$out" || fail "(3) writing manual_valve_v 1.5 over Modbus: $out"
 faulted=0

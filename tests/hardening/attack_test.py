@@ -43,7 +43,7 @@ import threading
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from epa_appliance import HOST, UNIT, UNLOCK_ADDRESS, UNLOCK_KEY, Appliance, f32_words, key_words  # noqa: E402
+from epa_appliance import HOST, UNIT, UNLOCK_ADDRESS, UNLOCK_KEY, Appliance, f32_words, key_words, wait_until  # noqa: E402
 
 M_R = 20
 failures = []
@@ -100,6 +100,13 @@ def input_u32(s, address):
     return struct.unpack(">I", payload[1:5])[0]
 
 
+def clients_seen_by(s):
+    """modbus_clients (input register 126): the connected clients the appliance counts."""
+    s.sendall(fc4(9, 126, 1))
+    fc, payload = read_answer(s)
+    return struct.unpack(">H", payload[1:3])[0]
+
+
 def discrete_locked(s):
     s.sendall(struct.pack(">HHHBBHH", 2, 0, 6, UNIT, 0x02, 3, 1))  # discrete input 3: locked
     fc, payload = read_answer(s)
@@ -122,7 +129,7 @@ def brute_force(app):
     failures_count = input_u32(s, 132)
     check(failures_count >= 50, f"unlock_failures >= 50 ({failures_count})")
     s.close()
-    time.sleep(0.2)
+    wait_until(lambda: "refused for 10 s" in app.log_text(), 5.0, 0.05)  # the log line, bounded
     log = app.log_text()
     check("127.0.0.2:" in log and "wrong unlock key" in log and "refused for 10 s" in log,
           "the log names the address and the lock-out")
@@ -137,7 +144,7 @@ def unlock_scope(app):
     a.sendall(fc16(3, M_R, f32_words(1.8, "ABCD")))
     check(exception_of(read_answer(a)) == 0, "the unlocked connection can")
     a.close()
-    time.sleep(0.3)
+    wait_until(lambda: clients_seen_by(b) == 1, 3.0, 0.02)  # the appliance has dropped a
     c = connect(app.port)
     c.sendall(fc16(4, M_R, f32_words(1.9, "ABCD")))
     check(exception_of(read_answer(c)) == 4, "after the unlocked connection closed, a new one is locked")
@@ -167,7 +174,7 @@ def poll_while_held(app, idle, slow, seconds):
     slow_threads = [threading.Thread(target=dribble, daemon=True) for _ in range(slow)]
     for t in slow_threads:
         t.start()
-    time.sleep(1.5)  # the slow ones are mid-frame now
+    time.sleep(1.5)  # stays, the stimulus: the slow ones are mid-frame now
     served = total = 0
     client = None
     deadline = time.monotonic() + seconds
@@ -286,7 +293,7 @@ def slow_http(app, connections, seconds):
     threads = [threading.Thread(target=dribble, args=(f"127.0.0.{10 + i % 20}",), daemon=True) for i in range(connections)]
     for t in threads:
         t.start()
-    time.sleep(2.0)
+    time.sleep(2.0)  # stays, the stimulus: the crowd connects and dribbles before the polls
     served = total = 0
     slowest_s, unexpected = 0.0, set()
     deadline = time.monotonic() + seconds
@@ -352,7 +359,7 @@ def http_rows(app, hold_s):
                b"Content-Type: application/json\r\nContent-Length: %d\r\nConnection: close\r\n\r\n%s" % (i, len(body), body))
         codes.append(http_raw(app.web_port, req)[0][9:12])
     check(codes[:5] == ["401"] * 5 and set(codes[5:]) == {"429"}, f"token guessing: 401 five times, then 429: {codes}")
-    time.sleep(0.2)
+    wait_until(lambda: "wrong tokens from 127.0.0.1" in app.log_text(), 5.0, 0.05)  # the log line, bounded
     check("wrong tokens from 127.0.0.1" in app.log_text(), "the log names the guessing address")
 
 

@@ -201,7 +201,7 @@ def one_fault(rig, target, name, command, undo, code, sensor):
     if not check(failures, reached, "" if reached else f"{name}: the piston did not reach {target} mm before the fault {rig.state()}"):
         return failures, None
     rig.write(0, f32_words(target + (60.0 if target < 250 else -60.0), "ABCD"))  # moving when the fault comes
-    time.sleep(0.15)
+    time.sleep(0.15)  # stays, the stimulus: the fault comes 0.15 s into the move
     t0 = time.monotonic()
     if command:
         rig.plant.command(command)
@@ -339,7 +339,7 @@ def sigkill_and_restart(rig, written):
     failures = []
     rig.move_to(200.0)
     rig.write(0, f32_words(300.0, "ABCD"))
-    time.sleep(0.1)
+    time.sleep(0.1)  # stays, the stimulus: the kill comes 0.1 s into the move
     rig.app.kill()
     t0 = time.monotonic()
     safe = wait_until(lambda: rig.plant.status()["watchdog"] == "tripped" and float(rig.plant.status()["valve"]) == 0.0, 1.0)

@@ -69,7 +69,7 @@ def main():
         check(r.returncode == 1 and "excitation_s" in r.stderr and "[recorder] buffer_s" in r.stderr and took < 10,
               f"an experiment longer than the recorder's ring is refused before anything runs (exit {r.returncode}, "
               f"{took:.1f} s): {r.stderr.strip()}")
-        time.sleep(0.5)
+        time.sleep(0.5)  # stays: time for a wrong change of mode to show, were there one
         check(mode(app) == RUN, f"the mode is left as it was (RUN): reads {mode(app)}")
 
         # Without a token: refused naming where to give one; with --token-file: it is read.

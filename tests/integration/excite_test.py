@@ -19,7 +19,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from epa_appliance import UNIT, Appliance, Checks, f32_value, f32_words, u32_value, u32_words, unlock  # noqa: E402
+from epa_appliance import UNIT, Appliance, Checks, f32_value, f32_words, u32_value, u32_words, unlock, wait_until  # noqa: E402
 
 ILLEGAL_VALUE = 0x03
 CANNOT_APPLY = 0x04
@@ -114,7 +114,8 @@ def main():
         check(valves and max(abs(v) for v in valves) <= AMPLITUDE_MAX_V + 1e-6 and max(abs(v) for v in valves) > 0.5,
               f"the valve moved within +-{AMPLITUDE_MAX_V} V (largest seen {max((abs(v) for v in valves), default=0):.3f})")
         check(input_f32(VALVE) == 0.0 and input_f32(EXCITE_LEFT) == 0.0, "after it: the valve safe, excite_left_s 0")
-        time.sleep(0.3)  # the recorder thread polls every 20 ms
+        # The recorder thread polls every 20 ms and writes the file whole (a rename): wait for it, bounded.
+        wait_until(lambda: glob.glob(os.path.join(app.dir, "runs", f"excite-*-seed{SEED}.csv")), 5.0, 0.02)
     finally:
         status = app.stop()
     check(status == 0, f"epa serve stopped cleanly ({status})")

@@ -28,7 +28,7 @@ import time
 import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from epa_appliance import HOST, UNIT, Appliance, Checks, ModbusTcpClient, f32_value, f32_words, u32_value, u32_words, wait_until  # noqa: E402
+from epa_appliance import HOST, UNIT, Appliance, Checks, ModbusTcpClient, f32_value, f32_words, u32_value, u32_words, wait_until, wait_until_steady  # noqa: E402
 
 SOFT_MAX_MM = 300.0
 MANUAL_V = 1.5
@@ -153,10 +153,10 @@ def main():
         caused.append(("following-error", "run", target))
 
         # 2: heartbeat-lost in MANUAL, the valve at its safe command: the heartbeat stops for 0.3 s.
-        time.sleep(1.0)  # the piston comes to rest
+        wait_until_steady(rig.position, 0.05, 5.0)  # the piston comes to rest (bounded)
         before = rig.faults_counter()
         rig.write(2, [2])
-        time.sleep(0.1)
+        wait_until(lambda: rig.mode() == 2, 2.0)  # MANUAL taken before the heartbeat stops
         rig.beating.clear()
         check(wait_until(lambda: rig.faults_counter() == before + 1, 3.0), "heartbeat-lost: latched")
         rig.beating.set()
@@ -165,7 +165,7 @@ def main():
         position_before_soft_limit = rig.position()
 
         # 3: soft-limit in MANUAL: 1.5 V (beyond the dead zone) drives the piston up past soft_max_mm.
-        time.sleep(0.5)
+        wait_until_steady(rig.position, 0.05, 5.0)  # at rest again (bounded)
         before = rig.faults_counter()
         rig.write(2, [2])
         check(wait_until(lambda: rig.mode() == 2, 2.0), "soft-limit: MANUAL")
@@ -173,7 +173,9 @@ def main():
         check(wait_until(lambda: rig.faults_counter() == before + 1, 10.0), "soft-limit: latched")
         check(wait_until(lambda: rig.mode() == 0, 2.0), "soft-limit: reset to STOP at once by the second client")
         caused.append(("soft-limit", "manual", target))
-        time.sleep(0.3)  # the supervisor drains the ring every 50 ms; the store thread writes it at once
+        # The supervisor drains the ring every 50 ms and the store thread writes it at once; the
+        # resetting client has timed the third fault (bounded wait; the checks below judge).
+        wait_until(lambda: len(rig.latched_ms) == 3 and http_json(app, "/api/faults")["count"] == 3, 5.0, 0.05)
         shown = ", ".join(f"{ms:.1f}" for ms in rig.latched_ms)
         check(len(rig.latched_ms) == 3 and max(rig.latched_ms) < 50.0,
               f"each fault was visible to the resetting client for less than the supervisor's 50 ms tick: {shown} ms")

@@ -210,7 +210,7 @@ class EpaMapTest(ApplianceTest):
         self.assertGreater(u32_value(s[14:16]), 0, "modbus_requests")
         self.assertGreaterEqual(s[16], 1, "modbus_clients")
         # The loop runs: cycles and uptime advance.
-        time.sleep(0.1)
+        time.sleep(0.1)  # stays, the stimulus: 0.1 s of loop cycles
         later = self.regs(4, 90, 14, "input 90-103")
         self.assertGreater(u32_value(later[12:14]), u32_value(loop[12:14]), "cycles advance")
 

@@ -11,6 +11,19 @@ failed=0
 
 now_ms() { echo $(( ${EPOCHREALTIME/./} / 1000 )); }
 
+# wait_until MS COMMAND [ARGS...]: runs COMMAND every 50 ms until it succeeds or MS milliseconds
+# have passed, and returns whether it succeeded (tried once more at the deadline). A wait for an
+# event instead of a fixed sleep; the test then checks what it checked before.
+wait_until() {
+  local deadline=$(( $(now_ms) + $1 ))
+  shift
+  while [ "$(now_ms)" -lt "$deadline" ]; do
+    "$@" && return 0
+    sleep 0.05
+  done
+  "$@"
+}
+
 # Stops the appliance by its PID; returns its exit status.
 stop_appliance() {
   [ -n "$pid" ] || return 0

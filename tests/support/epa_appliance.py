@@ -86,6 +86,20 @@ def wait_until(predicate, timeout_s, every_s=0.01):
     return predicate()
 
 
+def wait_until_steady(read, tolerance, timeout_s, every_s=0.1):
+    """Polls `read` every `every_s` until two readings in a row differ by at most `tolerance` (at
+    rest) or `timeout_s` has passed; returns whether it came to rest."""
+    deadline = time.monotonic() + timeout_s
+    last = read()
+    while time.monotonic() < deadline:
+        time.sleep(every_s)
+        now = read()
+        if abs(now - last) <= tolerance:
+            return True
+        last = now
+    return False
+
+
 def stop_process(proc, grace_s=5.0):
     """Stops a child by its PID: SIGTERM, SIGKILL after `grace_s`."""
     proc.terminate()
