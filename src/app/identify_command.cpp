@@ -137,17 +137,125 @@ void print_dead_band(std::ostream& out, const ident::DeadBandReading& band) {
   }
 }
 
-}  // namespace
-
-int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err) {
-  auto fail = [&](const std::string& message) { return err << "epa identify: " << message << "\n", 1; };
+core::Result<ident::OrderSearch> order_search(const IdentifyOptions& o) {
   const auto na = ident::parse_order_range(o.na, "--na");
   const auto nb = ident::parse_order_range(o.nb, "--nb");
   const auto nk = ident::parse_order_range(o.nk, "--nk");
   for (const auto* r : {&na, &nb, &nk})
-    if (!*r) return fail(r->error().message);
-  const ident::OrderSearch search{.na = *na, .nb = *nb, .nk = *nk, .tolerance_pct = o.tolerance_pct};
-  const auto nesting = nesting_orders(search);
+    if (!*r) return r->error();
+  return ident::OrderSearch{.na = *na, .nb = *nb, .nk = *nk, .tolerance_pct = o.tolerance_pct};
+}
+
+// Step 1's settings: the dead zone by the swarm, with the ARX part of the nesting order solved
+// inside every evaluation; its progress lines go to `err`.
+ident::IdentificationOptions identification_options(const IdentifyOptions& o, const ident::OrderSearch& search,
+                                                    const ident::ArxOrders& nesting, double Ts, std::ostream& err) {
+  ident::IdentificationOptions options;
+  options.search = search;
+  options.swarm.orders = nesting;
+  options.swarm.seed = o.seed;
+  options.swarm.particles = o.particles;
+  options.swarm.generations = o.generations;
+  options.swarm.m_l = o.m_l;
+  options.swarm.progress_every = std::max(1u, o.generations / 6);
+  options.swarm.progress = [&err](const ident::FitProgress& p) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "  generation %u/%u: V = %.4e, b_r = %.4f V, b_l = %.4f V, m_r/m_l = %.4f (%zu fits)\n",
+                  p.generation, p.generations, p.best_loss, p.best.b_r, p.best.b_l, p.best.m_r / p.best.m_l, p.evaluations);
+    err << buf << std::flush;
+  };
+  options.criterion = o.criterion == "simulation" ? ident::FitCriterion::kSimulation : ident::FitCriterion::kOneStep;
+  options.window_s = o.window_s;
+  options.ramp_band = o.break_points == "ramps";
+  options.Ts = Ts;
+  options.mm_per_volt = o.mm_per_volt;
+  return options;
+}
+
+void print_swarm_header(std::ostream& out, const IdentifyOptions& o, const ident::ArxOrders& nesting) {
+  out << "\nDead zone: particle swarm (pagmo2 PSO, seed " << o.seed << ", " << o.particles << " particles x "
+      << o.generations << " generations) over m_r/m_l, b_r, b_l, with ARX " << nesting.to_string()
+      << " by least squares inside each evaluation, then a compass-search polish\n"
+      << std::flush;  // the progress lines go to err meanwhile
+}
+
+void print_order_selection(std::ostream& out, const IdentifyOptions& o, const ident::Identification& identified) {
+  if (o.criterion == "simulation") {
+    if (identified.dead_band) print_dead_band(out, *identified.dead_band);
+    out << "\nRefinement: every order's A, B and dead zone moved to minimise the free-run simulation error "
+        << (o.window_s > 0.0 ? "(restarted from the measured position every " + format_number(o.window_s) + " s)"
+                             : std::string("over whole runs"))
+        << " (Levenberg-Marquardt), starting from least squares on the swarm's dead zone"
+        << (identified.dead_band ? "" : "; break points free") << "\n";
+    out << "\nOrder selection (refined models; fit % = 100 (1 - |y - yhat| / |y - mean y|), pooled over runs; "
+           "loss V: the simulation error):\n";
+  } else {
+    out << "\nOrder selection (ARX on u_d = dead zone(u); fit % = 100 (1 - |y - yhat| / |y - mean y|), pooled over runs):\n";
+  }
+  out << ident::format_order_table(identified.selection) << "Recommended " << identified.selection.reason << "\n";
+}
+
+// The stick-slip model fitted from the Hammerstein model and printed, when not --no-stick-slip.
+core::Result<std::optional<ident::StickSlipIdentification>> fit_stick_slip(const IdentifyOptions& o, const std::vector<ident::Segment>& est,
+                                                                          const std::vector<ident::Segment>& val,
+                                                                          const core::HammersteinModel& model, int nk,
+                                                                          const report::ModelFitSummary& summary, std::ostream& out) {
+  if (!o.stick_slip) return std::optional<ident::StickSlipIdentification>{};
+  out << "\nStick-slip model (plant/stick_slip_model.hpp: flow dead zone, air spring, sliding and breakaway "
+         "friction, spool lag, dead time), fitted on the free-run simulation error (BOBYQA) from the model above:\n"
+      << std::flush;
+  ident::StickSlipFitOptions fit_options;
+  fit_options.Ts = model.Ts;
+  fit_options.mm_per_volt = o.mm_per_volt;
+  auto fitted = ident::identify_stick_slip(est, val, model, nk, fit_options);
+  if (!fitted) return fitted.error();
+  report::print_stick_slip(out, *fitted, summary);
+  return std::optional(std::move(*fitted));
+}
+
+// The model file's and the store's `source`: orders, runs, the fit that scores it, the seed.
+std::string model_source(const IdentifyOptions& o, const ident::ArxOrders& chosen, const report::ModelFitSummary& summary,
+                         const std::optional<ident::StickSlipIdentification>& stick_slip) {
+  std::string runs_text;
+  for (const auto& r : o.runs) runs_text += (runs_text.empty() ? "" : ", ") + r;
+  char source[640];
+  const char* scored = summary.validated ? "validation" : "estimation";
+  const int used = std::snprintf(source, sizeof source, "epa identify: %s from %s; %s free-run fit %.2f %%; PSO seed %llu%s",
+                                 chosen.to_string().c_str(), runs_text.c_str(), scored,
+                                 summary.validated ? summary.validation.simulation_pct : summary.estimation.simulation_pct,
+                                 static_cast<unsigned long long>(o.seed),
+                                 o.criterion == "simulation" ? ", refined on the simulation error" : "");
+  if (stick_slip && used > 0 && static_cast<std::size_t>(used) < sizeof source)
+    std::snprintf(source + used, sizeof source - static_cast<std::size_t>(used), "; stick-slip model: %s free-run fit %.2f %%",
+                  scored, summary.validated ? stick_slip->validation_pct : stick_slip->estimation_pct);
+  return source;
+}
+
+core::Status save_identified(const IdentifyOptions& o, const core::HammersteinModel& model, const std::string& source,
+                             const ident::ArxOrders& chosen, const report::ModelFitSummary& summary,
+                             const std::optional<ident::StickSlipIdentification>& stick_slip, std::ostream& out) {
+  const nlohmann::json fit_json = {
+      {"orders", chosen.to_string()}, {"runs", o.runs}, {"validation_runs", o.validate},
+      {"estimation", {{"one_step_pct", summary.estimation.one_step_pct}, {"simulation_pct", summary.estimation.simulation_pct}}},
+      {"validation", summary.validated ? nlohmann::json{{"one_step_pct", summary.validation.one_step_pct},
+                                                        {"simulation_pct", summary.validation.simulation_pct}}
+                                       : nlohmann::json(nullptr)},
+      {"pso_seed", o.seed}, {"criterion", o.criterion},
+      {"stick_slip", stick_slip ? report::stick_slip_json(*stick_slip, summary.validated) : nlohmann::json(nullptr)}};
+  auto id = appliance::save_model(o.db_path, {.id = 0, .name = o.save_name, .created_ms = 0, .source = source, .model = model,
+                                              .fit_json = fit_json.dump()});
+  if (!id) return id.error();
+  out << "model saved as '" << o.save_name << "' (id " << *id << ") in " << o.db_path << "\n";
+  return core::ok();
+}
+
+}  // namespace
+
+int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err) {
+  auto fail = [&](const std::string& message) { return err << "epa identify: " << message << "\n", 1; };
+  const auto search = order_search(o);
+  if (!search) return fail(search.error().message);
+  const auto nesting = nesting_orders(*search);
   if (!nesting) return fail(nesting.error().message);
   // A store that --save cannot use is said before the fit, not after it with the model file written.
   if (!o.save_name.empty())
@@ -161,102 +269,30 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   if (!val) return fail(val.error().message);
   const auto est_segments = all_segments(*est), val_segments = all_segments(*val);
 
-  // Step 1: the dead zone, with the ARX part of the nesting order solved inside every evaluation.
-  out << "\nDead zone: particle swarm (pagmo2 PSO, seed " << o.seed << ", " << o.particles << " particles x "
-      << o.generations << " generations) over m_r/m_l, b_r, b_l, with ARX " << nesting->to_string()
-      << " by least squares inside each evaluation, then a compass-search polish\n"
-      << std::flush;  // the progress lines go to err meanwhile
-  const bool refining = o.criterion == "simulation";
-  ident::IdentificationOptions options;
-  options.search = search;
-  options.swarm.orders = *nesting;
-  options.swarm.seed = o.seed;
-  options.swarm.particles = o.particles;
-  options.swarm.generations = o.generations;
-  options.swarm.m_l = o.m_l;
-  options.swarm.progress_every = std::max(1u, o.generations / 6);
-  options.swarm.progress = [&err](const ident::FitProgress& p) {
-    char buf[200];
-    std::snprintf(buf, sizeof buf, "  generation %u/%u: V = %.4e, b_r = %.4f V, b_l = %.4f V, m_r/m_l = %.4f (%zu fits)\n",
-                  p.generation, p.generations, p.best_loss, p.best.b_r, p.best.b_l, p.best.m_r / p.best.m_l, p.evaluations);
-    err << buf << std::flush;
-  };
-  options.criterion = refining ? ident::FitCriterion::kSimulation : ident::FitCriterion::kOneStep;
-  options.window_s = o.window_s;
-  options.ramp_band = o.break_points == "ramps";
-  options.Ts = *Ts;
-  options.mm_per_volt = o.mm_per_volt;
-  auto identified = ident::identify_hammerstein(est_segments, val_segments, options);
+  print_swarm_header(out, o, *nesting);
+  auto identified = ident::identify_hammerstein(est_segments, val_segments, identification_options(o, *search, *nesting, *Ts, err));
   if (!identified) return fail(identified.error().message);
-
-  if (refining) {
-    if (identified->dead_band) print_dead_band(out, *identified->dead_band);
-    out << "\nRefinement: every order's A, B and dead zone moved to minimise the free-run simulation error "
-        << (o.window_s > 0.0 ? "(restarted from the measured position every " + format_number(o.window_s) + " s)"
-                             : std::string("over whole runs"))
-        << " (Levenberg-Marquardt), starting from least squares on the swarm's dead zone"
-        << (identified->dead_band ? "" : "; break points free") << "\n";
-    out << "\nOrder selection (refined models; fit % = 100 (1 - |y - yhat| / |y - mean y|), pooled over runs; "
-           "loss V: the simulation error):\n";
-  } else {
-    out << "\nOrder selection (ARX on u_d = dead zone(u); fit % = 100 (1 - |y - yhat| / |y - mean y|), pooled over runs):\n";
-  }
-  out << ident::format_order_table(identified->selection) << "Recommended " << identified->selection.reason << "\n";
+  print_order_selection(out, o, *identified);
   ident::HammersteinFit fit = std::move(identified->fit);
   fit.evaluations += identified->swarm_evaluations;
   const ident::ArxOrders chosen = fit.arx.model.orders;
   const core::HammersteinModel model = fit.model(*Ts, o.mm_per_volt);
   if (auto s = model.validate(); !s) return fail("the identified model is not valid: " + s.error().message);
-
   const report::ModelFitSummary summary = report::summarise_fit(fit, est_segments, val_segments, identified->selection.first);
   report::print_identified_model(out, fit, model, summary, o.m_l);
+  const auto stick_slip = fit_stick_slip(o, est_segments, val_segments, model, chosen.nk, summary, out);
+  if (!stick_slip) return fail(stick_slip.error().message);
+  const std::optional<core::StickSlipParams> stick_slip_params =  // what the model file and the plot take
+      *stick_slip ? std::optional((*stick_slip)->fit.params) : std::nullopt;
 
-  std::optional<ident::StickSlipIdentification> stick_slip;
-  std::optional<core::StickSlipParams> stick_slip_params;  // what the model file and the plot take
-  if (o.stick_slip) {
-    out << "\nStick-slip model (plant/stick_slip_model.hpp: flow dead zone, air spring, sliding and breakaway "
-           "friction, spool lag, dead time), fitted on the free-run simulation error (BOBYQA) from the model above:\n"
-        << std::flush;
-    ident::StickSlipFitOptions fit_options;
-    fit_options.Ts = *Ts;
-    fit_options.mm_per_volt = o.mm_per_volt;
-    auto fitted = ident::identify_stick_slip(est_segments, val_segments, model, chosen.nk, fit_options);
-    if (!fitted) return fail(fitted.error().message);
-    stick_slip = *fitted;
-    stick_slip_params = fitted->fit.params;
-    report::print_stick_slip(out, *stick_slip, summary);
-  }
-
-  std::string runs_text;
-  for (const auto& r : o.runs) runs_text += (runs_text.empty() ? "" : ", ") + r;
-  char source[640];
-  const char* scored = summary.validated ? "validation" : "estimation";
-  const int used = std::snprintf(source, sizeof source, "epa identify: %s from %s; %s free-run fit %.2f %%; PSO seed %llu%s",
-                                 chosen.to_string().c_str(), runs_text.c_str(), scored,
-                                 summary.validated ? summary.validation.simulation_pct : summary.estimation.simulation_pct,
-                                 static_cast<unsigned long long>(o.seed), refining ? ", refined on the simulation error" : "");
-  if (stick_slip && used > 0 && static_cast<std::size_t>(used) < sizeof source)
-    std::snprintf(source + used, sizeof source - static_cast<std::size_t>(used), "; stick-slip model: %s free-run fit %.2f %%",
-                  scored, summary.validated ? stick_slip->validation_pct : stick_slip->estimation_pct);
+  const std::string source = model_source(o, chosen, summary, *stick_slip);
   if (!o.out_path.empty()) {
-    const auto axis = stick_slip ? report::axis_model_verdict(*stick_slip, summary) : core::AxisModel::kHammerstein;
+    const auto axis = *stick_slip ? report::axis_model_verdict(**stick_slip, summary) : core::AxisModel::kHammerstein;
     if (auto s = core::write_model_file(o.out_path, {model, source, stick_slip_params, axis}); !s) return fail(s.error().message);
     out << "\nmodel written to " << o.out_path << "\n";
   }
-  if (!o.save_name.empty()) {
-    const nlohmann::json fit_json = {
-        {"orders", chosen.to_string()}, {"runs", o.runs}, {"validation_runs", o.validate},
-        {"estimation", {{"one_step_pct", summary.estimation.one_step_pct}, {"simulation_pct", summary.estimation.simulation_pct}}},
-        {"validation", summary.validated ? nlohmann::json{{"one_step_pct", summary.validation.one_step_pct},
-                                                          {"simulation_pct", summary.validation.simulation_pct}}
-                                         : nlohmann::json(nullptr)},
-        {"pso_seed", o.seed}, {"criterion", o.criterion},
-        {"stick_slip", stick_slip ? report::stick_slip_json(*stick_slip, summary.validated) : nlohmann::json(nullptr)}};
-    auto id = appliance::save_model(o.db_path, {.id = 0, .name = o.save_name, .created_ms = 0, .source = source, .model = model,
-                                     .fit_json = fit_json.dump()});
-    if (!id) return fail("--save: " + id.error().message);
-    out << "model saved as '" << o.save_name << "' (id " << *id << ") in " << o.db_path << "\n";
-  }
+  if (!o.save_name.empty())
+    if (auto s = save_identified(o, model, source, chosen, summary, *stick_slip, out); !s) return fail("--save: " + s.error().message);
   if (!o.plot_path.empty()) {
     const auto& shown = val->empty() ? *est : *val;
     if (auto s = write_output(o.plot_path, report::render_identification_plot(shown, fit, model, !val->empty(), stick_slip_params), out);
