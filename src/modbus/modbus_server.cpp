@@ -14,6 +14,8 @@
 #include <cstring>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "core/ip_address.hpp"
 #include "core/listen_backlog.hpp"
 #include "modbus/slot_log.hpp"
@@ -151,7 +153,7 @@ bool ModbusServer::Impl::make_room(const std::string& ip, std::int64_t now_ns) {
 // Closes client `i`; `why` (null: an eviction, counted elsewhere) goes to the log, rate-limited.
 void ModbusServer::Impl::drop(std::size_t i, const char* why) {
   const std::int64_t now_ns = clock.now_ns();
-  if (log && why && slot_log.disconnect_line(now_ns)) log("modbus: client " + clients[i].session.peer + " disconnected (" + why + ")");
+  if (log && why && slot_log.disconnect_line(now_ns)) log(fmt::format("modbus: client {} disconnected ({})", clients[i].session.peer, why));
   handler.connection_closed(clients[i].session);
   ::close(clients[i].fd);
   clients.erase(clients.begin() + static_cast<std::ptrdiff_t>(i));

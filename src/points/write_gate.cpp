@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "core/format.hpp"
 #include "points/point_catalog.hpp"
 #include "points/tuning_values.hpp"
@@ -186,10 +188,10 @@ GateResult WriteGate::check_values(std::span<const PointWrite> writes) const {
   for (const PointWrite& w : writes) {
     if (index(w.id) >= kPointCount) return refuse(Refusal::kNotWritable, "unknown point");
     const PointDef& p = point(w.id);
-    if (!p.gated()) return refuse(Refusal::kNotWritable, quoted(w.id) + " is read-only");
+    if (!p.gated()) return refuse(Refusal::kNotWritable, fmt::format("{} is read-only", quoted(w.id)));
     if (auto e = limits_.check(w.id, w.value); !e.empty()) return refuse(Refusal::kInvalidValue, e);
     if (p.integer && w.value != std::floor(w.value))
-      return refuse(Refusal::kInvalidValue, quoted(w.id) + " takes whole numbers, not " + core::format_number(w.value));
+      return refuse(Refusal::kInvalidValue, fmt::format("{} takes whole numbers, not {}", quoted(w.id), core::format_number(w.value)));
   }
   return {};
 }
@@ -199,15 +201,15 @@ GateResult WriteGate::check_rights(std::span<const PointWrite> writes, const Req
   if (!who.may_write) return refuse(Refusal::kForbidden, who.no_write_reason.empty() ? "this client may not write" : who.no_write_reason);
   for (const PointWrite& w : writes)
     if (point(w.id).tuning() && !who.tuning_unlocked)
-      return refuse(Refusal::kForbidden, quoted(w.id) + " is a tuning point: unlock the tuning first");
+      return refuse(Refusal::kForbidden, fmt::format("{} is a tuning point: unlock the tuning first", quoted(w.id)));
   return {};
 }
 
 // A commissioning command is written alone, and only to a gate with a service behind it.
 GateResult WriteGate::check_commission_command(std::span<const PointWrite> writes) const {
   const std::string point = quoted(PointId::kCommissionCommand);
-  if (writes.size() > 1) return refuse(Refusal::kInvalidValue, point + " is written alone");
-  if (!commission_) return refuse(Refusal::kNotWritable, point + ": this appliance runs no commissioning service");
+  if (writes.size() > 1) return refuse(Refusal::kInvalidValue, fmt::format("{} is written alone", point));
+  if (!commission_) return refuse(Refusal::kNotWritable, fmt::format("{}: this appliance runs no commissioning service", point));
   return {};
 }
 
@@ -218,12 +220,12 @@ GateResult WriteGate::edit_records(std::span<const PointWrite> writes, Decision&
     RecordField f;
     if (!record_field(w.id, f)) continue;
     if (f.kind == RecordField::kTarget && !(w.value >= loop_rules_.setpoint_min_mm && w.value <= loop_rules_.setpoint_max_mm))
-      return refuse(Refusal::kInvalidValue, quoted(w.id) + " " + core::format_number(w.value) + " mm is outside the setpoint range [" +
-                                                core::format_number(loop_rules_.setpoint_min_mm) + ", " +
-                                                core::format_number(loop_rules_.setpoint_max_mm) + "] mm");
+      return refuse(Refusal::kInvalidValue,
+                    fmt::format("{} {} mm is outside the setpoint range [{}, {}] mm", quoted(w.id), core::format_number(w.value),
+                                core::format_number(loop_rules_.setpoint_min_mm), core::format_number(loop_rules_.setpoint_max_mm)));
     if (f.kind == RecordField::kController && w.value != kKeepController && !(w.value >= 0 && w.value <= 3))
-      return refuse(Refusal::kInvalidValue, quoted(w.id) + " takes 0 pp, 1 pp-ngidz, 2 pp-ffidz, 3 pp-traj or 255 (the running law), not " +
-                                                core::format_number(w.value));
+      return refuse(Refusal::kInvalidValue, fmt::format("{} takes 0 pp, 1 pp-ngidz, 2 pp-ffidz, 3 pp-traj or 255 (the running law), not {}",
+                                                        quoted(w.id), core::format_number(w.value)));
     set_record_value(out.records[f.record], f.kind, w.value);
   }
   return {};
@@ -266,7 +268,7 @@ GateResult WriteGate::command_for(const PointWrite& w, std::span<const PointWrit
       if (c.controller == control::ControllerKind::kPpTraj) {  // said here, not only by the loop after the answer
         control::ControllerConfig traj = tuning;
         traj.kind = control::ControllerKind::kPpTraj;
-        if (auto p = control::ControllerParams::make(traj); !p) return refuse(Refusal::kInvalidValue, quoted(w.id) + ": " + p.error().message);
+        if (auto p = control::ControllerParams::make(traj); !p) return refuse(Refusal::kInvalidValue, fmt::format("{}: {}", quoted(w.id), p.error().message));
       }
       break;
     case PointId::kManualValve: c = runtime::manual_valve_command(w.value); break;
@@ -280,7 +282,7 @@ GateResult WriteGate::command_for(const PointWrite& w, std::span<const PointWrit
     case PointId::kExciteDuration: out.excitation.duration_s = w.value; break;
     default: {
       const int bit = control_bit(w.id);
-      if (bit < 0) return refuse(Refusal::kNotWritable, quoted(w.id) + " has no command behind it");
+      if (bit < 0) return refuse(Refusal::kNotWritable, fmt::format("{} has no command behind it", quoted(w.id)));
       const auto mask = static_cast<std::uint16_t>(1u << bit);
       c = control_command(static_cast<std::uint16_t>(w.value != 0.0 ? out.control_word | mask : out.control_word & ~mask), writes, snap, out);
       break;
@@ -315,7 +317,7 @@ GateResult WriteGate::add_commands(std::span<const PointWrite> writes, const run
     // Every tuning point of the group becomes one tuning command, validated whole (e.g. b_l > b_r
     // after this write is refused), last in the group.
     auto t = runtime::make_tuning(out.tuning);
-    if (!t) return refuse(Refusal::kInvalidValue, "the tuning would not validate: " + t.error().message);
+    if (!t) return refuse(Refusal::kInvalidValue, fmt::format("the tuning would not validate: {}", t.error().message));
     out.tuning_changed = true;
     out.commands.push_back(runtime::tuning_command(*t));
     out.command_point.push_back(first_tuning_point);
@@ -325,7 +327,7 @@ GateResult WriteGate::add_commands(std::span<const PointWrite> writes, const run
     // above the maximum is refused), first in the group, so "settings and mode excite" in one
     // write starts the experiment with the new settings.
     if (const char* problem = runtime::excitation_problem(out.excitation, loop_rules_))
-      return refuse(Refusal::kInvalidValue, "the excitation settings would not validate: " + std::string(problem));
+      return refuse(Refusal::kInvalidValue, fmt::format("the excitation settings would not validate: {}", problem));
     out.excitation_changed = true;
     out.commands.insert(out.commands.begin(), runtime::excitation_command(out.excitation));
     out.command_point.insert(out.command_point.begin(), first_excitation_point);
@@ -353,7 +355,7 @@ GateResult WriteGate::check_loop_rules(const Decision& d, const runtime::Snapsho
   for (std::size_t i = 0; i < d.commands.size(); ++i) {
     const runtime::Command& c = d.commands[i];
     if (const auto r = runtime::check_command(c, mode, snap.position_mm, next_excitation, word, loop_rules_); r != runtime::CommandRefusal::kNone)
-      return refuse(gate_refusal(r), quoted(d.command_point[i]) + ": " + std::string(runtime::describe(r)));
+      return refuse(gate_refusal(r), fmt::format("{}: {}", quoted(d.command_point[i]), runtime::describe(r)));
     if (c.kind == runtime::CommandKind::kControl) word = c.control_word;
     if (c.kind == runtime::CommandKind::kMode) mode = c.mode;
     if (c.kind == runtime::CommandKind::kExcitation) next_excitation = c.excitation;
