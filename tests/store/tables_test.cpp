@@ -10,6 +10,7 @@
 #include "store/run_table.hpp"
 #include "store/statement.hpp"
 #include "store/transaction.hpp"
+#include "store/tuning_points.hpp"
 #include "store/tuning_set_table.hpp"
 #include "store_fixture.hpp"
 
@@ -236,6 +237,35 @@ TEST(Database, ErrorsNameTheStatementAndSqlitesReason) {
   auto missing = Database::open("/nonexistent-dir/epa.db", true);
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.error().message.find("/nonexistent-dir/epa.db"), std::string::npos);
+}
+
+// An accepted tuning write edits the running set's value in the point's own unit (mm for l_c and
+// the hold band), through the same point -> value map as the write gate.
+TEST(TuningPoints, AWriteEditsTheSetsValueInThePointsUnit) {
+  TuningSet set;
+  EXPECT_TRUE(apply_tuning_point(set, points::PointId::kLc, 7.5));
+  EXPECT_EQ(set.lc_mm, 7.5);
+  EXPECT_TRUE(apply_tuning_point(set, points::PointId::kTrajHoldBand, 0.25));
+  EXPECT_EQ(set.trajectory.hold_band_mm, 0.25);
+  EXPECT_TRUE(apply_tuning_point(set, points::PointId::kBl, -0.5));
+  EXPECT_EQ(set.dead_zone.b_l, -0.5);
+  EXPECT_TRUE(apply_tuning_point(set, points::PointId::kController, 0));
+  EXPECT_EQ(set.controller, control::ControllerKind::kPp);
+  EXPECT_FALSE(apply_tuning_point(set, points::PointId::kController, 1.5));
+  EXPECT_FALSE(apply_tuning_point(set, points::PointId::kSetpoint, 1.0));
+}
+
+// The law gets the set's lengths in sensor volts at the model's scale, the rest as the set has them.
+TEST(TuningPoints, TheLawGetsTheSetsLengthsInSensorVolts) {
+  TuningSet set;
+  set.lc_mm = 6.0;
+  set.dead_zone.m_r = 1.3;
+  core::HammersteinModel model;
+  model.mm_per_volt = 40.0;
+  const auto law = controller_config(set, model, 0.0);
+  EXPECT_EQ(law.lc_v, 6.0 / 40.0);
+  EXPECT_EQ(law.trajectory.hold_band_v, set.trajectory.hold_band_mm / 40.0);
+  EXPECT_EQ(law.dead_zone.m_r, 1.3);
 }
 
 }  // namespace
