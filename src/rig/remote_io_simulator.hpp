@@ -1,32 +1,14 @@
 #pragma once
-// A test rig, not part of the product's HAL: a stand-in for a remote analog I/O module with the plant behind it: a Modbus TCP server
-// (libmodbus) whose registers follow a RemoteIoLayout, and a plant thread that steps a plant in
-// real time: the paper's Hammerstein plant, or any plant::PlantSimulator (the physics model). `epa plant-server` runs it in its own process; the modbus-io
-// tests run it in-process on a free port.
-//
-// Plant thread, every Ts (absolute deadlines, clock_nanosleep TIMER_ABSTIME on CLOCK_MONOTONIC):
-// decode the valve register(s) (an undecodable value counts as 0 V, the centred valve), step the
-// plant, encode its measured sensor volts into the sensor register(s). When it falls more than
-// 10 periods behind (a suspended process) it starts a fresh schedule instead of catching up in a
-// burst, and counts an overrun.
-//
-// Synchronised (sync_to_valve_writes): each step comes half a period after the master's last valve
-// write (within half a period of the free schedule, so it locks after one write and the plant's
-// rate stays bounded), as a module with synchronised I/O applies outputs and latches inputs at the
-// master's sync point. Why: a plant that is itself a discrete model at the master's period (the
-// paper's) adds, on a free clock, no delay or one whole sample depending on the two clocks' phase
-// (a step between the master's read and its write applies the previous command), and the paper's
-// FF-IDZ loop does not survive one sample (`epa simulate --delay 1`). Without writes it runs free.
-//
-// Server thread: select() over the listening socket and up to kMaxClients clients, waking at
-// least every 50 ms so that stop() returns promptly; libmodbus' modbus_receive/modbus_reply do the
-// protocol (modbus_reply also answers illegal addresses and functions with exceptions). Requests
-// for the configured unit id or for 0xFF (Modbus TCP's "no unit id") are served; any other unit
-// id gets exception 0x0B (gateway target device failed to respond) rather than silence, so that
-// a misconfigured client gets a clear error at once instead of a timeout. A client that
-// disconnects, sends garbage or stalls mid-frame for more than 100 ms is dropped; the server
-// carries on. The register mapping is shared under a std::mutex: this is a test tool, not the
-// real-time loop.
+// A test rig, not part of the product's HAL: a stand-in for a remote analog I/O module with the
+// plant behind it, the paper's Hammerstein plant or any plant::PlantSimulator (the physics model).
+// `epa plant-server` runs it in its own process; the modbus-io tests run it in-process on a free
+// port. Four parts, each its own file:
+//   module_registers  the module's registers, where a RemoteIoLayout puts the valve and the sensor
+//   module_server     the Modbus TCP server answering from them (libmodbus), on its own thread
+//   plant_loop        the plant stepped in real time between them, on its own thread, in sync with
+//                     the master's valve writes if asked, with the module's comms watchdog
+//   module_faults     what a test injects: how the module answers, what its sensor reads
+// Here they are validated, started and stopped together.
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -37,6 +19,7 @@
 #include "hal/remote_io_layout.hpp"
 #include "plant/hammerstein_plant.hpp"
 #include "plant/plant_simulator.hpp"
+#include "rig/module_faults.hpp"
 
 namespace epa::rig {
 
@@ -53,17 +36,6 @@ struct RemoteIoSimulatorConfig {
                                       // with synchronised I/O does; off: the plant's clock runs free
   int watchdog_ms = 0;                // a module's comms watchdog: no request for this long (after the
                                       // first) centres the valve until requests come back; 0: off
-};
-
-// Faults a test injects into the module (epa plant-server --control-stdin): how it answers, and
-// what its sensor reads. The defaults are a healthy module.
-struct ModuleFaults {
-  enum class Answers : std::uint8_t { kNormal, kSilent, kLate, kGarbage };
-  enum class Sensor : std::uint8_t { kNormal, kNotANumber, kFixed, kFrozen };
-  Answers answers = Answers::kNormal;
-  int late_ms = 0;            // kLate: every answer this much late
-  Sensor sensor = Sensor::kNormal;
-  double sensor_v = 0.0;      // kFixed: what the sensor reads (e.g. out of range)
 };
 
 class RemoteIoSimulator {
@@ -84,7 +56,7 @@ class RemoteIoSimulator {
   int port() const;               // the bound port (the real one when configured as 0)
   double position_mm() const;     // true piston position, for tests and logs
   std::uint64_t steps() const;    // plant steps done
-  std::uint64_t overruns() const; // times the plant thread gave up catching up (see above)
+  std::uint64_t overruns() const; // times the plant thread gave up catching up (plant_loop.hpp)
   // When the step the plant thread waits for (or is doing) is due, on steady_clock (which is
   // CLOCK_MONOTONIC): tells a test a thread that woke late on a loaded machine from a wrong schedule.
   std::chrono::steady_clock::time_point next_step_due() const;
