@@ -4,7 +4,7 @@
 #include <cstdint>
 
 #include "control/paper_controller.hpp"
-#include "runtime/scan_cycle.hpp"
+#include "runtime/tuning.hpp"
 
 namespace epa::runtime::testing {
 
