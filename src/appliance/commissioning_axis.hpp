@@ -7,8 +7,8 @@
 #include "appliance/recorded_runs.hpp"
 #include "commission/axis.hpp"
 #include "points/write_gate.hpp"
+#include "runtime/loop_channels.hpp"
 #include "runtime/runtime_config.hpp"
-#include "runtime/scan_cycle.hpp"
 #include "store/store_writer.hpp"
 
 namespace epa::appliance {
