@@ -457,7 +457,7 @@ class Mb:
 
     def halt_edge(self):
         self.w1(H_CONTROL_WORD, CW_HALT)
-        time.sleep(0.03)
+        time.sleep(0.03)  # stays, the stimulus: the width of the halt pulse
         self.w1(H_CONTROL_WORD, 0)
 
     def wait_in_position(self, target, window, bound_s=IN_POSITION_BOUND_S):
@@ -730,7 +730,7 @@ def group_a(env):
         mb.write_record(5, t, 20.0, 0.0, RECORD_RUNNING_LAW, key=app.unlock_key)
         mb.w1(H_RECORD_SELECT, 5)
         acked, _ = mb.start_edge()
-        time.sleep(1.0)
+        time.sleep(1.0)  # stays, the stimulus: the halt comes 1 s into the move
         p_halt = mb.pos()
         mb.halt_edge()
         t0 = time.monotonic()
@@ -780,7 +780,7 @@ def group_a(env):
             a4.fail("the move before STOP did not come into position (%s, %.3f mm)" % (sw_text(s), p))
         mb.w1(H_MODE, MODE_STOP)
         s_now = mb.status()
-        time.sleep(0.3)
+        time.sleep(0.3)  # stays: the status is judged right after the write and 0.3 s later
         s_later = mb.status()
         a4.info("status right after mode := STOP: %s; 0.3 s later: %s" % (sw_text(s_now), sw_text(s_later)))
         for when, s in (("right after the write", s_now), ("0.3 s later", s_later)):
@@ -1255,7 +1255,7 @@ def group_c(env):
                 ex["fault"] = (time.monotonic() - t0, code, s)
                 capture(ex, MOVE_END_BOUND_S)
                 hb.paused.clear()
-                time.sleep(2 * C_HEARTBEAT_PERIOD_S)
+                time.sleep(2 * C_HEARTBEAT_PERIOD_S)  # stays, the stimulus: the heartbeat stays paused
                 mb.recover_fault()
                 mb.wait_in_position(None, WINDOW_MM, 3.0)
                 state["law"] = mb.hr(H_CONTROLLER, 1)[0]

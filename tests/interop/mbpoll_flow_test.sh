@@ -159,7 +159,7 @@ pass "(5) start record 1 (150 -> 250 mm at 40 mm/s): ack after ${t_ack} ms, clea
 # ---- (6) halt a setpoint move ----
 step="(6) halt"
 out=$(mb -t 4:float -B -r "$A_SETPOINT" "$host" 40 2>&1); written "$out" || die "setpoint 40: $out"
-sleep 0.1
+sleep 0.1  # stays, the stimulus: the halt comes 0.1 s into the move
 t0=$(now_ms)
 write16 "$A_CW" 2
 wait_status $HALTED 0 2000 "halted after halt=1"; t_halted=$waited
