@@ -1,6 +1,6 @@
 #include "commission/simulated_verification.hpp"
 
-#include <cstdio>
+#include <fmt/format.h>
 
 #include "core/units.hpp"
 #include "plant/plant_adapter.hpp"
@@ -27,20 +27,17 @@ core::StickSlipParams perturbed_axis(core::StickSlipParams p, double gain_factor
 
 std::vector<Variant> variants(const core::HammersteinModel& m, const std::optional<core::StickSlipParams>& axis,
                               const CommissionSpec& spec) {
-  char buf[64];
   std::vector<Variant> out = {{"identified", m, axis}};
   if (spec.robust_gain > 0.0)
     for (double f : {1.0 - spec.robust_gain, 1.0 + spec.robust_gain}) {
       Variant v{{}, sim::perturbed(m, {.gain_factor = f}), axis ? std::optional(perturbed_axis(*axis, f, 0.0)) : std::nullopt};
-      std::snprintf(buf, sizeof buf, "gain x%.2f", f);
-      v.name = buf;
+      v.name = fmt::format("gain x{:.2f}", f);
       out.push_back(std::move(v));
     }
   if (spec.robust_breakpoint_v > 0.0)
     for (double d : {spec.robust_breakpoint_v, -spec.robust_breakpoint_v}) {
       Variant v{{}, sim::perturbed(m, {.dead_band_widening_v = d}), axis ? std::optional(perturbed_axis(*axis, 1.0, d)) : std::nullopt};
-      std::snprintf(buf, sizeof buf, "dead band %+.2f V each side", d);
-      v.name = buf;
+      v.name = fmt::format("dead band {:+.2f} V each side", d);
       out.push_back(std::move(v));
     }
   return out;

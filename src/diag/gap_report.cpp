@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 namespace epa::diag {
@@ -64,12 +64,10 @@ GapReport build_report(const Diagnosis& d, const std::vector<NamedRun>& train, c
   r.residuals_after = residual_stats(shown_runs, after.replays);
   r.hints = hints(d.effects.empty() ? sb : sa, d.effects.empty() ? r.residuals_before : r.residuals_after);
   if (d.rest_drift.moving) {
-    char line[300];
-    std::snprintf(line, sizeof line,
-                  "the readings move %.2f mm/s while the valve rests inside the dead band (median of %zu rests): a drifting "
-                  "sensor, a leaking valve or seal, or a load, none of them in the vocabulary",
-                  d.rest_drift.median_speed_mm_s, d.rest_drift.rests);
-    r.hints.insert(r.hints.begin(), line);
+    r.hints.insert(r.hints.begin(),
+                   fmt::format("the readings move {:.2f} mm/s while the valve rests inside the dead band (median of {} rests): a drifting "
+                               "sensor, a leaking valve or seal, or a load, none of them in the vocabulary",
+                               d.rest_drift.median_speed_mm_s, d.rest_drift.rests));
   }
 
   auto add_runs = [&](const std::vector<NamedRun>& runs, const char* set) {
@@ -182,7 +180,6 @@ std::string to_json(const GapReport& r) {
 
 std::string verdict_text(const GapReport& r) {
   const Diagnosis& d = r.diagnosis;
-  char buf[400];
   std::string s;
   if (d.effects.empty() && d.rest_drift.moving) {
     s = "Unexplained: the readings move while the valve rests inside the dead band, which no effect in the library does";
@@ -198,14 +195,11 @@ std::string verdict_text(const GapReport& r) {
            " are confusable on these runs (either explains it)";
     if (d.unexplained) s += "; a significant gap remains unexplained";
   }
-  std::snprintf(buf, sizeof buf, ". Held-out gap %.3f mm, %.3f mm after re-fitting gain and break points, %.3f mm with the accepted effects (noise floor %.3f mm).",
-                d.baseline_gap_mm, d.refit_gap_mm, d.final_gap_mm, d.noise_floor_mm);
-  s += buf;
-  if (d.windows_at_end_stop) {
-    std::snprintf(buf, sizeof buf, " %zu of %zu windows touch an end stop and are left out of every gap.", d.windows_at_end_stop,
-                  d.windows);
-    s += buf;
-  }
+  s += fmt::format(". Held-out gap {:.3f} mm, {:.3f} mm after re-fitting gain and break points, {:.3f} mm with the accepted effects "
+                   "(noise floor {:.3f} mm).",
+                   d.baseline_gap_mm, d.refit_gap_mm, d.final_gap_mm, d.noise_floor_mm);
+  if (d.windows_at_end_stop)
+    s += fmt::format(" {} of {} windows touch an end stop and are left out of every gap.", d.windows_at_end_stop, d.windows);
   if (d.unexplained && !r.hints.empty()) s += " Where: " + r.hints.front() + ".";
   return s;
 }

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+#include <fmt/format.h>
 
 namespace epa::diag {
 
@@ -136,22 +136,18 @@ ResidualStats residual_stats(const std::vector<const core::Run*>& runs, const st
 
 std::vector<std::string> hints(const std::vector<RegimeShare>& sh, const ResidualStats& st) {
   std::vector<std::string> out;
-  char buf[300];
   for (const auto& s : sh) {
     if (s.time_share_pct < 5.0 || s.gap_share_pct < 1.5 * s.time_share_pct) continue;
-    std::snprintf(buf, sizeof buf, "%s: %.0f %% of the gap in %.0f %% of the time", s.regime.c_str(), s.gap_share_pct, s.time_share_pct);
-    std::string h = buf;
+    std::string h = fmt::format("{}: {:.0f} % of the gap in {:.0f} % of the time", s.regime, s.gap_share_pct, s.time_share_pct);
     if (s.regime.find("near-deadband") != std::string::npos) h += " (break points or friction)";
     else if (s.regime == "large-move" || s.regime == "moving-beyond-deadband") h += " (gain, flow saturation)";
     else if (s.regime.rfind("stroke-", 0) == 0) h += " (dynamics that change along the stroke)";
     else if (s.regime == "transient") h += " (delay, valve lag, friction)";
     out.push_back(h);
   }
-  if (std::abs(st.peak_input_correlation) > 0.2) {
-    std::snprintf(buf, sizeof buf, "the error follows valve command changes %zu sample(s) earlier (r = %.2f): timing (delay, lag)",
-                  st.peak_input_lag, st.peak_input_correlation);
-    out.push_back(buf);
-  }
+  if (std::abs(st.peak_input_correlation) > 0.2)
+    out.push_back(fmt::format("the error follows valve command changes {} sample(s) earlier (r = {:.2f}): timing (delay, lag)",
+                              st.peak_input_lag, st.peak_input_correlation));
   return out;
 }
 
