@@ -57,7 +57,7 @@ struct Requester {
 
 class WriteGate {
  public:
-  // `loop_rules` is the scan cycle's configuration (its command rules and mm_per_volt); `tuning`
+  // `loop_rules` is the scan cycle's configuration (its command rules and sensor scale); `tuning`
   // the running tuning's configuration; `audit` may be null.
   WriteGate(WriteLimits limits, const runtime::RuntimeConfig& loop_rules, control::ControllerConfig tuning,
             runtime::LoopChannels& channels, core::AuditSink* audit, const PositionRecords& records = {});
