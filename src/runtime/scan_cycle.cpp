@@ -383,40 +383,49 @@ void ScanCycle::check_faults(bool read_ok, std::int64_t now_ns) noexcept {
 }
 
 void ScanCycle::command_valve(bool read_ok, std::int64_t now_ns) noexcept {
-  const double y_v = position_v();
   saturated_ = false;
   switch (mode_) {
-    case Mode::kRun:
-      if (!read_ok) break;  // hold the last command for a missed sample (counted below)
-      if (init_state_on_next_read_) start_run_at_first_reading();
-      step_law(motion_.step(position_mm_), y_v);
-      break;
+    case Mode::kRun: drive_run(read_ok); break;
     case Mode::kManual:
-      if (jog_law_) {  // the law drives the jog (holding the last command for a missed sample)
-        if (!read_ok) break;
-        if (config_.jog_keepalive_s > 0.0 && static_cast<double>(now_ns - jog_keepalive_ns_) > config_.jog_keepalive_s * 1e9)
-          motion_.jog(0, position_mm_, speed_mm_s_);  // no keep-alive: brake as if released
-        step_law(motion_.step(position_mm_), y_v);
-        if (mode_ == Mode::kManual && motion_.task() != MotionTask::kJog) jog_law_ = profile_law_ = false;  // braked: the manual command next
-        break;
+      if (jog_law_) {
+        drive_jog(read_ok, now_ns);
+      } else {
+        valve_v_ = manual_valve_v_;
+        controller_v_ = 0.0;
       }
-      valve_v_ = manual_valve_v_;
-      controller_v_ = 0.0;
       break;
-    case Mode::kExcite:
-      controller_v_ = 0.0;
-      if (excitation_.done()) {  // every command given: STOP by itself, the valve safe in this cycle
-        end_excitation(ExcitationEnd::kComplete);
-        mode_ = Mode::kStop;
-        valve_v_ = config_.safe_valve_v;
-        break;
-      }
-      if (!read_ok) break;  // hold the last command for a missed sample, as RUN does
-      valve_v_ = excitation_.next(position_mm_);
-      break;
+    case Mode::kExcite: drive_excitation(read_ok); break;
     case Mode::kStop:
     case Mode::kFault: valve_v_ = config_.safe_valve_v; controller_v_ = 0.0; break;
   }
+}
+
+void ScanCycle::drive_run(bool read_ok) noexcept {
+  if (!read_ok) return;  // hold the last command for a missed sample (counted by the detector)
+  const double y_v = position_v();
+  if (init_state_on_next_read_) start_run_at_first_reading();
+  step_law(motion_.step(position_mm_), y_v);
+}
+
+// The law drives the jog (holding the last command for a missed sample).
+void ScanCycle::drive_jog(bool read_ok, std::int64_t now_ns) noexcept {
+  if (!read_ok) return;
+  if (config_.jog_keepalive_s > 0.0 && static_cast<double>(now_ns - jog_keepalive_ns_) > config_.jog_keepalive_s * 1e9)
+    motion_.jog(0, position_mm_, speed_mm_s_);  // no keep-alive: brake as if released
+  step_law(motion_.step(position_mm_), position_v());
+  if (mode_ == Mode::kManual && motion_.task() != MotionTask::kJog) jog_law_ = profile_law_ = false;  // braked: the manual command next
+}
+
+void ScanCycle::drive_excitation(bool read_ok) noexcept {
+  controller_v_ = 0.0;
+  if (excitation_.done()) {  // every command given: STOP by itself, the valve safe in this cycle
+    end_excitation(ExcitationEnd::kComplete);
+    mode_ = Mode::kStop;
+    valve_v_ = config_.safe_valve_v;
+    return;
+  }
+  if (!read_ok) return;  // hold the last command for a missed sample, as RUN does
+  valve_v_ = excitation_.next(position_mm_);
 }
 
 void ScanCycle::start_run_at_first_reading() noexcept {

@@ -87,6 +87,9 @@ class ScanCycle {
   void record_sample() noexcept;
 
   void take_reading(double sensor_v) noexcept;  // the position and the speed from a reading
+  void drive_run(bool read_ok) noexcept;        // the valve commands of the modes that drive
+  void drive_jog(bool read_ok, std::int64_t now_ns) noexcept;
+  void drive_excitation(bool read_ok) noexcept;
   void start_run_at_first_reading() noexcept;   // RUN entered: hold, or drive to the setpoint
   void enter_fault(FaultCode code) noexcept;
   void publish(bool full_stats = false) noexcept;
