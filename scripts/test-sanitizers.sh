@@ -19,8 +19,9 @@
 #    does not have, and its code paths run instrumented in the process tier: integration.commission
 #    (190-430 s under ASan) through integration.commission_defaults and commission_physics_test,
 #    integration_test (the HIL move) through the EpaCli serve cases and the interop flows, the crowd
-#    checks (fair_slots, shared_lockout, http_crowd) through web_test, modbus_test and attack. A new
-#    realtime test is left out until it is named here.
+#    checks (fair_slots, shared_lockout, http_crowd) through web_test, modbus_test and attack, the
+#    synchronised remote I/O module's wake-up checks through hal_test's other simulator cases. A
+#    new realtime test is left out until it is named here.
 #  - figures from more of the same paths run in the release suite only (EPA_SANITIZER_RUN=1 in the
 #    preset; its tests say which, tests/support/sanitizer_run.hpp): the self-check's three seeds (one
 #    here), the two other physics plants' identification, the crash test's 100 kills (20 here).
