@@ -9,7 +9,7 @@
 namespace epa::core {
 
 // Its fields' names, in field order: the keys of the [dead_zone] table in the model file and the
-// tuning file alike (FORMATS.md), and the names validate() gives.
+// tuning file alike (docs/formats.md), and the names validate() gives.
 inline constexpr std::string_view kDeadZoneKeys[] = {"m_r", "m_l", "b_r", "b_l"};
 
 struct DeadZone {

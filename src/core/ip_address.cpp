@@ -72,7 +72,7 @@ Result<int> open_listener(const SocketAddress& address, int backlog, const std::
     const std::string why = std::strerror(errno);
     if (fd >= 0) ::close(fd);
     return io_error("cannot listen on " + where + ": " + step + ": " + why +
-                    (address.family() == AF_INET6 ? " (has this machine IPv6, and that address?)" : ""));
+                    (address.family() == AF_INET6 ? " (has this host IPv6, and that address?)" : ""));
   };
   if (fd < 0) return fail("socket");
   const int yes = 1;

@@ -1,6 +1,6 @@
 #pragma once
-// Everything the paper (Sunar et al., ../shared/paper) prints that the product reproduces,
-// in one place. Interpretations follow NOTES.md; deviations are explained where used.
+// Everything the paper (Sunar et al., docs/paper.md) prints that the product reproduces,
+// in one place. Interpretations as docs/paper.md gives them; deviations are explained where used.
 #include <array>
 
 #include "core/hammerstein_model.hpp"
@@ -13,12 +13,12 @@ inline HammersteinModel model() {
   m.A = {1.0, -0.9094, -0.6110, 0.5204};
   m.B = {0.0, 1.024, -2.046, 1.029};
   m.dead_zone = {.m_r = 1.7627, .m_l = 1.0707, .b_r = 1.232, .b_l = -1.722};
-  m.Ts = 0.005;  // not printed: NOTES.md, best match of Table 1 timings
+  m.Ts = 0.005;  // not printed: docs/paper.md, best match of Table 1 timings
   m.mm_per_volt = 50.0;
   return m;
 }
 
-// Eq 11-13: desired characteristic polynomial and the printed controller (H = G, NOTES.md).
+// Eq 11-13: desired characteristic polynomial and the printed controller (H = G, docs/paper.md).
 inline Polynomial T() { return {1.0, -2.865, 2.7344, -0.8694}; }
 inline Polynomial F() { return {1.0, -1.778, 0.7828}; }
 inline Polynomial G() { return {-0.1734, 0.577, -0.3958}; }
@@ -27,7 +27,7 @@ inline Polynomial G() { return {-0.1734, 0.577, -0.3958}; }
 inline constexpr std::array<double, 6> kEq14 = {1.0, -3.0551, 3.7470, -2.7583, 1.5027, -0.4362};
 inline constexpr std::array<double, 6> kEq15 = {1.0, -3.1780, 4.4014, -3.9791, 2.4740, -0.7181};
 
-inline constexpr double kLcDefaultMm = 5.0;     // l_c, NOTES.md
+inline constexpr double kLcDefaultMm = 5.0;     // l_c, docs/paper.md
 inline constexpr double kValveLimitV = 5.0;     // section 4.1
 
 // Table 1 (experimental results on the rig).

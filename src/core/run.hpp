@@ -1,5 +1,5 @@
 #pragma once
-// One recorded or simulated run, column-wise (what epa-run/1 files hold, FORMATS.md).
+// One recorded or simulated run, column-wise (what epa-run/1 files hold, docs/formats.md).
 // Sample k is at t_s[k] = k * Ts: the position y_mm[k] was read, then u_V[k] was applied
 // and held until k+1 (sample, compute, hold; no extra computation delay).
 #include <string>

@@ -1,5 +1,5 @@
 #pragma once
-// Reader and writer of run files, format epa-run/1 (FORMATS.md): `#` comments, `# key=value`
+// Reader and writer of run files, format epa-run/1 (docs/formats.md): `#` comments, `# key=value`
 // metadata (Ts in seconds, controller, source, ...), one CSV header row, one row per sample.
 // Readers keep reading epa-run/1 when later versions appear; a file tagged with another
 // version is refused, a file without a tag (hand-made export) is read if it parses.

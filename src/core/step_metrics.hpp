@@ -1,5 +1,5 @@
 #pragma once
-// Step-response metrics with MATLAB stepinfo conventions (NOTES.md): rise time 10-90 % and a
+// Step-response metrics with MATLAB stepinfo conventions (docs/paper.md): rise time 10-90 % and a
 // 2 % settling band, both against the final value; overshoot against the final value; the
 // steady-state error is the mean |r - y| over the last window (2 s of a 20 s run).
 // "Never reached" is std::nullopt, never a large number.

@@ -1,6 +1,6 @@
 #pragma once
 // Reading a TOML file's text, for every TOML reader: a syntax error as "file:line: what", and for
-// the versioned formats of FORMATS.md the "schema" key checked against the one the reader knows.
+// the versioned formats of docs/formats.md the "schema" key checked against the one the reader knows.
 #include <string>
 #include <string_view>
 #include <toml++/toml.h>

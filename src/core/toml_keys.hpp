@@ -1,7 +1,7 @@
 #pragma once
 // Every key of a TOML table must be one the reader knows: a misspelt key is refused with its name
-// and line, never left out in silence (a model file's `mm_per_vlot = 25` ran on the default
-// 50 mm/V until 2026-11-29). One wording for every TOML file the product reads (the model and
+// and line, never left out in silence (a misspelt `mm_per_vlot = 25` would run on the default
+// 50 mm/V). One wording for every TOML file the product reads (the model and
 // tuning files, the physics parameters, the configuration), in the compiler's form editors jump to:
 //   file:line: unknown key 'key' in [table] (expected one of: a, b, c)
 // (" in [table]" left out at the top level; the place as core::at_line() writes it).

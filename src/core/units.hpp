@@ -1,6 +1,6 @@
 #pragma once
 // Units shared by the model, the controller and the tools. The model's output y is in sensor
-// volts (0-10 V over the 500 mm stroke), as NOTES.md chooses: a user-facing position is in mm.
+// volts (0-10 V over the 500 mm stroke), as docs/paper.md reads the paper: a user-facing position is in mm.
 
 #include <algorithm>
 #include <cmath>

@@ -23,7 +23,7 @@ inline std::string utc_stamp(std::int64_t unix_time_ms) {
 }
 
 // ISO 8601 in UTC to the millisecond, as the JSON API and the command line show times:
-// "2026-11-24T21:33:05.120Z".
+// "YYYY-MM-DDThh:mm:ss.mmmZ".
 inline std::string iso_utc(std::int64_t unix_time_ms) {
   const std::tm utc = utc_time(unix_time_ms);
   char text[40];

@@ -96,7 +96,7 @@ std::string utc_stamp() { return core::utc_stamp(core::unix_time_ms()); }
 void Recorder::write(const RecordRequest& request) {
   core::Run run;
   run.Ts = config_.Ts;
-  // As FORMATS.md: open-loop when no controller drove the samples, so `epa identify` takes them as
+  // As docs/formats.md says: open-loop when no controller drove the samples, so `epa identify` takes them as
   // open-loop data.
   run.set_meta("controller", request.open_loop ? "open-loop" : std::string(control::to_string(request.controller)));
   run.set_meta("source", config_.source);

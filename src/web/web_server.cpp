@@ -404,7 +404,7 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
   } else {
     if (!s.bind_to_port(config.address, config.port))
       return core::io_error("web: cannot bind to " + config.address + ":" + std::to_string(config.port) +
-                            " (in use, or not an address of this machine?)");
+                            " (in use, or not an address of this host?)");
     impl->port = config.port;
   }
   if (*listening_socket == INVALID_SOCKET || ::listen(*listening_socket, core::kListenBacklog) != 0)
