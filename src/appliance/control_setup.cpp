@@ -62,7 +62,7 @@ core::Result<points::WriteLimits> write_limits(const config::ApplianceConfig& c,
 core::Result<ControlSetup> prepare_control(config::ApplianceConfig& c, const std::optional<modbus::RegisterMap>& map, bool setpoint_given) {
   auto plant_model = load_model(c.model_path);
   if (!plant_model) return plant_model.error();
-  // The paper does not print its Ts (NOTES.md), so its model takes the loop's period; an
+  // The paper does not print its Ts (docs/dev/decisions.md), so its model takes the loop's period; an
   // identified model is only valid at the Ts it was identified at.
   if (c.model_path.empty()) plant_model->model.Ts = c.runtime.period_s;
   auto seed = seed_from_config(c, *plant_model);
