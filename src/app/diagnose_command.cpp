@@ -44,7 +44,7 @@ core::Result<std::vector<core::Run>> load(const std::vector<std::string>& paths,
     auto run = core::read_run_file(path, Ts);
     if (!run)
       return core::Error{run.error().code, run.error().message + " (epa diagnose reads epa-run/1 files with Ts equal to the model's, " +
-                                               format_number(Ts) + " s; see FORMATS.md)"};
+                                               format_number(Ts) + " s; see docs/formats.md)"};
     if (run->size() < std::max(kMinSamples, 2 * horizon))
       return core::invalid_argument(path + ": only " + std::to_string(run->size()) + " samples; the diagnosis needs at least " +
                                     std::to_string(std::max(kMinSamples, 2 * horizon)) + " (and two windows of --horizon)");

@@ -1,7 +1,7 @@
 #pragma once
 // `epa diagnose`: where and why simulated and recorded runs disagree (the sim-to-real gap), which
 // unmodelled effect explains it, and how far the gap shrinks once it is added (epa::diag). Writes
-// the epa-gap-report/1 JSON (FORMATS.md) and an HTML report with plots.
+// the epa-gap-report/1 JSON (docs/formats.md) and an HTML report with plots.
 #include <CLI/CLI.hpp>
 #include <ostream>
 #include <string>

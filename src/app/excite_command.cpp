@@ -39,7 +39,7 @@ void add_excite_command(CLI::App& app, ExciteOptions& o) {
       ->capture_default_str();
   cmd->add_option("--guard", o.guard_mm, "Pulses away from the middle end this close to a stroke end, mm")->capture_default_str();
   cmd->add_flag("--centring", o.centring,
-                "Pulse signs keep the piston near the middle (before 2026-11-27 the only way); default: they sweep the "
+                "Pulse signs keep the piston near the middle; default: they sweep the "
                 "stroke between the guard lines, which identifies a model that holds across it");
 }
 

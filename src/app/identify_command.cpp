@@ -63,7 +63,7 @@ void add_identify_command(CLI::App& app, IdentifyOptions& o) {
 namespace {
 
 constexpr const char* kFormatHint =
-    "epa identify reads epa-run/1 files: columns t_s, y_mm, u_V, uniformly sampled at Ts; see FORMATS.md";
+    "epa identify reads epa-run/1 files: columns t_s, y_mm, u_V, uniformly sampled at Ts; see docs/formats.md";
 
 // Reads, splits at the end stops and checks one group of runs; the first run fixes Ts.
 core::Result<std::vector<report::IdentifiedRun>> load_runs(const std::vector<std::string>& paths, std::optional<double>& Ts,

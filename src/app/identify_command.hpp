@@ -31,7 +31,7 @@ struct IdentifyOptions {
   double tolerance_pct = 0.5;         // order rule: fit points from the best that count as equal
   double mm_per_volt = 50.0;          // sensor scale of the model's y
   double stroke_mm = 500.0;           // end stops
-  std::string criterion = "simulation";  // or "one-step": the swarm's least-squares fit alone (before issue 19)
+  std::string criterion = "simulation";  // or "one-step": the swarm's least-squares fit alone, without the free-run refinement
   double window_s = 0.0;              // simulation criterion: restart from measured y every window_s (0: whole runs)
   std::string break_points = "ramps"; // simulation criterion: "ramps" (within the ramps' band) or "free"
   bool stick_slip = true;             // also fit the stick-slip model (plant/stick_slip_model.hpp)

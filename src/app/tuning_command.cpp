@@ -41,7 +41,7 @@ void add_tuning_command(CLI::App& app, TuningOptions& o) {
   imp->add_option("--name", o.name, "Name of the new set (default: the file's)");
   imp->add_flag("--activate", o.activate, "Make it the active set");
   auto* audit = cmd->add_subcommand("audit", "The audit log, newest first");
-  audit->add_option("--since", o.since, "From this time on: 2026-11-21, 2026-11-21T10:00:00Z or unix ms");
+  audit->add_option("--since", o.since, "From this time on: YYYY-MM-DD, YYYY-MM-DDThh:mm:ssZ (UTC) or unix ms");
   audit->add_option("--until", o.until, "Up to this time (same forms)");
   audit->add_option("--source", o.source, "Only sources containing this text (modbus, web, cli, an address)");
   audit->add_option("--point", o.point, "Only this point (setpoint_mm, m_r, ...)");
@@ -54,7 +54,7 @@ namespace {
 
 std::string iso_time(std::int64_t ms) { return core::iso_utc(ms); }
 
-// "2026-11-21", "2026-11-21T10:00:00Z" (UTC) or unix milliseconds.
+// YYYY-MM-DD, YYYY-MM-DDThh:mm:ssZ (UTC) or unix milliseconds.
 core::Result<std::int64_t> parse_time(const std::string& text, const char* option) {
   if (!text.empty() && text.find_first_not_of("0123456789") == std::string::npos) return std::stoll(text);
   std::tm tm{};
@@ -64,7 +64,7 @@ core::Result<std::int64_t> parse_time(const std::string& text, const char* optio
     end = strptime(text.c_str(), "%Y-%m-%d", &tm);
   }
   if (!end || !(*end == '\0' || (end[0] == 'Z' && end[1] == '\0')))
-    return core::invalid_argument(std::string(option) + " '" + text + "' is not a time: use 2026-11-21, 2026-11-21T10:00:00Z or unix ms");
+    return core::invalid_argument(std::string(option) + " '" + text + "' is not a time: use YYYY-MM-DD, YYYY-MM-DDThh:mm:ssZ or unix ms");
   return static_cast<std::int64_t>(timegm(&tm)) * 1000;
 }
 

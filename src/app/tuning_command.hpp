@@ -15,7 +15,7 @@ struct TuningOptions {
   std::string file;          // export --out / import FILE
   std::string name;          // import --name
   bool activate = false;     // import --activate
-  std::string since, until;  // audit: ISO 8601 UTC ("2026-11-21", "2026-11-21T10:00:00Z") or unix ms
+  std::string since, until;  // audit: ISO 8601 UTC (YYYY-MM-DD or YYYY-MM-DDThh:mm:ssZ) or unix ms
   std::string source, point;
   std::size_t limit = 100;
   bool json = false;
