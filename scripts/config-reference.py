@@ -21,11 +21,7 @@ LOADER = ROOT / "src" / "config" / "appliance_config.cpp"
 OUTPUT = ROOT / "docs" / "configuration-reference.md"
 
 # Comments in config/epa.toml that point at README sections which now live in docs/.
-REWRITES = [
-    ('(README "Beyond the paper")', "(docs/paper.md, pp-traj)"),
-    ("(README: Connections)", "(docs/modbus.md, Connections)"),
-    ("this machine's addresses", "the appliance's addresses"),
-]
+REWRITES = []  # (old, new) wording changes for the generated page, none at present
 
 # Named constants the loader uses as bounds.
 CONSTANTS = {
