@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # The blind test of `epa diagnose` (tests/diag/blind/): rigs whose effects are written from
 # physics in forms the diagnosis does not fit, 6 training + 3 held-out runs each, scored as the
-# withheld benchmark scores (issue 18). Prints every case, the confusion matrix and the score line.
+# withheld benchmark scores them. Prints every case, the confusion matrix and the score line.
 #
 #   bench/diagnose_blind.sh [SEEDS=2] [BUILD_DIR=build/release]     (38 cases per seed)
 #   bench/diagnose_blind.sh fast                                    (11 cases: one per phenomenon)
 #
-# Exit 0 when it ran; the thresholds of issue 18 are reported on the "blind check" line.
+# Exit 0 when it ran; the thresholds (tests/diag/blind/blind_diagnosis.py --check) are reported
+# on the "blind check" line.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 arg=${1:-2}

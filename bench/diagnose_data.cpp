@@ -1,6 +1,6 @@
 // Writes the runs for the diagnosis benchmark and the CLI test: `diagnose_data DIR [EFFECT] [RUNS]
 // [SECONDS]` writes DIR/run-N.csv (epa-run/1), closed- and open-loop in turn, from the paper's
-// model slightly perturbed, with EFFECT (a FORMATS.md name at its self-check size, or "none")
+// model slightly perturbed, with EFFECT (a docs/formats.md name at its self-check size, or "none")
 // hidden in the simulator. bench/diagnose_bench.sh times `epa diagnose` on 9 x 20 s of them.
 #include <cstdio>
 #include <cstdlib>

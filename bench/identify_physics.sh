@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Issue 19's identification figures for the README: `epa identify` on open-loop runs of the physics
-# plant (defaults, supply 4.8 bar, spool overlap 0.2 V wider each way, friction 1.5x and 0.5x of
-# the defaults' static / sliding 40 / 25 N), every ordered pair of seeds
+# The identification figures of docs/identification.md: `epa identify` on open-loop runs of the
+# physics plant (defaults, supply 4.8 bar, spool overlap 0.2 V wider each way, friction 1.5x and
+# 0.5x of the defaults' static / sliding 40 / 25 N), every ordered pair of seeds
 # (estimation run i, validation run j), the Hammerstein model's and the stick-slip model's
 # validation free-run fits and the stick-slip model's ramp starts. The plant's own ramp starts
 # (the truth for the break points) come from ident_physics_test, which measures them on the plant.

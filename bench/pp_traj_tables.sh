@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 17's tables for the README, each row from one `epa simulate --json` command:
+# pp-traj's tables in docs/paper.md, each row from one `epa simulate --json` command:
 #   1. Table 1 on the printed model for the four laws (no noise), and pp-traj with 0.1 mm noise;
 #   2. robustness of pp-traj: gain x0.8 / x1.2, dead band 0.1 V wider / narrower, 20 ms valve
 #      lag, 1-sample delay (the plant differs, the controller keeps the printed model);

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 9: builds the libFuzzer targets (preset fuzz: clang 14, ASan + UBSan, build/fuzz) and runs
+# Builds the libFuzzer targets (preset fuzz: clang 14, ASan + UBSan, build/fuzz) and runs
 # each for N seconds, one after another, from its seed corpus (fuzz/corpus/<target>, read only)
 # plus what earlier runs found (build/fuzz/corpus/<target>), with its dictionary. Prints
 # executions, exec/s and new corpus entries per target; a crash, leak, timeout or sanitizer

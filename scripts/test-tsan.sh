@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 9: the threaded tests under ThreadSanitizer (preset tsan: g++ -O1 -g1, build/tsan): the
+# The threaded tests under ThreadSanitizer (preset tsan: g++ -O1 -g1, build/tsan): the
 # scan cycle and its channels (runtime_test), the Modbus server over loopback (modbus_test), the
 # store thread (store_test), the HTTP server (web_test) and the remote I/O backend against its
 # simulator (hal_test). Only those executables are built. Suppressions (scripts/tsan.supp) are

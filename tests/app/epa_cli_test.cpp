@@ -58,9 +58,9 @@ TEST_F(EpaCli, UnknownControllerIsRefusedWithTheChoices) {
   EXPECT_NE(o.output.find("unknown controller 'pid'"), std::string::npos) << o.output;
 }
 
-// What a new user mistypes (an outside walk-through, 2026-11-29): each refused, naming the option
-// and the rule, before anything runs; none taken as something else (a wrapped port, a negative
-// seed taken as 2^64 - 3, a negative setpoint taken as "not given").
+// What a new user mistypes: each refused, naming the option and the rule, before anything runs;
+// none taken as something else (a wrapped port, a negative seed taken as 2^64 - 3, a negative
+// setpoint taken as "not given").
 TEST_F(EpaCli, MistypedCommandsAndNumbersAreRefusedNamingWhatWasWrong) {
   const std::string config = "serve --config " + std::string(EPA_SOURCE_DIR) + "/config/epa.toml --db " + path("epa.db") +
                              " --modbus-port 0 --web-port 0 --duration 0.1";
@@ -89,9 +89,8 @@ TEST_F(EpaCli, MistypedCommandsAndNumbersAreRefusedNamingWhatWasWrong) {
 }
 
 // `serve --duration` is how a script runs the appliance for a while: the exit code says whether
-// the axis ended the run in FAULT (it exited 0 either way; an outside walk-through, 2026-11-29).
-// Plain PP stands still in the dead band 25 mm short (the paper's point), so a following error of
-// 10 mm for 0.5 s faults it.
+// the axis ended the run in FAULT. Plain PP stands still in the dead band 25 mm short (the paper's
+// point), so a following error of 10 mm for 0.5 s faults it.
 TEST_F(EpaCli, ATimedServeThatEndsInFaultExitsFourAndSaysWhy) {
   std::ifstream shipped(std::string(EPA_SOURCE_DIR) + "/config/epa.toml");
   std::stringstream text;

@@ -25,7 +25,7 @@ constexpr double kSlopeRatioRelTol = 0.02;
 // Small swarm budgets keep the test fast (the CLI defaults are larger).
 const std::string kSmallBudget = " --particles 16 --generations 20";
 // The paper's T (eq 11) with its integrating root moved from z = 1 to 0.99: the exact solution for
-// eq 11 itself leaves a closed-loop root at z = 1 (NOTES.md).
+// eq 11 itself leaves a closed-loop root at z = 1 (docs/paper.md).
 const std::string kDesignT = " --T 1,-2.855,2.71575,-0.860706";
 
 class IdentifyCli : public epa::testing::ScratchDirTest {
@@ -158,8 +158,8 @@ TEST_F(IdentifyCli, IdentifiesThePhysicsPlant) {
   const auto none = run_epa("simulate --plant stick-slip --controller pp-ffidz --steps 50");
   EXPECT_NE(none.exit_code, 0);
   EXPECT_NE(none.output.find("[stick_slip] table"), std::string::npos) << none.output;
-  // The one-step criterion alone (before issue 19) cannot see the right side of this plant in runs
-  // that keep near the middle, as the issue's were.
+  // The one-step criterion alone cannot see the right side of this plant in runs that keep near
+  // the middle, as centring runs do.
   const auto centring = run_epa("excite --plant physics --centring --out " + path("c1.csv") + " --duration 60 --seed 1");
   ASSERT_EQ(centring.exit_code, 0) << centring.output;
   const auto one_step = run_epa("identify " + path("c1.csv") + " --criterion one-step" + kSmallBudget);
@@ -246,7 +246,7 @@ TEST_F(IdentifyCli, ThreeCommandsTakeRunFilesToAStepTable) {
 }
 
 // On a cylinder with stiction the model file says the stick-slip model describes the axis, and a set
-// designed on it has pp-traj arrive while sliding; on the paper's plant neither (issue 17, 19).
+// designed on it has pp-traj arrive while sliding; on the paper's plant neither.
 TEST_F(IdentifyCli, AStickSlipAxisIsRecordedInTheModelFileAndGivesPpTrajItsCoast) {
   auto o = run_epa("serve --config " + std::string(EPA_SOURCE_DIR) + "/config/epa.toml --modbus-port 0 --web-port 0 " +
                    "--duration 0.2 --db " + path("epa.db") + " --record-dir " + path("runs"));

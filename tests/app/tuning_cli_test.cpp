@@ -115,8 +115,8 @@ TEST_F(TuningCli, AnActiveSetAtAnotherSamplePeriodIsRefusedAndTheLastGoodOneRuns
   EXPECT_NE(s.output.find("tuning set 'paper'"), std::string::npos) << s.output;
 }
 
-// A set edited over Modbus or HTTP keeps where it came from, and says it was edited since (it
-// read "seeded from the configuration" after any edit; an outside walk-through, 2026-11-29).
+// A set edited over Modbus or HTTP keeps where it came from, and says it was edited since (not
+// just "seeded from the configuration" after an edit).
 TEST_F(TuningCli, AnEditedSetSaysSoBesideWhereItCameFrom) {
   ASSERT_EQ(serve().exit_code, 0);
   EXPECT_EQ(tuning("show paper").output.find("edited since"), std::string::npos) << "not edited yet";

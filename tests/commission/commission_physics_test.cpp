@@ -1,10 +1,10 @@
 // Commissioning, whole, on a rig that is none of the models it fits (physics_rig_commissioning.hpp):
 // the physics plant through an I/O path whose commands reach the valve on time, or a cycle late
 // 20 or 50 % of the time. The seeds are bench/commission_physics.sh's: its first two on time, and
-// the first one in its range where each of the two faults of the code before 2026-11-29 rolled a
-// run back on the axis: the verdict taken on the split the Hammerstein model fits best (seed 108,
-// 50 % late: pp-traj deployed without its sliding arrival overshot 8 mm), and a retry band of half
-// the e_ss limit (seed 102, 20 % late: the retries ran into the metrics' window, e_ss 1.65 mm).
+// the first one in its range where each of two faults, now mended, rolled a run back on the axis:
+// the verdict taken on the split the Hammerstein model fits best (seed 108, 50 % late: pp-traj
+// deployed without its sliding arrival overshot 8 mm), and a retry band of half the e_ss limit
+// (seed 102, 20 % late: the retries ran into the metrics' window, e_ss 1.65 mm).
 // About 12 s, 90 s under ASan, so four runs, not more; under the sanitizers two (on time, and the
 // one that takes both the late commands' retries and the Hammerstein split's verdict), which reach
 // the paths the other two repeat (tests/support/sanitizer_run.hpp).

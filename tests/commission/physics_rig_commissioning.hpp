@@ -1,7 +1,7 @@
 #pragma once
 // One whole commissioning run, offline, on tests/integration/commission_test.py's rig: the physics
 // plant with its hidden perturbations (orifice 3.2 mm2, spool overlap +1.4/-1.5 V) behind a
-// late-command I/O path (physics_rig_axis.hpp), the test's spec (pp-traj, issue 19's limits). Before
+// late-command I/O path (physics_rig_axis.hpp), the test's spec (pp-traj, limits 1 mm, 5 %). Before
 // commissioning the axis makes the test's ten HMI moves with the paper's tuning: the chambers'
 // pressures a working axis has, which the excitation's response depends on (from a fresh 3 bar in
 // both chambers the identified models followed their held-out runs 15-25 points worse than those

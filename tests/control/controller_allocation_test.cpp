@@ -1,5 +1,5 @@
 // Proves the control law allocates nothing: operator new is replaced for this whole test process
-// and counted while the loop runs (ARCHITECTURE.md: the cycle never allocates).
+// and counted while the loop runs (the cycle never allocates: docs/dev/decisions.md).
 #include <gtest/gtest.h>
 
 #include <cmath>

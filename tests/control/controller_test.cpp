@@ -88,7 +88,7 @@ TEST(PpLaw, FirstSamplesMatchTheRecursionByHand) {
   EXPECT_NEAR(controller_step(p, s, e, 0.0).valve_v, u2, kExact);
 }
 
-// G(1)/F(1) = 0.0078 / 0.0048 = 1.625 (NOTES.md): held error e settles at u = 1.625 e.
+// G(1)/F(1) = 0.0078 / 0.0048 = 1.625 (docs/paper.md): held error e settles at u = 1.625 e.
 TEST(PpLaw, StaticGainIsGOfOneOverFOfOne) {
   const auto p = make_params(ControllerKind::kPp);
   ControllerState s;

@@ -10,7 +10,7 @@ namespace {
 constexpr double kTol = 1e-12;
 const core::DeadZone kDz = core::paper::model().dead_zone;
 
-// NOTES.md: (1 + 1/m*) u + b* through the dead zone gives (1 + m*) u: the gain of eq 14/15.
+// (1 + 1/m*) u + b* through the dead zone gives (1 + m*) u: the branch gain of eq 14/15 (docs/paper.md).
 TEST(FfidzCompensation, ThroughTheDeadZoneGivesOnePlusSlopeTimesU) {
   for (double u : {0.05, 0.3, 1.0, 2.0}) {
     EXPECT_NEAR(kDz.apply(ffidz_command(kDz, u, /*e=*/1.0, /*lc=*/0.1)), (1.0 + kDz.m_r) * u, kTol) << u;

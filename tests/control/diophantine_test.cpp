@@ -18,8 +18,8 @@ constexpr double kHandTol = 1e-12;
 // max |A F + B G - T| of a computed solution: rounding of a backward-stable solve on
 // coefficients of size ~3, far below this bound.
 constexpr double kResidualTol = 1e-12;
-// NOTES.md prints the re-solved paper F, G to 5 decimals (rounded): half a unit in the 5th
-// decimal is 5e-6, and 5e-5 leaves room for the last digit either way.
+// The re-solved paper F, G below are given to 5 decimals (rounded; docs/paper.md prints 4): half a
+// unit in the 5th decimal is 5e-6, and 5e-5 leaves room for the last digit either way.
 constexpr double kNotesDigitsTol = 5e-5;
 
 // The paper's model and desired polynomial (eq 9 and 11).
@@ -86,14 +86,14 @@ TEST(Diophantine, PaperModelResolvedGivesTheNotesSolution) {
 TEST(Diophantine, PaperModelSylvesterSystemIsIllConditioned) {
   const auto sol = solve_diophantine(kA, kB, kT);
   ASSERT_TRUE(sol.has_value()) << sol.error().message;
-  // NOTES.md: condition number about 3.6e3.
+  // docs/paper.md: condition number about 3.6e3.
   EXPECT_GT(sol->condition_number, 3.4e3);
   EXPECT_LT(sol->condition_number, 3.8e3);
 }
 
 TEST(Diophantine, PaperExactSolutionHasNoIntegralActionInG) {
   // A(1) = 0 and T(1) = 0, so A(1)F(1) + B(1)G(1) = T(1) reduces to 0.007 G(1) = 0: G(1) = 0,
-  // i.e. the exact controller has zero static gain (NOTES.md: the exact loop has a root at 1).
+  // i.e. the exact controller has zero static gain (docs/paper.md: the exact loop has a root at 1).
   const auto sol = solve_diophantine(kA, kB, kT);
   ASSERT_TRUE(sol.has_value()) << sol.error().message;
   EXPECT_NEAR(sol->G.at(1.0), 0.0, 1e-9);  // 1e-9: cond 3.6e3 times rounding, with margin

@@ -202,7 +202,7 @@ TEST(Jury, VerdictNamesAreReadable) {
 }
 
 TEST(Jury, PaperClosedLoopsOfEq14And15AreStable) {
-  // NOTES.md: both loops are stable, largest root about 0.974.
+  // docs/paper.md: both loops are stable, largest root about 0.974.
   for (const auto& eq : {core::paper::kEq14, core::paper::kEq15}) {
     const Coeffs p(eq.begin(), eq.end());
     EXPECT_EQ(verdict(p), Stability::kStable);
@@ -211,7 +211,7 @@ TEST(Jury, PaperClosedLoopsOfEq14And15AreStable) {
 }
 
 TEST(Jury, PaperTAndAAreMarginalAndBZerosAreOutside) {
-  // T = (1 - q)(1 - 1.865q + 0.8694q^2) and A = (1 - q)(...): a root at z = 1 each (NOTES.md).
+  // T = (1 - q)(1 - 1.865q + 0.8694q^2) and A = (1 - q)(...): a root at z = 1 each (docs/paper.md).
   EXPECT_EQ(verdict(core::paper::T().coefficients()), Stability::kMarginal);
   EXPECT_EQ(verdict(core::paper::model().A.coefficients()), Stability::kMarginal);
   // B's zeros: 1.024z^2 - 2.046z + 1.029 (leading 0 dropped), |z|^2 = 1.029 / 1.024 > 1.

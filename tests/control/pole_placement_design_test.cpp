@@ -26,7 +26,7 @@ TEST(PaperBranches, LeftAndRightReproduceEq14And15ToThreeDecimals) {
 TEST(PaperBranches, AllBranchesAreStableByJuryWithLargestRootNearPointNineSeven) {
   for (const auto& b : analyse_branches(core::paper::model(), core::paper::F(), core::paper::G())) {
     EXPECT_EQ(b.jury.verdict, Stability::kStable) << b.name;
-    EXPECT_LT(b.max_root_abs, 0.985) << b.name;  // NOTES.md: about 0.974 for left/right
+    EXPECT_LT(b.max_root_abs, 0.985) << b.name;  // docs/paper.md: about 0.974 for left/right
     EXPECT_GT(b.max_root_abs, 0.96) << b.name;
   }
 }
@@ -38,7 +38,7 @@ TEST(PaperBranches, GainsAreOnePlusSlope) {
   EXPECT_DOUBLE_EQ(b[2].gain, 1.0 + 1.7627);
 }
 
-// NOTES.md: with the exact solution of eq 4 the loop has a root at z = 1 (T(1) = 0).
+// docs/paper.md: with the exact solution of eq 4 the loop has a root at z = 1 (T(1) = 0).
 TEST(PaperBranches, ExactlySolvedControllerIsMarginalNotStable) {
   const auto m = core::paper::model();
   auto sol = solve_diophantine(m.A, m.B, core::paper::T());

@@ -15,7 +15,7 @@ namespace {
 // ulps of the break point (about 2 V), so 1e-12 V is loose by three orders of magnitude.
 constexpr double kTolV = 1e-12;
 
-// Paper eq 10 (m_l = 1.0707, NOTES.md).
+// Paper eq 10 (m_l = 1.0707, docs/paper.md).
 constexpr DeadZone kPaper{.m_r = 1.7627, .m_l = 1.0707, .b_r = 1.232, .b_l = -1.722};
 
 using epa::test::contains;

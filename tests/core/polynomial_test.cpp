@@ -209,7 +209,7 @@ TEST(Polynomial, ToStringWithLowerPrecisionIsShorter) {
   EXPECT_EQ(p.to_string('q', 2).rfind("0.12", 0), 0u) << p.to_string('q', 2);
 }
 
-// --- The paper's polynomials (NOTES.md, "Facts that were checked") ---
+// --- The paper's polynomials, checked (docs/paper.md reads them) ---
 
 TEST(PaperPolynomials, AHasARootAtZEqualOne) {
   // 1 - 0.9094 - 0.6110 + 0.5204 = 1.5204 - 1.5204 = 0: the plant integrates.

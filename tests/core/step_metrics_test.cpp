@@ -197,7 +197,7 @@ TEST(StepMetrics, SteadyStateErrorIsMeanAbsoluteErrorNotAbsoluteMeanError) {
 }
 
 TEST(StepMetrics, StalledResponseMeasuresRiseAgainstTheFinalValue) {
-  // Stalls at 12.5 on a 50 mm reference. Against the final value (NOTES.md: stepinfo
+  // Stalls at 12.5 on a 50 mm reference. Against the final value (docs/paper.md: stepinfo
   // conventions) the 10-90 % rise is the same as for any first-order approach, 0.10 s; against
   // the reference, 90 % (45 mm) would never be reached.
   const StepMetrics m = step_metrics(first_order(12.5), 50.0, options_with_ts(kTs));

@@ -1,4 +1,4 @@
-// The epa-gap-report/1 JSON against FORMATS.md, the regime breakdown's shares, and `epa diagnose`
+// The epa-gap-report/1 JSON against docs/formats.md, the regime breakdown's shares, and `epa diagnose`
 // run as a user would: on run files with an effect hidden in them, and on bad input.
 #include "diag/gap_report.hpp"
 

@@ -180,7 +180,7 @@ TEST(ComediRail, EndsOfScaleAreRails) {
   EXPECT_TRUE(is_rail(4095, 4095));
 }
 
-// ---- the device (none on this machine) ----
+// ---- the device (absent: a machine without a Comedi board) ----
 
 TEST(ComediDaq, OpenMissingDeviceNamesIt) {
   ComediConfig c;

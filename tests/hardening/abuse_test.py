@@ -18,8 +18,8 @@ the scan cycle has no overrun fault (no 10 missed 5 ms deadlines in a row); the 
 the floods are answered or dropped, never served at the expense of the valid ones.
 The scan period's p99 jitter under abuse (its bound: 1 ms, 20 % of Ts) is a timing target, judged
 by bench/abuse_jitter.sh on the median of several runs, not here: on a shared VM
-one run can meet a stall of the whole machine (2026-11-26: wake-ups 100 ms late, and 3 ms p99
-jitter in CI with the 8 clients alone), which says nothing about the appliance. The floods'
+one run can meet a stall of the whole machine (wake-ups 100 ms late, or 3 ms p99 jitter
+with the 8 clients alone), which says nothing about the appliance. The floods'
 loopback traffic is handled in softirq context, which preempts even the SCHED_FIFO loop.
 Prints both columns; exit 1 on any failure.
 """

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Hostile clients, as an attacker on the plant network would try them: raw sockets and
 hand-built Modbus frames (nothing of the project's Modbus code), against `epa serve` on loopback
-with a key and the shipped limits. Each row of issue 15's table that this release answers:
+with a key and the shipped limits. The attacks this release answers, one row each:
 
   brute force   50 wrong 64-bit keys pipelined on one connection, then the right key from the same
                 address: the right key is refused (04, locked out), `locked` stays 1,

@@ -71,8 +71,8 @@ class Rig:
     def __init__(self, epa, src, shim, data_dir):
         self.plant = PlantServer(epa)
         self.read_only_trigger = os.path.join(tempfile.gettempdir(), f"epa-erofs-{os.getpid()}")
-        # The module's response timeout is 20 ms, not the shipped 2 ms: on this shared virtual
-        # machine the hypervisor takes a CPU away for 5-40 ms at times (2026-11-26), and the simulated
+        # The module's response timeout is 20 ms, not the shipped 2 ms: on a shared virtual
+        # machine the hypervisor can take a CPU away for 5-40 ms at times, and the simulated
         # module on it then answers late, which 2 ms turns into io-errors in checks about something
         # else (the heartbeat, the disk). The io-errors checks hold with it: silent, 40 ms late and
         # garbage all fail a 20 ms exchange; only their detection time is longer.

@@ -1,4 +1,4 @@
-// Identification on a plant that is not its own model (issue 19): open-loop runs of the physics
+// Identification on a plant that is not its own model: open-loop runs of the physics
 // plant (plant/pneumatic_plant.hpp: 5/3 valve with spool overlap, Stribeck friction, compressible
 // air) made in-process as `epa excite --plant physics` makes them, identified as `epa identify`
 // does by default, and checked against the plant itself. The truth for each break point is
@@ -31,12 +31,12 @@ constexpr std::uint64_t kNoiseStream = 0x6E6F697365ull;  // as epa excite: the n
 constexpr double kMidStrokeMm = 250.0;
 constexpr double kRampVPerS = 0.1;       // a slow ramp: the start of motion with little dynamics in it
 constexpr double kStartTravelMm = 0.5;   // "the piston has moved"
-constexpr double kBreakPointTolV = 0.15; // the issue's acceptance
-// The issue asked >= 90 %; no Hammerstein model reaches that on these runs (fitted to the validation
-// run itself the best whole-run fit is 83-88 %, README). This floor only guards the method's level
-// (52 %, 59 %, 42 % for the three plants below on 2026-11-24).
+constexpr double kBreakPointTolV = 0.15; // the acceptance for a break point
+// A validation fit of >= 90 % is the aim; no Hammerstein model reaches that on these runs (fitted to
+// the validation run itself the best whole-run fit is 83-88 %, README). This floor only guards the
+// method's level (52 %, 59 %, 42 % for the three plants below when it was set).
 constexpr double kValidationFitFloorPct = 35.0;
-constexpr double kStickSlipValidationFloorPct = 90.0;  // the issue's figure
+constexpr double kStickSlipValidationFloorPct = 90.0;  // the aim, which the stick-slip model reaches
 
 plant::PneumaticOptions plant_options(std::uint64_t noise_seed, double noise_mm) {
   plant::PneumaticOptions o;

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Commissioning over two processes (issue 19): `epa plant-server --plant physics` with hidden
+"""Commissioning over two processes: `epa plant-server --plant physics` with hidden
 perturbations (the valve's gain x0.8 through its orifice, the spool overlap shifted +0.2 V) behind a
 simulated remote I/O module, `epa serve --hal modbus-io` in real time, and `epa commission` driving
 the appliance over HTTP, unattended, with a shortened excitation.
@@ -7,7 +7,7 @@ the appliance over HTTP, unattended, with a shortened excitation.
     commission_test.py <epa binary> <source dir>
 
 Checks, each printed with its figures:
-  * deployed: `epa commission` with pp-traj and issue 19's limits (1 mm, 5 %) exits 0 with verdict
+  * deployed: `epa commission` with pp-traj and the default limits (1 mm, 5 %) exits 0 with verdict
     "deployed", the new set is the running and the stored active set; then moves of 25-200 mm in
     both directions, commanded over HTTP like an HMI would, end within 1 mm with overshoot <= 5 %,
     and closer to their targets on average than the paper's tuning did on the same rig before;
@@ -154,9 +154,8 @@ def start_rig(epa, src, folder, name):
     try:
         app = Appliance(epa, os.path.join(src, "registers", "epa.csv"),
                         # 20 ms per request, not the rig default of 2 ms, and 40 late cycles in a row (200 ms)
-                        # before an overrun fault, not 10: this machine is a virtual one whose scheduling
-                        # stalls of 5-10 ms (2026-11-26: 18-42 overruns in a test, p99 wake-up 73 us), and
-                        # up to 89 ms under ASan (2026-11-28: an overrun fault, and the whole test ran again),
+                        # before an overrun fault, not 10: on a virtual machine, scheduling stalls of 5-10 ms
+                        # (18-42 overruns in a test, p99 wake-up 73 us), and up to 89 ms under ASan, would
                         # otherwise fault the axis mid-test; what is tested here is the commissioning: the
                         # fault injection test keeps the strict I/O timing, tests/runtime/faults_test.cpp
                         # the overrun fault.
@@ -209,7 +208,7 @@ def check_roll_back(out):
 
 def run_once(epa, src):
     folder = tempfile.mkdtemp(prefix="epa-commission-test.")
-    # Issue 19's limits with pp-traj: identification finds that a stick-slip model describes this
+    # The default limits with pp-traj: identification finds that a stick-slip model describes this
     # rig, so pp-traj arrives while sliding (README, pp-traj). The verification moves cover the
     # sizes the HMI moves below command, both ways (100-200 mm, then -25 and +50 mm: a short
     # move is where a breakaway would overshoot). A move that needs a retry takes 2-3 s, so each
@@ -244,7 +243,7 @@ def run_once(epa, src):
 
         before = http(app, "GET", "/api/status")[1]["store"]["tuning_set"]
         # Also under the sanitizers: these moves leave the rig where the commissioning starts from
-        # (without them, an ASan run identified the Hammerstein model and rolled back, 2026-11-29).
+        # (without them, an ASan run identified the Hammerstein model and rolled back).
         paper_moves = hmi_moves(app)  # the paper's tuning, which the appliance starts with
         print(f"      before commissioning ({before}): {summary(paper_moves)}")
 
@@ -255,8 +254,8 @@ def run_once(epa, src):
         # Deployed.
         r, outcome, report, took = commission(epa, app, dict(base, name="rig-1"), folder, "deployed")
         deployed = r.returncode == 0 and bool(outcome) and outcome["verdict"] == "deployed"
-        # Under the sanitizers the loop runs late (ASan, 2026-12-02: 146 overruns, wake-ups late by
-        # 1.7 ms at the 99th percentile) and the axis's figures are not the product's: a roll-back
+        # Under the sanitizers the loop runs late (under ASan 146 overruns in a run, wake-ups late
+        # by 1.7 ms at the 99th percentile) and the axis's figures are not the product's: a roll-back
         # for a figure missed on the axis is a whole outcome there too, judged below by the state it
         # leaves; the release run judges the figures.
         rolled_back_on_axis = (SANITIZER_RUN and r.returncode == 2 and bool(outcome) and outcome["verdict"] == "rolled-back"

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The fault history end to end (issue 16): faults that a client resets as fast as it can still
+"""The fault history end to end: faults that a client resets as fast as it can still
 appear, with their cause, in GET /api/faults, in the Modbus registers (read with pymodbus, a
 client this project did not write), in `epa faults` and in the log, in the order they happened.
 
@@ -11,7 +11,7 @@ piston stands while the motion it should follow goes on; 10 ms allowed for a 5 m
 heartbeat-lost in MANUAL (the heartbeat stops for 0.3 s) and soft-limit in MANUAL (3 V drives the
 piston past soft_max_mm = 300), the piston at rest before each. A second client polls fault_active in a tight loop and writes
 reset the moment it reads 1, so each fault is latched for a cycle or two, far less than the
-supervisor's 50 ms tick (before issue 16 such faults were logged as "FAULT none: no fault").
+supervisor's 50 ms tick (such a fault must not be logged as "FAULT none: no fault").
 Checked: the three entries newest first with the right code, name, mode, position and setpoint;
 fault_history_count and the newest entries over Modbus (empty slots: code 0, NaN); `epa faults`
 (table and --json) from the database while the appliance runs; the log's FAULT lines carry the

@@ -27,11 +27,11 @@ constexpr double kPaperRiseS = 0.30, kRiseMarginS = 0.10;
 constexpr double kPaperEssMm = 1.04, kEssMarginMm = 1.0;
 
 // Under a sanitizer both processes run several times slower, and the simulated module is no
-// longer a module's firmware answering within the shipped 2 ms (on this VM on 2026-11-26, of 20
-// ASan runs with the shipped config, some faulted with io-errors), so a sanitized build gives the
-// module 20 ms. The control figures are judged in both: since the module steps in phase with the
-// valve writes, 10 of 10 ASan runs ended 0.94-0.97 mm off (2026-11-29), as in simulation; before,
-// some ended 2.3 mm off, the free clock's phase at work.
+// longer a module's firmware answering within the shipped 2 ms (on a 2-core VM, of 20 ASan runs
+// with the shipped config, some faulted with io-errors), so a sanitized build gives the module
+// 20 ms. The control figures are judged in both: since the module steps in phase with the valve
+// writes, 10 of 10 ASan runs ended 0.94-0.97 mm off, as in simulation; with a free-running module
+// clock some ended 2.3 mm off, its phase at work.
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 constexpr bool kSanitized = true;
 #else

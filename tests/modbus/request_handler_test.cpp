@@ -132,7 +132,7 @@ TEST_F(Handler, TheConfiguredLimitsReadAsInputRegisters) {
   EXPECT_NE(loop_.soft_max_mm, loop_.setpoint_max_mm) << "the test tells the two apart only when they differ";
 }
 
-// Issue 16: fault_history_count (input 200-201) and the newest 8 entries of 10 registers each from
+// fault_history_count (input 200-201) and the newest 8 entries of 10 registers each from
 // 202 (code, mode, time uint32, position, setpoint, valve float32), newest first; empty slots read
 // code 0, the integer sentinels and NaN. One read of all 82 registers: the block has no gap.
 TEST_F(Handler, TheFaultHistoryReadsNewestFirstWithEmptySlots) {

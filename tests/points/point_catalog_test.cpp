@@ -34,7 +34,7 @@ TEST(PointCatalog, OneEntryPerIdInOrderWithUniqueNames) {
   EXPECT_EQ(name(indexed_id(PointId::kG0, 3)), "G3");
 }
 
-// Files that spell a point's name as a key of their own documented format (FORMATS.md), not as
+// Files that spell a point's name as a key of their own documented format (docs/formats.md), not as
 // the point: the configuration's [startup] setpoint_mm and [controller] lc_mm, epa-tuning/1 and
 // epa-model/1 keys, the run files' `controller` metadata, report labels, the recent-moves list.
 const std::map<std::string, std::string> kFormatFiles = {

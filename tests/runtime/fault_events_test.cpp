@@ -1,4 +1,4 @@
-// Issue 16: a fault reset within one cycle still reaches the supervisor, with its cause. The loop
+// A fault reset within one cycle still reaches the supervisor, with its cause. The loop
 // runs against a scripted DAQ on a virtual clock; a fault is caused for one cycle and the reset is
 // already queued for the next, so no snapshot after that cycle shows it any more. The expected
 // values come from the script: the reading the DAQ gave, the calibration (50 mm/V), the setpoint

@@ -334,11 +334,11 @@ TEST(Positioning, AResetBitClearsALatchedFault) {
 }
 
 TEST(Positioning, AHaltDuringASlowMoveAfterAHoldStopsWhereItIsHaltedAndStays) {
-  // The browser test's sequence (CI, 2026-11-29): FF-IDZ to 50 mm, a record start under pp-traj to
-  // 200 mm and a hold there, a record at 15 mm/s towards 420 mm, halted at ten phases. pp-traj's
-  // integral from the hold had driven the whole slow move 1.7 mm ahead of its path, the halt
-  // (braking from the piston) then asked the law for a jump, the piston ran 2.9 mm past the
-  // halt, came back and crept on 0.5 mm three seconds later.
+  // The browser test's sequence: FF-IDZ to 50 mm, a record start under pp-traj to 200 mm and a
+  // hold there, a record at 15 mm/s towards 420 mm, halted at ten phases. If pp-traj's integral
+  // from the hold drives the slow move ahead of its path (by 1.7 mm), the halt (braking from the
+  // piston) asks the law for a jump: the piston runs 2.9 mm past the halt, comes back and creeps
+  // on 0.5 mm three seconds later.
   for (int phase = 0; phase < 40; phase += 4) {
     Axis axis(0.0, ControllerKind::kPpFfidz);
     axis.push(mode_command(Mode::kRun));

@@ -208,7 +208,7 @@ TEST(ScanCycle, ControllerSwitchIsBumplessTheHistoryCarriesOver) {
   EXPECT_DOUBLE_EQ(rig.daq.last_written_v, held_v);                  // and the valve does not step
 }
 
-// Issue 17: switching between any two laws while moving makes no step in the valve command; the
+// Switching between any two laws while moving makes no step in the valve command; the
 // new law takes over within a few time constants and brings the piston to the target. On the
 // paper's plant, every ordered pair, switched 80 ms into a 100 mm move.
 TEST(ScanCycle, EverySwitchBetweenTwoLawsWhileMovingIsBumpless) {

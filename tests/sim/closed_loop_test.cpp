@@ -1,4 +1,4 @@
-// Closed-loop tests on the paper's plant: what the paper claims qualitatively (NOTES.md explains why
+// Closed-loop tests on the paper's plant: what the paper claims qualitatively (docs/paper.md explains why
 // its numbers cannot all be reproduced from the printed model).
 #include "sim/closed_loop.hpp"
 

@@ -1,5 +1,5 @@
 // pp-traj arriving while sliding (control/sliding_approach.hpp) on the physics plant, a cylinder
-// with stiction whose form is not the law's model: issue 17's physics limits. The law gets what
+// with stiction whose form is not the law's model, held to pp-traj's limits there. The law gets what
 // commissioning gives it, a model file `epa identify` wrote from open-loop runs of that plant
 // (support/physics_identified_model.hpp): the Hammerstein model for its feed-forward, and the
 // stick-slip model that describes the axis for its coast.
@@ -105,8 +105,9 @@ TEST(PpTrajSliding, TheCoastAlongTheStrokeFollowsThePhysicsPlant) {
   EXPECT_LT(physics_coast_s(25.0, -1.0), 0.67 * physics_coast_s(250.0, -1.0)) << "a coast the same everywhere would miss";
 }
 
-// Issue 17's physics limits on the 18 moves of bench/pp_traj_tables.sh: each from a fresh law, so
-// nothing is learned from an earlier move, and every first approach must land within the band.
+// pp-traj's limits on the physics plant, on the 18 moves of bench/pp_traj_tables.sh: each from a
+// fresh law, so nothing is learned from an earlier move, and every first approach must land within
+// the band.
 TEST(PpTrajSliding, OnThePhysicsPlantEveryMoveSettlesWithinASecondWithinAThirdOfAMillimetreWithoutOvershoot) {
   const auto params = pp_traj_for(identified());
   for (double from : {100.0, 250.0, 400.0})

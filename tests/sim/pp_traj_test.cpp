@@ -1,5 +1,5 @@
 // pp-traj on the paper's printed model, judged against the paper's FF-IDZ measured in the same
-// run (issue 17's acceptance), with sensor noise, and on plants its model gets wrong.
+// run (pp-traj's acceptance), with sensor noise, and on plants its model gets wrong.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -63,7 +63,7 @@ TEST(PpTraj, WithSensorNoiseItStaysWithinTheNoiseAndHoldsTheValve) {
   }
 }
 
-// Issue 17's robustness cases: the plant differs, the controller keeps the printed model.
+// The robustness cases (docs/paper.md, "Robustness"): the plant differs, the controller keeps the printed model.
 struct RobustnessCase {
   const char* name;
   ModelPerturbation plant;
@@ -76,7 +76,7 @@ const RobustnessCase kRobustnessCases[] = {{"gain x0.8", {.gain_factor = 0.8}, {
                                            {"20 ms valve lag", {}, {.lag_s = 0.02}},
                                            {"1 sample delay", {}, {.delay_samples = 1}}};
 
-// Issue 17's robustness cases. Asserted in all of them: no divergence, no chatter, e_ss within
+// The robustness cases. Asserted in all of them: no divergence, no chatter, e_ss within
 // 0.15 mm, settled within 3 s (10 s with the delay). The overshoot limit (30 %) is asserted in the
 // next test, for every case but the 20 ms valve lag, whose short moves still exceed it (README).
 TEST(PpTraj, OnPlantsItsModelGetsWrongItHoldsTheTargetWithoutChatterAndSettlesInTime) {
@@ -93,7 +93,7 @@ TEST(PpTraj, OnPlantsItsModelGetsWrongItHoldsTheTargetWithoutChatterAndSettlesIn
   }
 }
 
-// Overshoot within issue 17's 30 % on plants whose gain, dead band or timing the model gets
+// Overshoot within the 30 % limit on plants whose gain, dead band or timing the model gets
 // wrong. Short moves were the hard ones: the creeping inverse dead zone used to take over at
 // arrival in one sample, which stepped the drive of such a plant, and the printed B answers a
 // step of its drive with a spike (gain x1.2 at 25 mm: 30.6 %, dead band 0.1 V narrower: 40.2 %).

@@ -1,4 +1,4 @@
-// The fault history in the store (issue 16): written by the store thread in its batch, trimmed to
+// The fault history in the store: written by the store thread in its batch, trimmed to
 // the newest 64 in the same transaction, counted since the store was created, read by a second
 // connection while the writer holds the file, kept across reopening, and added by schema
 // migration 4 to a schema-3 file without touching the other tables.

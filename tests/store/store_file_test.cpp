@@ -64,7 +64,7 @@ TEST_F(StoreFile, AnEmptyFileIsTreatedAsMissing) {
 TEST_F(StoreFile, AFileThatIsNotADatabaseIsMovedAsideWithATimestampAndReplaced) {
   const std::string garbage(8192, '\x5a');
   std::ofstream(path("epa.db"), std::ios::binary) << garbage;
-  const std::int64_t now_ms = 1'795'000'000'000;  // 2026-11-19T...Z
+  const std::int64_t now_ms = 1'795'000'000'000;  // a fixed time, ms since the epoch
   auto opened = open_store(path("epa.db"), paper_seed(), now_ms);
   ASSERT_TRUE(opened) << opened.error().message;
   EXPECT_EQ(opened->moved_aside, moved_aside_name(path("epa.db"), now_ms));

@@ -1,8 +1,8 @@
 #pragma once
 // A model file as `epa identify` wrote it from open-loop runs of the default physics plant
-// (epa excite --plant physics --seed 1,2,3 --duration 30; epa identify ex1 ex2 --validate ex3,
-// 2026-11-27): test input for what the law and the stick-slip model do on that plant, shared so
-// that the tests read one model, not two copies of it.
+// (epa excite --plant physics --seed 1,2,3 --duration 30; epa identify ex1 ex2 --validate ex3):
+// test input for what the law and the stick-slip model do on that plant, shared so that the tests
+// read one model, not two copies of it.
 namespace epa::testing {
 
 inline constexpr const char* kPhysicsIdentifiedModelToml = R"(schema = "epa-model/1"

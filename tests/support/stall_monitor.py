@@ -2,8 +2,8 @@
 appliance.
 
 A hardware-in-the-loop test runs the appliance and its simulated I/O module on the same machine. On
-a shared virtual machine the hypervisor sometimes stops a CPU for tens of milliseconds (this VM:
-wake-ups up to 100 ms late on 2026-11-26). The appliance is then right to fault (io-errors,
+a shared virtual machine the hypervisor sometimes stops a CPU for tens of milliseconds (on a 2-core
+VM: wake-ups up to 100 ms late). The appliance is then right to fault (io-errors,
 overruns), as it would be if a real module went silent, but the test meant to check something
 else. StallMonitor runs one process pinned to each CPU that sleeps 2 ms at a time and notes every
 wake-up that came more than `threshold_ms` late; a test may retry a check once when its failure
@@ -22,8 +22,8 @@ import os
 import time
 
 # A real-time check that fails while the machine was stalled this share of its time or more is
-# run once more; failing again on a machine as stalled, it has no verdict (SKIP_RETURN_CODE). This
-# VM idle on 2026-11-26: 0 % in a calm hour (no stall in 10 s), 0.9 % in a noisy one (8 stalls of
+# run once more; failing again on a machine as stalled, it has no verdict (SKIP_RETURN_CODE). A
+# 2-core VM, idle: 0 % in a calm hour (no stall in 10 s), 0.9 % in a noisy one (8 stalls of
 # 7-24 ms in 8 s).
 UNFIT_SHARE = 0.01
 # Or one stall this long: longer than the fault thresholds of the tests with relaxed I/O timing (20 ms

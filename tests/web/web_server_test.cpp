@@ -253,7 +253,7 @@ TEST_F(WebServerTest, TrendMovesTuningAndAuditHaveTheirShapes) {
   EXPECT_EQ(log_.entries.size(), 1u);  // forwarded to the next sink
 }
 
-// Issue 16: GET /api/faults, no token needed; the supervisor adds to the history, the page reads it.
+// GET /api/faults, no token needed; the supervisor adds to the history, the page reads it.
 TEST_F(WebServerTest, FaultsListTheHistoryNewestFirstWithoutAToken) {
   start("a-token-that-is-long-enough");
   json f = get_json("/api/faults");

@@ -5,25 +5,24 @@ truth forms were fixed before the diagnosis was changed, and are not to be chang
 
 How each truth form differs from the fitted one:
 
-  friction      fitted (since 2026-11-27): Coulomb against the model's mechanical speed while
-                sliding, holding the drive up to a breakaway level while sticking; a force through
-                the model's slow pole, the valve's flow still reaching B (before: stick/slip on the
-                size of the drive, cutting the drive that reaches B).
+  friction      fitted: Coulomb against the model's mechanical speed while sliding, holding the
+                drive up to a breakaway level while sticking; a force through the model's slow
+                pole, the valve's flow still reaching B.
                 truth: Karnopp with a Stribeck curve and viscous term on the piston's velocity,
                 which freezes the piston while stuck; and LuGre bristles (presliding, no hard stick).
                 Shared: how a force enters the printed model (through its slow pole, not B), a
                 physical choice both sides make; the friction laws differ.
   position      fitted: a gain slope along the stroke, a chamber slope mirrored per direction and
                 a quadratic curvature, at the mean of the last few positions; a gain that holds
-                beside them is their level (since 2026-12-02).
+                beside them is their level.
                 truth: chamber compressibility, gain ~ 1/(dead volume + chamber length), mirrored
                 per direction; and a cosine dip of the gain around mid-stroke.
-  spool         fitted: one lag, or two real lags in series (since 2026-11-27; critically or
-                over-damped).   truth: second-order spool (natural frequency,
-                damping 0.7-0.8: under-damped); a slew-rate-limited spool.
+  spool         fitted: one lag, or two real lags in series (critically or over-damped).
+                truth: second-order spool (natural frequency, damping 0.7-0.8: under-damped);
+                a slew-rate-limited spool.
   delay         fitted: whole samples.     truth: fractional delays, and a line delay with a lag.
   flow          fitted: a ceiling per direction through a knee s / (1 + |s/c|^n)^(1/n)
-                (n from 1.5, soft, to 64, hard; since 2026-11-27; before: one symmetric hard ceiling).
+                (n from 1.5, soft, to 64, hard).
                 truth: soft (tanh) saturation with a different knee each way; hard limits that
                 differ per direction.
   supply        fitted: one gain ratio.    truth: flow ~ sqrt of the pressure drop, rod-side area
