@@ -64,7 +64,7 @@ for r in nominal:
     print("%-9s %-6g %8s %8s %8s %8s %5d" % (r["controller"], r["step_mm"], f(r["rise_s"]), f(r["settling_s"]), f(r["ess_mm"]),
                                           f(r["overshoot_pct"], "%.2f"), r["valve_sign_changes_last_10s"]))
 print()
-print("pp-traj against issue 17's limits (FF-IDZ from the same command)")
+print("pp-traj against its limits (FF-IDZ from the same command)")
 for r in nominal:
     if r["controller"] != "pp-traj": continue
     s, peer = r["step_mm"], ff[r["step_mm"]]
