@@ -53,17 +53,21 @@ def commission(epa, app, folder, spec=None, env_token=True, token_file=None, tim
     return r, time.monotonic() - t0
 
 
+def read_outcome(folder):
+    """The epa-commission/1 outcome `epa commission --json` wrote; {} when there is none."""
+    try:
+        with open(os.path.join(folder, "outcome.json")) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return {}
+
+
 def commission_instrumented(check, epa, app, folder):
     """The whole sequence through the instrumented appliance on a short experiment: it must end with
     a verdict (deployed 0, rolled back 2) and write its outcome; the figures are not judged here."""
     spec = {"excitation_runs": 2, "excitation_s": 15, "moves_mm": [150, 250], "move_hold_s": 3}
     r, took = commission(epa, app, folder, spec=spec, timeout_s=600)
-    outcome = {}
-    try:
-        with open(os.path.join(folder, "outcome.json")) as f:
-            outcome = json.load(f)
-    except (OSError, ValueError):
-        pass
+    outcome = read_outcome(folder)
     verdict = outcome.get("verdict")
     check(r.returncode in (0, 2) and verdict in ("deployed", "rolled-back"),
           f"instrumented: the short commissioning ended in {took:.0f} s with a verdict (exit {r.returncode}, "
@@ -108,12 +112,7 @@ def main():
             commission_instrumented(check, epa, app, folder)
             return 1 if check.failures else 0
         r, took = commission(epa, app, folder)
-        outcome = {}
-        try:
-            with open(os.path.join(folder, "outcome.json")) as f:
-                outcome = json.load(f)
-        except (OSError, ValueError):
-            pass
+        outcome = read_outcome(folder)
         check(r.returncode == 0 and outcome.get("verdict") == "deployed" and took <= 180.0,
               f"no spec: deployed in {took:.0f} s (at most 180 s; exit {r.returncode}, verdict {outcome.get('verdict')!r}: "
               f"{outcome.get('reason', r.stderr.strip()[-300:])})")
