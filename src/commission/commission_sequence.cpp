@@ -247,7 +247,7 @@ std::optional<store::TuningSet> CommissionSequence::design_tuning_set(const Iden
   // scatter; with half the limit, commissioning through a remote I/O path whose commands reach
   // the valve a cycle late 30-50 % of the time retried stops already within the limit until the
   // last approach fell into the metrics' window, and rolled back 12 runs of 80 that 3/4 deploys
-  // (tests/commission/commission_physics_sweep.cpp, README "Commissioning").
+  // (tests/commission/commission_physics_sweep.cpp, docs/commissioning.md).
   const auto coast = plant::sliding_arrival_coast_s(
       core::ModelFile{identified.model, "", identified.stick_slip, identified.axis_model}, set.trajectory.approach_speed_mm_s);
   if (!coast) return finish(Verdict::kRolledBack, "design: " + coast.error().message, out), std::nullopt;

@@ -463,7 +463,7 @@ bool any_address_may_command(const ApplianceConfig& c) {
 std::string any_address_notice(const ApplianceConfig& c) {
   if (!any_address_may_command(c)) return "";
   return "any address may command motion over Modbus: set [modbus] write_clients to restrict it "
-         "(README, \"Who may command the axis\")";
+         "(docs/modbus.md, \"Who may command the axis\")";
 }
 
 core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, const std::string& file) {

@@ -1,5 +1,5 @@
 #pragma once
-// pp-traj's arrival on an axis with stick-slip (README "pp-traj", notes/stick-slip.md): arrive while
+// pp-traj's arrival on an axis with stick-slip (docs/paper.md, notes/stick-slip.md): arrive while
 // sliding, never correct from rest by a small amount.
 //
 // Why. A stopped pneumatic piston cannot be moved by less than one breakaway jump (the chambers must

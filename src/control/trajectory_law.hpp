@@ -1,5 +1,5 @@
 #pragma once
-// pp-traj: this project's law beyond the paper (README "pp-traj"): a model-based reference
+// pp-traj: this project's law beyond the paper (docs/paper.md, "Beyond the paper: pp-traj"): a model-based reference
 // trajectory with an exact feed-forward, and a low-bandwidth feedback that only corrects what the
 // model does not know. Per sample, in sensor volts:
 //
@@ -26,7 +26,7 @@
 // piston stays), so sensor noise cannot make it chatter; it corrects again when the filtered error
 // exceeds hold_band_v.
 //
-// With coast_s > 0 (an axis with stick-slip: the identified stick-slip model's coast, README) the
+// With coast_s > 0 (an axis with stick-slip: the identified stick-slip model's coast, docs/paper.md) the
 // reference comes from sliding_approach.hpp instead of the motion profile, and the law arrives by
 // centring the valve while the piston still slides: no integrator, no creeping inverse. A setpoint
 // that moves sample after sample (a halt's braking, a jog, a move with a speed limit:
@@ -52,7 +52,7 @@ struct TrajectoryConfig {
   double accel_per_distance = 200.0;  // short moves: accel <= this x |move|, 1/s^2 (motion_profile.hpp); 0: off
   // Moving-average length of the profile (jerk limit), s. 55 ms (11 samples at 5 ms) rather than
   // 50: with a 20 ms valve lag the printed model's short moves overshot 35 % at 50 ms and 3-6 %
-  // at 55 ms, and the lag they bear within 30 % grew from under 20 ms to 20-25 ms (README).
+  // at 55 ms, and the lag they bear within 30 % grew from under 20 ms to 20-25 ms (docs/paper.md).
   double smoothing_s = 0.055;
   double feedback_bandwidth_rad_s = 6.0;  // crossover of the feedback loop on the model's integrator
   double filter_ratio = 8.0;          // the feedback's 2nd-order low-pass sits this far above the crossover

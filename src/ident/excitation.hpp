@@ -24,7 +24,7 @@
 // Why sweep. A run that stays near the middle leaves the model's behaviour elsewhere unseen and
 // fits the few long moves that dominate a free run by chance: on the physics plant a stick-slip
 // model fitted to centring runs reached 79-88 % on held-out runs, fitted to sweeping ones 91-92 %
-// on the same plant and seeds (README, Identification).
+// on the same plant and seeds (docs/identification.md).
 //
 // Timing as core/run.hpp: next(y(k)) returns u(k), applied from k to k+1.
 #include <cstdint>

@@ -27,7 +27,7 @@
 // slowly (the balance between the two sides' gains, friction that creeps) shows only over long
 // horizons, and that is exactly what a free run of the model (and a controller relying on the
 // model's gains) depends on. On the physics plant (pneumatic_plant.hpp) no window length did
-// clearly better on validation runs, and short ones much worse (README, Identification).
+// clearly better on validation runs, and short ones much worse (docs/identification.md).
 //
 // Method: Levenberg-Marquardt with the exact Jacobian of the simulation (the sensitivity of yhat to
 // each parameter runs through the same recursion as yhat itself; the dead zone's derivatives exist

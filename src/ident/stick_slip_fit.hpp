@@ -6,7 +6,7 @@
 // scale), then the dead time is chosen among 0..2 samples around it.
 //
 // Why a second model beside the Hammerstein one. On a pneumatic axis the Hammerstein model's
-// free-run fit stays near 55-80 % (README, Identification): how far a pulse moves the piston
+// free-run fit stays near 55-80 % (docs/identification.md): how far a pulse moves the piston
 // depends on what the last move left in the chambers, and a static dead zone on a linear model
 // cannot hold that. The stick-slip model holds it in one state (the air spring's wind-up) and
 // fits such runs above 90 %. The pole-placement design still takes the Hammerstein model (it

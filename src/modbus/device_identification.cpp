@@ -42,7 +42,7 @@ DeviceIdentity with_host(DeviceIdentity identity, std::string_view host) {
 DeviceIdentity appliance_identity(std::string_view register_map_path, std::string_view status_page_url) {
   return {{"EPA project", "epa", std::string(core::kVersion),
            // No public project address exists yet: the appliance's own status page, where its documentation
-           // for the integrator lives (README, "The status page and HTTP API").
+           // for the integrator lives (docs/http-api.md).
            std::string(status_page_url), "EPA electro-pneumatic axis controller", "epa appliance",
            std::filesystem::path(register_map_path).filename().string()}};
 }

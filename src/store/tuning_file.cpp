@@ -81,7 +81,7 @@ std::string format_tuning_toml(const TuningSet& t, const ModelRecord& m) {
   s += "\n[rst]\nF = " + toml_float_array(t.F.coefficients()) + "\nG = " + toml_float_array(t.G.coefficients()) +
        "\nH = " + toml_float_array(t.H.coefficients()) + "\n";
   s += "\n" + core::format_dead_zone_table(t.dead_zone);
-  s += "\n[trajectory]  # pp-traj's parameters (README \"pp-traj\")\n";
+  s += "\n[trajectory]  # pp-traj's parameters (docs/paper.md, \"Beyond the paper: pp-traj\")\n";
   for (const auto& [key, value] : trajectory_setting_values(t.trajectory)) s += key + " = " + toml_float(value) + "\n";
   // The model section is the model file's own text, moved under [model].
   std::string model_text = core::format_model_toml({m.model, m.source});

@@ -101,8 +101,8 @@ TEST(TuningFile, BadFilesAreRefusedNamingWhatIsWrong) {
       {replaced(good, "controller = \"pp-ngidz\"", "controller = \"pid\""), "controller"},
       {replaced(good, "b_l = -1.722", "b_l = 3.0"), "b_l"},  // b_l > b_r: refused whole
       {replaced(good, "[rst]\n", "[rst]\nX = [1.0]\n"), "unknown key 'X' in [rst] (expected one of: F, G, H)"},
-      {replaced(good, "[trajectory]  # pp-traj's parameters (README \"pp-traj\")\n",
-                "[trajectory]  # pp-traj's parameters (README \"pp-traj\")\ncoast = 1.0\n"),
+      {replaced(good, "[trajectory]  # pp-traj's parameters (docs/paper.md, \"Beyond the paper: pp-traj\")\n",
+                "[trajectory]  # pp-traj's parameters (docs/paper.md, \"Beyond the paper: pp-traj\")\ncoast = 1.0\n"),
        "unknown key 'coast' in [trajectory] (expected one of: "},
       {replaced(good, "lc_mm = 5.0", "lc_mm = \"five\""), "lc_mm must be a number"},
       {replaced(good, "lc_mm = 5.0", "lc_mm = = 5"), "x.toml:"},
