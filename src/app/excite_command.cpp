@@ -27,6 +27,10 @@ void add_excite_command(CLI::App& app, ExciteOptions& o) {
   cmd->add_option("--physics-config", o.physics_config,
                   "Physics plant parameters (epa-pneumatic/1 TOML) for --plant physics; default: built in")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--sensor-bits", o.sensor_bits, "Physics plant: ADC resolution over 0-10 V (0: none)")
+      ->capture_default_str()->check(CLI::Range(0, 24));
+  cmd->add_option("--delay", o.delay_samples, "Physics plant: samples of transport delay before the spool (a long line)")
+      ->capture_default_str()->check(CLI::Range(0, 32));
   cmd->add_option("--plot", o.plot_path, "Draw the run (position and valve command) as an SVG picture");
   cmd->add_option("--duration", o.duration_s, "Length of the run, s")->capture_default_str()->check(cli::kPositive);
   cmd->add_option("--seed", o.seed, "Seed of the pulse sequence and of the sensor noise")->capture_default_str()->check(cli::kSeed);
@@ -87,7 +91,8 @@ core::Result<ExcitedRun> excite_physics(const ExciteOptions& o, ident::Excitatio
                                                         .initial_pressure_bar = 3.0,
                                                         .noise_std_mm = o.noise_mm,
                                                         .seed = o.seed ^ kNoiseStream,
-                                                        .sensor_bits = 0,
+                                                        .sensor_bits = o.sensor_bits,
+                                                        .command_delay_samples = o.delay_samples,
                                                         .Ts = kPhysicsTs,
                                                         .substeps = 50});
   if (!plant) return plant.error();
@@ -121,6 +126,8 @@ int run_excite(const ExciteOptions& o, std::ostream& out, std::ostream& err) {
     return fail("--model applies to --plant hammerstein only (the physics plant takes --physics-config)");
   if (!physics && !o.physics_config.empty())
     return fail("--physics-config applies to --plant physics only");
+  if (!physics && (o.sensor_bits != 0 || o.delay_samples != 0))
+    return fail("--sensor-bits and --delay apply to --plant physics only");
 
   ident::ExcitationOptions eo;
   eo.duration_s = o.duration_s;

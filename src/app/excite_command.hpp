@@ -31,6 +31,8 @@ struct ExciteOptions {
   double ramp_travel_mm = 40.0;
   double guard_mm = 100.0;
   bool centring = false;  // pulse signs towards the middle instead of sweeps
+  int sensor_bits = 0;     // physics: ADC resolution over 0-10 V (0: none)
+  int delay_samples = 0;   // physics: transport delay before the spool, samples
 };
 
 void add_excite_command(CLI::App& app, ExciteOptions& options);

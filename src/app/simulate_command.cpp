@@ -49,6 +49,8 @@ void add_simulate_command(CLI::App& app, SimulateOptions& o) {
   cmd->add_option("--duration", o.duration_s, "Length of each run, s")->capture_default_str()->check(cli::kPositive);
   cmd->add_option("--Ts", o.Ts, "Sample time, s (default: the model's, 0.005 for the paper)")->check(cli::kPositive);
   cmd->add_option("--lc", o.lc_mm, "FF-IDZ switch-off band l_c, mm")->capture_default_str()->check(cli::kNonNegative);
+  cmd->add_option("--sensor-bits", o.sensor_bits, "Physics plant: ADC resolution over 0-10 V (0: none)")
+      ->capture_default_str()->check(CLI::Range(0, 24));
   cmd->add_option("--noise", o.noise_mm, "Sensor noise standard deviation, mm")->capture_default_str()->check(cli::kNonNegative);
   cmd->add_option("--seed", o.seed, "Seed of the sensor noise")->capture_default_str()->check(cli::kSeed);
   cmd->add_option("--model", o.model_path, "Model file (epa-model/1 TOML); default: the paper's eq 9-10")->check(CLI::ExistingFile);
@@ -87,6 +89,7 @@ core::Status check_plant_options(const SimulateOptions& o, const core::ModelFile
   if (stick_slip_plant(o) && !model_file.stick_slip)
     return core::invalid_argument("--plant stick-slip needs a model file with a [stick_slip] table (--model; epa identify writes one)");
   if (!physics_plant(o) && !o.physics_config.empty()) return core::invalid_argument("--physics-config applies to --plant physics only");
+  if (!physics_plant(o) && o.sensor_bits != 0) return core::invalid_argument("--sensor-bits applies to --plant physics only");
   return core::ok();
 }
 
@@ -105,7 +108,7 @@ core::Result<PlantMaker> plant_maker(const SimulateOptions& o, const core::Model
   return PlantMaker([&o, &model_file, model, plant_model, physics_params]() -> core::Result<std::unique_ptr<plant::PlantSimulator>> {
     if (physics_plant(o))
       return plant::make_pneumatic_simulator(physics_params, {.initial_position_mm = o.start_mm, .noise_std_mm = o.noise_mm,
-                                                               .seed = o.seed, .Ts = model.Ts});
+                                                               .seed = o.seed, .sensor_bits = o.sensor_bits, .Ts = model.Ts});
     if (stick_slip_plant(o))
       return plant::make_stick_slip_simulator(*model_file.stick_slip, model.Ts, model.mm_per_volt,
                                               {.initial_position_mm = o.start_mm, .noise_std_mm = o.noise_mm,

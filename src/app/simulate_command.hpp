@@ -23,6 +23,7 @@ struct SimulateOptions {
   double Ts = 0.0;           // 0: the model's own
   double lc_mm = 5.0;
   double noise_mm = 0.0;
+  int sensor_bits = 0;  // physics: ADC resolution over 0-10 V (0: none)
   std::uint64_t seed = 1;
   std::string model_path;    // empty: the paper's model
   std::string design_path;   // empty: the paper's F, G

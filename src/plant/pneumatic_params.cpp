@@ -43,6 +43,8 @@ constexpr std::array kFields{
     Field{"cylinder", "dead_volume_b_cm3", &PneumaticParams::dead_volume_b_cm3, 0.1, 1e4, false},
     Field{"cylinder", "piston_mass_kg", &PneumaticParams::piston_mass_kg, 0.01, 1000.0, false},
     Field{"cylinder", "polytropic_index", &PneumaticParams::polytropic_index, 1.0, 1.67, false},
+    Field{"cylinder", "leak_a_mm2", &PneumaticParams::leak_a_mm2, 0.0, 100.0, false},
+    Field{"cylinder", "leak_b_mm2", &PneumaticParams::leak_b_mm2, 0.0, 100.0, false},
     Field{"friction", "static_friction_n", &PneumaticParams::static_friction_n, 0.0, 1e5, false},
     Field{"friction", "coulomb_friction_n", &PneumaticParams::coulomb_friction_n, 0.0, 1e5, false},
     Field{"friction", "stribeck_velocity_mps", &PneumaticParams::stribeck_velocity_mps, 1e-4, 10.0, false},

@@ -5,7 +5,7 @@
 //   schema = "epa-pneumatic/1"
 //   [supply]    supply_pressure_bar, atmospheric_pressure_bar, temperature_k
 //   [cylinder]  bore_mm, rod_mm, stroke_mm, dead_volume_a_cm3, dead_volume_b_cm3, piston_mass_kg,
-//               polytropic_index
+//               polytropic_index, leak_a_mm2, leak_b_mm2
 //   [friction]  static_friction_n, coulomb_friction_n, stribeck_velocity_mps, viscous_friction_n_per_mps
 //   [valve]     orifice_area_mm2, discharge_coefficient, spool_time_constant_s, overlap_pos_v, overlap_neg_v
 //
@@ -33,6 +33,8 @@ struct PneumaticParams {
   double dead_volume_b_cm3 = 10.0;  // chamber B at x = stroke
   double piston_mass_kg = 1.5;      // piston, rod and carriage
   double polytropic_index = 1.4;    // n in dp/dt = n(RT m' - p V')/V; 1.4: adiabatic, 1.0: isothermal
+  double leak_a_mm2 = 0.0;          // effective area of a leak from chamber A to atmosphere (a worn seal); 0: tight
+  double leak_b_mm2 = 0.0;          // the same for chamber B
 
   // [friction] F(v) = sgn(v) [Fc + (Fs - Fc) exp(-(v/vs)^2)] + b v, sticking below Fs at v = 0
   double static_friction_n = 40.0;           // Fs, breakaway force

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
 #include <string>
 
 #include "core/format.hpp"
@@ -54,6 +55,9 @@ core::Result<PneumaticPlant> PneumaticPlant::make(const PneumaticParams& params,
   if (o.sensor_bits < 0 || o.sensor_bits > 24)
     return core::invalid_argument("pneumatic plant: sensor bits " + std::to_string(o.sensor_bits) +
                                   " is outside 0..24 (0: no quantisation)");
+  if (o.command_delay_samples < 0 || o.command_delay_samples > kMaxCommandDelay)
+    return core::invalid_argument("pneumatic plant: command delay " + std::to_string(o.command_delay_samples) +
+                                  " samples is outside 0.." + std::to_string(kMaxCommandDelay));
   if (!(o.Ts >= 1e-4 && o.Ts <= 1.0))
     return core::invalid_argument("pneumatic plant: Ts " + num(o.Ts) + " s is outside 0.0001..1 s");
   if (o.substeps < 1 || o.substeps > 100000)
@@ -79,6 +83,8 @@ core::Result<PneumaticPlant> PneumaticPlant::make(const PneumaticParams& params,
   p.vs_ = params.stribeck_velocity_mps;
   p.b_ = params.viscous_friction_n_per_mps;
   p.orifice_eff_m2_ = params.discharge_coefficient * params.orifice_area_mm2 * 1e-6;
+  p.leak_a_m2_ = params.leak_a_mm2 * 1e-6;
+  p.leak_b_m2_ = params.leak_b_mm2 * 1e-6;
   p.tau_s_ = params.spool_time_constant_s;
   p.overlap_pos_v_ = params.overlap_pos_v;
   p.overlap_neg_v_ = params.overlap_neg_v;
@@ -92,6 +98,7 @@ core::Result<PneumaticPlant> PneumaticPlant::make(const PneumaticParams& params,
   p.max_code_ = o.sensor_bits > 0 ? std::ldexp(1.0, o.sensor_bits) - 1.0 : 0.0;
   p.Ts_ = o.Ts;
   p.substeps_ = o.substeps;
+  p.command_delay_ = o.command_delay_samples;
   p.h_ = o.Ts / o.substeps;
 
   // RK4 is stable for h |lambda| up to about 2.8 on the real and imaginary axes; keep h |lambda|
@@ -168,8 +175,10 @@ PneumaticPlant::Deriv PneumaticPlant::derivative(const State& s, double u, bool 
   const double open_neg = std::clamp((overlap_neg_v_ - s.spool_v) / (kMaxValveV + overlap_neg_v_), 0.0, 1.0);
   const double a_pos = orifice_eff_m2_ * open_pos, a_neg = orifice_eff_m2_ * open_neg;
   const double pa = s.pressure_a_pa, pb = s.pressure_b_pa;
-  const double mdot_a = orifice_mass_flow(a_pos, supply_pa_, pa) - orifice_mass_flow(a_neg, pa, atm_pa_);
-  const double mdot_b = orifice_mass_flow(a_neg, supply_pa_, pb) - orifice_mass_flow(a_pos, pb, atm_pa_);
+  const double mdot_a = orifice_mass_flow(a_pos, supply_pa_, pa) - orifice_mass_flow(a_neg, pa, atm_pa_) -
+                        orifice_mass_flow(leak_a_m2_, pa, atm_pa_);
+  const double mdot_b = orifice_mass_flow(a_neg, supply_pa_, pb) - orifice_mass_flow(a_pos, pb, atm_pa_) -
+                        orifice_mass_flow(leak_b_m2_, pb, atm_pa_);
   const double x = std::clamp(s.position_m, 0.0, stroke_m_);
   const double v = held ? 0.0 : s.velocity_mps;
   const double Va = dead_a_m3_ + area_a_m2_ * x, Vb = dead_b_m3_ + area_b_m2_ * (stroke_m_ - x);
@@ -228,7 +237,12 @@ void PneumaticPlant::substep(double u) noexcept {
 }
 
 void PneumaticPlant::step(double valve_v) noexcept {
-  const double u = std::isfinite(valve_v) ? std::clamp(valve_v, -kMaxValveV, kMaxValveV) : 0.0;
+  double u = std::isfinite(valve_v) ? std::clamp(valve_v, -kMaxValveV, kMaxValveV) : 0.0;
+  if (command_delay_ > 0) {  // the command sent command_delay_ samples ago reaches the spool now
+    auto& line = state_.command_line;
+    std::swap(u, line[state_.command_head]);
+    state_.command_head = (state_.command_head + 1) % static_cast<std::size_t>(command_delay_);
+  }
   for (int i = 0; i < substeps_; ++i) substep(u);
   sample_sensor();
 }

@@ -27,6 +27,8 @@
 //
 // Timing, like HammersteinPlant: step(u) holds u(k) over [k Ts, (k+1) Ts) and advances to k+1;
 // measured_v() is the sensor at k (0-10 V over the stroke, seeded noise, then ADC quantisation).
+#include <array>
+#include <cstddef>
 #include <cstdint>
 
 #include "core/random.hpp"
@@ -43,12 +45,14 @@ struct PneumaticOptions {
   double noise_std_mm = 0.0;          // Gaussian sensor noise (measurement only)
   std::uint64_t seed = 1;             // for the noise
   int sensor_bits = 0;                // ADC resolution over the sensor's 0-10 V; 0: no quantisation
+  int command_delay_samples = 0;      // transport delay before the spool (a long line), 0..kMaxCommandDelay
   double Ts = 0.005;                  // sample period, s
   int substeps = 50;                  // RK4 steps per sample
 };
 
 class PneumaticPlant {
  public:
+  static constexpr int kMaxCommandDelay = 32;
   // All the plant's memory, so a run can be saved and replayed from any sample.
   struct State {
     double spool_v = 0.0;        // spool position in command volts
@@ -58,10 +62,12 @@ class PneumaticPlant {
     double velocity_mps = 0.0;
     double measured_v = 0.0;     // sensor reading at k
     core::Random rng;
+    std::array<double, kMaxCommandDelay> command_line{};  // commands in transit (command_delay_samples)
+    std::size_t command_head = 0;
   };
 
   // Errors name the parameter or option: invalid params (PneumaticParams::validate), an initial
-  // position outside the stroke, negative noise, bits outside 0..24, a bad Ts, or a sub-step too
+  // position outside the stroke, negative noise, bits outside 0..24, a delay outside 0..32, a bad Ts, or a sub-step too
   // long for the stiffest dynamics (with the substeps it needs).
   static core::Result<PneumaticPlant> make(const PneumaticParams& params, const PneumaticOptions& options);
 
@@ -107,11 +113,13 @@ class PneumaticPlant {
   double area_a_m2_ = 0, area_b_m2_ = 0, area_rod_m2_ = 0, stroke_m_ = 0, dead_a_m3_ = 0, dead_b_m3_ = 0;
   double supply_pa_ = 0, atm_pa_ = 0, RT_ = 0, sqrt_T_ = 0, n_ = 0, mass_kg_ = 0;
   double Fs_ = 0, Fc_ = 0, vs_ = 0, b_ = 0;
+  double leak_a_m2_ = 0, leak_b_m2_ = 0;  // leaks to atmosphere, effective areas
   double orifice_eff_m2_ = 0, tau_s_ = 0, overlap_pos_v_ = 0, overlap_neg_v_ = 0;
   double laminar_alpha_ = 0, laminar_beta_ = 0;  // psi = alpha d + beta d^2, d = 1 - r, near r = 1
   double mm_per_volt_ = 50.0, noise_std_v_ = 0.0, lsb_v_ = 0.0, max_code_ = 0.0;
   double Ts_ = 0.005, h_ = 1e-4;
   int substeps_ = 50;
+  int command_delay_ = 0;
   State state_;
 };
 

@@ -83,6 +83,53 @@ TEST_P(ChokedFilling, ClampedChamberPressureRisesLinearlyAtTheChokedRate) {
 
 INSTANTIATE_TEST_SUITE_P(AdiabaticAndIsothermal, ChokedFilling, ::testing::Values(1.4, 1.0));
 
+// A command delay of d samples is the undelayed plant driven by the command of d samples ago.
+TEST(PneumaticPlant, ACommandDelayShiftsTheCommandBySamples) {
+  const int d = 3;
+  auto delayed = make_plant({}, {.initial_position_mm = 250.0, .command_delay_samples = d});
+  auto plain = make_plant({}, {.initial_position_mm = 250.0});
+  std::vector<double> u;
+  for (int k = 0; k < 400; ++k) u.push_back(k % 100 < 50 ? 3.0 : -3.5);
+  for (int k = 0; k < 400; ++k) {
+    delayed.step(u[static_cast<std::size_t>(k)]);
+    plain.step(k >= d ? u[static_cast<std::size_t>(k - d)] : 0.0);
+    ASSERT_EQ(delayed.position_mm(), plain.position_mm()) << "sample " << k;
+  }
+  EXPECT_GT(std::abs(plain.position_mm() - 250.0), 5.0);  // it moved: the comparison saw motion
+  EXPECT_FALSE(PneumaticPlant::make({}, {.command_delay_samples = PneumaticPlant::kMaxCommandDelay + 1}).has_value());
+}
+
+// A leak from chamber A to atmosphere, valve centred and the piston held at the rod-end stop: the
+// chamber (fixed volume) empties through a choked orifice while p_atm / p_A <= 0.528, so
+// dp/dt = -n R T C1 A_leak p / (sqrt(T) V): p falls exponentially at that rate. Chamber B is tight.
+TEST(PneumaticPlant, ALeakEmptiesItsChamberAtTheChokedRateAndLeavesTheOtherTight) {
+  PneumaticParams params;
+  params.leak_a_mm2 = 0.05;
+  auto plant = make_plant(params, {.initial_position_mm = params.stroke_mm, .initial_pressure_bar = 0.0});
+  auto s = plant.state();
+  s.pressure_a_pa = 7.0 * kBar;  // the stop holds the piston: A pushes it into the stop
+  s.pressure_b_pa = 1.5 * kBar;  // low enough that A still holds it there at 2 bar
+  plant.set_state(s);
+  const double gamma = 1.4, R = 287.05, T = params.temperature_k;
+  const double C1 = std::sqrt(gamma / R * std::pow(2.0 / (gamma + 1.0), (gamma + 1.0) / (gamma - 1.0)));
+  const double V = params.dead_volume_a_cm3 * 1e-6 + area_m2(params.bore_mm) * params.stroke_mm * 1e-3;
+  const double rate_per_s = params.polytropic_index * R * T * C1 * params.leak_a_mm2 * 1e-6 / (std::sqrt(T) * V);
+  const double atm = params.atmospheric_pressure_bar * kBar;
+  int samples = 0;
+  double worst_rel = 0.0;
+  while (plant.pressure_a_pa() > atm / 0.5) {  // still choked
+    plant.step(0.0);
+    ++samples;
+    const double expected = 7.0 * kBar * std::exp(-rate_per_s * samples * plant.Ts());
+    worst_rel = std::max(worst_rel, std::abs(plant.pressure_a_pa() - expected) / expected);
+    ASSERT_EQ(plant.position_mm(), params.stroke_mm);
+    ASSERT_EQ(plant.pressure_b_pa(), 1.5 * kBar) << "chamber B has no leak and its valve edges are closed";
+  }
+  EXPECT_GT(samples, 100);
+  EXPECT_LT(worst_rel, 1e-9);  // RK4 on an exponential at h |lambda| << 1
+  RecordProperty("leak_worst_relative_error", figure(worst_rel));
+}
+
 // Valve centred, no friction: each sealed chamber is a polytropic spring, p V^n = const along
 // any motion. The piston oscillates on the two air springs; the invariant must hold throughout.
 TEST(PneumaticPlant, SealedChambersKeepPVToTheNConstantWhileThePistonOscillates) {
