@@ -91,6 +91,26 @@ Result<StickSlipParams> stick_slip_at(const toml::table& t, const std::string& s
   return p;
 }
 
+// The [stick_slip_spread] table: every field, by its name.
+Result<StickSlipSpread> stick_slip_spread_at(const toml::table& t, const std::string& src) {
+  StickSlipSpread s;
+  const std::pair<const char*, double*> fields[] = {{"friction_log_ratio", &s.friction_log_ratio},
+                                                    {"flow_gain_log_ratio", &s.flow_gain_log_ratio},
+                                                    {"break_v", &s.break_v},
+                                                    {"spool_lag_s", &s.spool_lag_s},
+                                                    {"delay_samples", &s.delay_samples}};
+  std::vector<std::string_view> keys;
+  for (const auto& [key, value] : fields) keys.push_back(key);
+  if (auto st = only_keys(t, keys, src, "stick_slip_spread"); !st) return st.error();
+  for (const auto& [key, value] : fields) {
+    auto v = number_at(t, "stick_slip_spread", key, src);
+    if (!v) return v.error();
+    *value = *v;
+  }
+  if (auto st = s.validate(); !st) return invalid_argument(src + ": [stick_slip_spread] " + st.error().message);
+  return s;
+}
+
 }  // namespace
 
 Result<ModelFile> parse_model_toml(const std::string& text, const std::string& src) {
@@ -98,7 +118,10 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
   if (!document) return document.error();
   const toml::table& root = *document;
 
-  if (auto s = only_keys(root, {"schema", "Ts", "mm_per_volt", "source", "axis_model", "arx", "dead_zone", "stick_slip"}, src); !s)
+  if (auto s = only_keys(root, {"schema", "Ts", "mm_per_volt", "source", "axis_model", "identified_drive_v", "arx", "dead_zone", "stick_slip",
+                          "stick_slip_spread"},
+                         src);
+      !s)
     return s.error();
   ModelFile f;
   auto Ts = number_at(root, "", "Ts", src);
@@ -139,6 +162,22 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
     if (!params) return params.error();
     f.stick_slip = *params;
   }
+  if (root.contains("stick_slip_spread")) {
+    const auto* t = root["stick_slip_spread"].as_table();
+    if (!t) return parse_error(src + ": stick_slip_spread must be a table");
+    if (!f.stick_slip) return parse_error(src + ": [stick_slip_spread] needs a [stick_slip] table");
+    auto spread = stick_slip_spread_at(*t, src);
+    if (!spread) return spread.error();
+    f.stick_slip_spread = *spread;
+  }
+  if (root.contains("identified_drive_v")) {
+    auto range = array_at(root, "identified_drive_v", src);
+    if (!range) return range.error();
+    const auto& v = range->coefficients();
+    if (v.size() != 2 || !(v[0] <= 0.0 && v[1] >= 0.0 && v[0] >= -10.0 && v[1] <= 10.0))
+      return parse_error(src + ": identified_drive_v must be [lowest, highest] valve command in V, within [-10, 0] and [0, 10]");
+    f.identified_drive_v = std::array<double, 2>{v[0], v[1]};
+  }
   if (root.contains("axis_model")) {
     const auto name = root["axis_model"].value<std::string>();
     if (name == "hammerstein") {
@@ -171,6 +210,12 @@ std::string format_stick_slip(const StickSlipParams& p) {
          "\ndelay_samples = " + std::to_string(p.delay_samples) + "\n";
 }
 
+std::string format_stick_slip_spread(const StickSlipSpread& s) {
+  auto num = [](double v) { return toml_float(v); };
+  return "\n[stick_slip_spread]\nfriction_log_ratio = " + num(s.friction_log_ratio) + "\nflow_gain_log_ratio = " + num(s.flow_gain_log_ratio) +
+         "\nbreak_v = " + num(s.break_v) + "\nspool_lag_s = " + num(s.spool_lag_s) + "\ndelay_samples = " + num(s.delay_samples) + "\n";
+}
+
 }  // namespace
 
 std::string format_dead_zone_table(const DeadZone& dead_zone) {
@@ -188,8 +233,12 @@ std::string format_model_toml(const ModelFile& f) {
   source << toml::value<std::string>(f.source);  // TOML string escaping by the library
   return "schema = \"" + std::string(kSchema) + "\"\nTs = " + num(m.Ts) + "\nmm_per_volt = " + num(m.mm_per_volt) +
          "\nsource = " + source.str() + "\n" +
-         (f.axis_model == AxisModel::kStickSlip ? "axis_model = \"stick-slip\"\n" : "") + "\n[arx]\nA = " + list(m.A) + "\nB = " + list(m.B) +
-         "\n\n" + format_dead_zone_table(m.dead_zone) + (f.stick_slip ? format_stick_slip(*f.stick_slip) : std::string());
+         (f.axis_model == AxisModel::kStickSlip ? "axis_model = \"stick-slip\"\n" : "") +
+         (f.identified_drive_v ? "identified_drive_v = " + toml_float_array(std::vector<double>(f.identified_drive_v->begin(), f.identified_drive_v->end())) + "\n"
+                               : std::string()) +
+         "\n[arx]\nA = " + list(m.A) + "\nB = " + list(m.B) +
+         "\n\n" + format_dead_zone_table(m.dead_zone) + (f.stick_slip ? format_stick_slip(*f.stick_slip) : std::string()) +
+         (f.stick_slip && f.stick_slip_spread ? format_stick_slip_spread(*f.stick_slip_spread) : std::string());
 }
 
 Status write_model_file(const std::string& path, const ModelFile& file) {

@@ -9,6 +9,8 @@
 //   axis_model = "stick-slip"  # optional: which of the file's models describes the axis ("hammerstein"
 //                         # when left out); "stick-slip" needs [stick_slip], and makes pp-traj arrive
 //                         # while sliding (control/sliding_approach.hpp)
+//   identified_drive_v = [-3.0, 3.0]  # optional: the lowest and highest valve command the model was
+//                         # identified on; epa diagnose judges it inside them (it extrapolates outside)
 //   [arx]
 //   A = [1.0, -0.9094, -0.6110, 0.5204]   # coefficients of q^0, q^-1, ...
 //   B = [0.0, 1.024, -2.046, 1.029]
@@ -20,6 +22,9 @@
 //   [stick_slip]    # optional: the stick-slip model `epa identify` fits beside it (core/stick_slip_params.hpp)
 //   break_right_v = 1.17
 //   ...             # every field of StickSlipParams, by its name; delay_samples an integer
+//   [stick_slip_spread]  # optional: how far its terms move between parts of the identification runs
+//   friction_log_ratio = 0.3  # ... every field of StickSlipSpread, by its name
+#include <array>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -49,6 +54,8 @@ struct ModelFile {
   std::string source;  // provenance text
   std::optional<StickSlipParams> stick_slip = std::nullopt;  // the axis as a stick-slip model, when identified
   AxisModel axis_model = AxisModel::kHammerstein;
+  std::optional<std::array<double, 2>> identified_drive_v = std::nullopt;  // V: lowest, highest
+  std::optional<StickSlipSpread> stick_slip_spread = std::nullopt;          // needs stick_slip
 };
 
 // Errors name the file, and the line for syntax errors, and the key that is missing or wrong.

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace epa::core {
 
@@ -29,6 +30,17 @@ Status StickSlipParams::validate() const {
   if (auto s = need(finite(static_mm) && static_mm >= coulomb_mm, "static_mm", "must be >= coulomb_mm"); !s) return s;
   if (auto s = need(finite(spool_lag_s) && spool_lag_s >= 0.0, "spool_lag_s", "must be >= 0"); !s) return s;
   return need(delay_samples >= 0 && delay_samples <= kMaxDelay, "delay_samples", "must be within 0..8");
+}
+
+Status StickSlipSpread::validate() const {
+  const std::pair<const char*, double> fields[] = {{"friction_log_ratio", friction_log_ratio},
+                                                   {"flow_gain_log_ratio", flow_gain_log_ratio},
+                                                   {"break_v", break_v},
+                                                   {"spool_lag_s", spool_lag_s},
+                                                   {"delay_samples", delay_samples}};
+  for (const auto& [name, v] : fields)
+    if (!(std::isfinite(v) && v >= 0.0)) return invalid_argument(std::string("stick-slip spread: ") + name + " must be finite and >= 0");
+  return ok();
 }
 
 }  // namespace epa::core

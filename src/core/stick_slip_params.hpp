@@ -23,4 +23,18 @@ struct StickSlipParams {
   Status validate() const;  // the message names the field
 };
 
+// How far the stick-slip model's terms move when it is re-fitted on parts of its own
+// identification runs (epa identify: parts of 15 s of the validation runs, diag/stick_slip_spread.hpp).
+// A change of the axis smaller than this cannot be told from the model's own error in some regime
+// of motion (a model fitted mostly on pulses reads slow ramps with more friction). Ratios as
+// |ln ratio|, the rest as the largest deviation.
+struct StickSlipSpread {
+  double friction_log_ratio = 0.0;
+  double flow_gain_log_ratio = 0.0;
+  double break_v = 0.0;
+  double spool_lag_s = 0.0;
+  double delay_samples = 0.0;
+  Status validate() const;  // every field finite and >= 0; the message names it
+};
+
 }  // namespace epa::core

@@ -103,8 +103,8 @@ TEST(ModelFile, NumbersOutsideAnyPhysicalRangeAreRefusedNamingKeyAndLine) {
 TEST(ModelFile, AMisspeltKeyIsRefusedNamingItAndItsLine) {
   for (const auto& [from, to, expected] :
        {std::tuple{"Ts = 0.005", "Ts = 0.005\nmm_per_vlot = 25.0",
-                   "m.toml:3: unknown key 'mm_per_vlot' (expected one of: schema, Ts, mm_per_volt, source, axis_model, arx, "
-                   "dead_zone, stick_slip)"},
+                   "m.toml:3: unknown key 'mm_per_vlot' (expected one of: schema, Ts, mm_per_volt, source, axis_model, "
+                   "identified_drive_v, arx, dead_zone, stick_slip, stick_slip_spread)"},
         std::tuple{"Ts = 0.005", "Ts = 0.005\naxis_modle = \"stick-slip\"", "m.toml:3: unknown key 'axis_modle' (expected"},
         std::tuple{"[dead_zone]", "[dead_zone]\nb_rx = 9.0",
                    "unknown key 'b_rx' in [dead_zone] (expected one of: m_r, m_l, b_r, b_l)"},
@@ -245,6 +245,53 @@ TEST(ModelFile, AStickSlipTableWithAMissingOrWrongFieldIsRefusedByName) {
   file = parse_model_toml(replaced(kValidText, "[arx]", "stick_slip = 3\n\n[arx]"), "ss.toml");
   ASSERT_FALSE(file.has_value());
   EXPECT_TRUE(contains(file.error().message, "stick_slip must be a table"));
+}
+
+// The valve commands the model was identified on: read, written back, and refused by name when
+// they are not a range around the centred valve.
+TEST(ModelFile, TheIdentifiedDriveRangeParsesRoundTripsAndIsCheckedByName) {
+  const auto file = parse_model_toml(replaced(kValidText, "Ts = 0.005", "Ts = 0.005\nidentified_drive_v = [-3.0, 2.5]"), "d.toml");
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  ASSERT_TRUE(file->identified_drive_v.has_value());
+  EXPECT_EQ((*file->identified_drive_v)[0], -3.0);
+  EXPECT_EQ((*file->identified_drive_v)[1], 2.5);
+  const auto back = parse_model_toml(format_model_toml(*file), "formatted");
+  ASSERT_TRUE(back.has_value()) << back.error().message;
+  EXPECT_EQ(back->identified_drive_v, file->identified_drive_v);
+  EXPECT_FALSE(parse_model_toml(kValidText, "plain.toml")->identified_drive_v.has_value());
+  for (const char* bad : {"[1.0, 3.0]", "[-3.0]", "[-3.0, 0.0, 3.0]", "[-11.0, 3.0]"}) {
+    const auto r = parse_model_toml(replaced(kValidText, "Ts = 0.005", std::string("Ts = 0.005\nidentified_drive_v = ") + bad), "d.toml");
+    ASSERT_FALSE(r.has_value()) << bad;
+    EXPECT_TRUE(contains(r.error().message, "identified_drive_v must be [lowest, highest]")) << r.error().message;
+  }
+}
+
+// The stick-slip model's spread: every field read and written back; it needs the model it is the
+// spread of, and a negative or missing field is refused by name.
+TEST(ModelFile, TheStickSlipSpreadParsesRoundTripsAndNeedsItsModel) {
+  const std::string spread =
+      "\n[stick_slip_spread]\nfriction_log_ratio = 0.33\nflow_gain_log_ratio = 0.08\nbreak_v = 0.1\nspool_lag_s = 0.012\n"
+      "delay_samples = 1.0\n";
+  const auto file = parse_model_toml(kValidText + kStickSlipTable + spread, "s.toml");
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  ASSERT_TRUE(file->stick_slip_spread.has_value());
+  EXPECT_EQ(file->stick_slip_spread->friction_log_ratio, 0.33);
+  EXPECT_EQ(file->stick_slip_spread->spool_lag_s, 0.012);
+  const auto back = parse_model_toml(format_model_toml(*file), "formatted");
+  ASSERT_TRUE(back.has_value()) << back.error().message;
+  ASSERT_TRUE(back->stick_slip_spread.has_value());
+  EXPECT_EQ(back->stick_slip_spread->break_v, 0.1);
+  EXPECT_EQ(back->stick_slip_spread->delay_samples, 1.0);
+
+  auto r = parse_model_toml(kValidText + spread, "s.toml");
+  ASSERT_FALSE(r.has_value());
+  EXPECT_TRUE(contains(r.error().message, "[stick_slip_spread] needs a [stick_slip] table")) << r.error().message;
+  r = parse_model_toml(kValidText + kStickSlipTable + replaced(spread, "break_v = 0.1", "break_v = -0.1"), "s.toml");
+  ASSERT_FALSE(r.has_value());
+  EXPECT_TRUE(contains(r.error().message, "break_v must be finite and >= 0")) << r.error().message;
+  r = parse_model_toml(kValidText + kStickSlipTable + replaced(spread, "spool_lag_s = 0.012\n", ""), "s.toml");
+  ASSERT_FALSE(r.has_value());
+  EXPECT_TRUE(contains(r.error().message, "spool_lag_s")) << r.error().message;
 }
 
 TEST(ModelFile, TheAxisModelIsHammersteinUnlessTheFileSaysStickSlipAndRoundTrips) {
