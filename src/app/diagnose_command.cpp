@@ -1,6 +1,9 @@
 #include "app/diagnose_command.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <fmt/format.h>
+#include <functional>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -53,16 +56,39 @@ core::Result<std::vector<core::Run>> load(const std::vector<std::string>& paths,
   return runs;
 }
 
+// The gap over whole moves and, against a model file's stick-slip model, what changed since
+// commissioning (diag/whole_move.hpp, diag/axis_change_selection.hpp).
+void judge_whole_moves(diag::GapReport& report, const core::ModelFile& file, const std::vector<const core::Run*>& train,
+                       const std::vector<const core::Run*>& heldout, double stroke_mm, const std::function<void(const std::string&)>& progress) {
+  const auto train_runs = diag::anchor_runs(train), heldout_runs = diag::anchor_runs(heldout);
+  const auto scope = diag::judged_scope(file, stroke_mm);
+  report.whole_move = diag::whole_move_gap(file, train_runs, heldout_runs, scope, report.diagnosis.noise_std_mm);
+  const auto& w = *report.whole_move;
+  progress(fmt::format("over whole moves: {} segments from rest ({} left out), law's model {:.3f} mm{}", w.segments, w.segments_left_out,
+                       w.hammerstein_heldout.rms_mm(),
+                       w.has_stick_slip ? fmt::format(", stick-slip model {:.3f} mm ({:.0f} % explained)", w.stick_slip_heldout.rms_mm(), w.explained_pct)
+                                        : std::string()));
+  if (!file.stick_slip || heldout.empty()) return;  // changes are scored on held-out runs only
+  const diag::ChangeFitData data{*file.stick_slip, file.model.Ts, train_runs, heldout_runs, scope};
+  report.changes = diag::select_axis_changes(data, file.stick_slip_spread, w.noise_floor_mm, report.diagnosis.rest_drift.moving);
+  const auto& d = report.diagnosis;
+  if (std::find(d.effects.begin(), d.effects.end(), plant::EffectKind::kSensorQuantization) != d.effects.end())
+    report.changes->sensor_step_mm = d.final_model.effects.param(plant::EffectKind::kSensorQuantization, 0);
+  progress(fmt::format("since commissioning: {} change(s) named, held-out gap {:.3f} -> {:.3f} mm", report.changes->accepted.kinds.size(),
+                       report.changes->commissioned_heldout_mm, report.changes->heldout_after_mm));
+}
+
 }  // namespace
 
 int run_diagnose(const DiagnoseOptions& o, std::ostream& out, std::ostream& err) {
   auto fail = [&](const std::string& m) { return err << "epa diagnose: " << m << "\n", 1; };
-  diag::ReplayModel nominal{core::paper::model(), {}, o.stroke_mm};
+  core::ModelFile model_file{core::paper::model(), "paper eq 9-10"};
   if (!o.model_path.empty()) {
     auto m = core::read_model_file(o.model_path);
     if (!m) return fail(m.error().message);
-    nominal.model = m->model;
+    model_file = *m;
   }
+  diag::ReplayModel nominal{model_file.model, {}, o.stroke_mm};
   if (o.holdout.empty() && o.runs.size() < 2)
     return fail("without --holdout the runs are cross-validated one against the others: give at least 2 runs, or --holdout FILE");
   // A run given twice would be fitted twice, or scored on the very data it was fitted on.
@@ -106,7 +132,8 @@ int run_diagnose(const DiagnoseOptions& o, std::ostream& out, std::ostream& err)
   out << "Diagnosing " << train_p.size() << " training run(s)" << (held_p.empty() ? " by cross-validation" : "") << ", "
       << held_p.size() << " held-out run(s), horizon " << o.horizon << " samples\n" << std::flush;
   const auto d = diag::diagnose(nominal, train_p, held_p, options);
-  const auto report = diag::build_report(d, train_n, held_n);
+  auto report = diag::build_report(d, train_n, held_n);
+  judge_whole_moves(report, model_file, train_p, held_p, o.stroke_mm, options.progress);
   out << diag::verdict_text(report) << "\n";
   if (!o.json_path.empty()) {
     if (auto s = write_output(o.json_path, diag::to_json(report), out); !s) return fail(s.error().message);

@@ -1,5 +1,7 @@
 #include "app/identify_command.hpp"
 
+#include <array>
+
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -12,6 +14,7 @@
 #include "core/model_file.hpp"
 #include "core/paper_reference.hpp"
 #include "core/run_file.hpp"
+#include "diag/stick_slip_spread.hpp"
 #include "ident/hammerstein_identification.hpp"
 #include "ident/order_selection.hpp"
 #include "ident/ramp_reading.hpp"
@@ -249,6 +252,35 @@ core::Status save_identified(const IdentifyOptions& o, const core::HammersteinMo
   return core::ok();
 }
 
+// The valve commands the estimation runs cover: the model file says so, and epa diagnose judges the
+// model inside them (outside, it extrapolates).
+std::array<double, 2> identified_drive_v(const std::vector<report::IdentifiedRun>& runs) {
+  std::array<double, 2> range{0.0, 0.0};
+  for (const auto& r : runs)
+    for (const double u : r.run.u_V) range[0] = std::min(range[0], u), range[1] = std::max(range[1], u);
+  return range;
+}
+
+// How far the stick-slip model's terms move over 15 s parts of the validation runs
+// (diag/stick_slip_spread.hpp): epa diagnose names a change of the axis only beyond it. None
+// without validation runs.
+std::optional<core::StickSlipSpread> model_spread(const core::StickSlipParams& params, const std::vector<report::IdentifiedRun>& validation,
+                                                  double Ts, const std::array<double, 2>& drive, std::ostream& out) {
+  if (validation.empty()) return std::nullopt;
+  std::vector<const core::Run*> runs;
+  for (const auto& r : validation) runs.push_back(&r.run);
+  diag::JudgedScope scope;
+  scope.drive_lo_v = drive[0], scope.drive_hi_v = drive[1];
+  const auto spread = diag::stick_slip_spread(params, Ts, runs, scope);
+  out << "  its terms over " << diag::kSpreadPartS << " s parts of the validation runs spread by: friction x"
+      << core::format_number(std::round(std::exp(spread.friction_log_ratio) * 100.0) / 100.0) << ", flow gain x"
+      << core::format_number(std::round(std::exp(spread.flow_gain_log_ratio) * 100.0) / 100.0) << ", break points "
+      << core::format_number(std::round(spread.break_v * 1000.0) / 1000.0) << " V, spool lag "
+      << core::format_number(std::round(spread.spool_lag_s * 1e4) / 10.0) << " ms, dead time " << spread.delay_samples
+      << " samples (epa diagnose names a change of the axis only beyond these)\n";
+  return spread;
+}
+
 }  // namespace
 
 int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err) {
@@ -288,7 +320,10 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   const std::string source = model_source(o, chosen, summary, *stick_slip);
   if (!o.out_path.empty()) {
     const auto axis = *stick_slip ? report::axis_model_verdict(**stick_slip, summary) : core::AxisModel::kHammerstein;
-    if (auto s = core::write_model_file(o.out_path, {model, source, stick_slip_params, axis}); !s) return fail(s.error().message);
+    const auto drive = identified_drive_v(*est);
+    const auto spread = stick_slip_params ? model_spread(*stick_slip_params, *val, model.Ts, drive, out) : std::nullopt;
+    if (auto s = core::write_model_file(o.out_path, {model, source, stick_slip_params, axis, drive, spread}); !s)
+      return fail(s.error().message);
     out << "\nmodel written to " << o.out_path << "\n";
   }
   if (!o.save_name.empty())

@@ -39,6 +39,124 @@ Scored score(const ReplayModel& m, const std::vector<NamedRun>& runs, const std:
   return s;
 }
 
+bool is_timing(plant::EffectKind k) { return k == plant::EffectKind::kInputDelay || k == plant::EffectKind::kValveLag; }
+
+// The stick-slip model's term as the verdict gives its parameters, in its own units.
+ordered_json mechanics_params(plant::EffectKind k, const core::StickSlipParams& p, double Ts) {
+  switch (k) {
+    case plant::EffectKind::kStaticFriction:
+      return {{"breakaway_mm", round_to(p.static_mm, 4)}, {"sliding_mm", round_to(p.coulomb_mm, 4)},
+              {"breakaway_m_s2", round_to(breakaway_m_s2(p), 4)}, {"sliding_m_s2", round_to(sliding_m_s2(p), 4)}};
+    case plant::EffectKind::kValveLag: return {{"tau_s", round_to(p.spool_lag_s, 5)}};
+    case plant::EffectKind::kInputDelay: return {{"delay_samples", p.delay_samples}, {"delay_s", round_to(p.delay_samples * Ts, 4)}};
+    default: return ordered_json::object();
+  }
+}
+
+// The effects the verdict names, each with the measure it shows on.
+std::vector<std::pair<plant::EffectKind, const char*>> named_effects(const GapReport& r) {
+  std::vector<std::pair<plant::EffectKind, const char*>> named;
+  if (!r.judged_on_whole_moves()) {
+    for (auto k : r.diagnosis.effects) named.emplace_back(k, "windowed");
+    return named;
+  }
+  for (auto k : r.whole_move->named) named.emplace_back(k, "whole_move");
+  // Timing shows best on the short windows: a delay or a lag they name stands beside.
+  for (auto k : r.diagnosis.effects)
+    if (is_timing(k) && std::find(r.whole_move->named.begin(), r.whole_move->named.end(), k) == r.whole_move->named.end())
+      named.emplace_back(k, "windowed");
+  return named;
+}
+
+ordered_json gap_sum_json(const GapSum& g) { return {{"gap_mm", round_to(g.rms_mm(), 4)}, {"segments", g.windows}}; }
+
+ordered_json whole_move_json(const WholeMoveGap& w) {
+  ordered_json j = {{"noise_floor_mm", round_to(w.noise_floor_mm, 4)},
+                    {"segments", w.segments},
+                    {"segments_left_out", w.segments_left_out},
+                    {"drive_range_v", w.scoped_to_identified_drive ? ordered_json::array({w.scope.drive_lo_v, w.scope.drive_hi_v})
+                                                                   : ordered_json(nullptr)},
+                    {"law_model", {{"train", gap_sum_json(w.hammerstein_train)}, {"heldout", gap_sum_json(w.hammerstein_heldout)}}}};
+  if (w.has_stick_slip) {
+    ordered_json terms = ordered_json::array();
+    for (const auto& t : w.terms)
+      terms.push_back({{"effect", std::string(plant::to_string(t.effect))}, {"heldout_gap_without_mm", round_to(t.heldout_without_mm, 4)},
+                       {"cost_pct", round_to(t.cost_pct, 2)}, {"named", t.named}});
+    j["stick_slip"] = {{"train", gap_sum_json(w.stick_slip_train)}, {"heldout", gap_sum_json(w.stick_slip_heldout)},
+                       {"explained_pct", round_to(w.explained_pct, 2)}, {"terms", terms}};
+  }
+  ordered_json per_run = ordered_json::array();
+  for (const auto& p : w.per_run)
+    per_run.push_back({{"set", p.set}, {"index", p.index}, {"law_model_gap_mm", round_to(p.hammerstein_mm, 4)},
+                       {"stick_slip_gap_mm", w.has_stick_slip ? ordered_json(round_to(p.stick_slip_mm, 4)) : ordered_json(nullptr)},
+                       {"segments", p.segments}, {"segments_left_out", p.segments_left_out}});
+  j["per_run"] = per_run;
+  return j;
+}
+
+ordered_json change_params_json(plant::EffectKind k, const AxisChange& c) {
+  ordered_json p = ordered_json::object();
+  if (k == plant::EffectKind::kInputDelay) return {{"delay_samples", c.delay_samples}};
+  const auto* v = c.values_of(k);
+  const auto specs = change_params(k, {});
+  for (std::size_t i = 0; v && i < v->size() && i < specs.size(); ++i) p[specs[i].name] = round_to((*v)[i], 4);
+  return p;
+}
+
+ordered_json changes_json(const AxisChanges& c, const core::StickSlipParams& commissioned) {
+  ordered_json candidates = ordered_json::array();
+  for (const auto& k : c.candidates)
+    candidates.push_back({{"effect", std::string(plant::to_string(k.effect))}, {"change", describe_change(k.effect, k.fit.change, commissioned)},
+                          {"params", change_params_json(k.effect, k.fit.change)}, {"heldout_gap_mm", round_to(k.fit.heldout_gap_mm, 4)},
+                          {"reduction_pct", round_to(k.reduction_pct, 2)}, {"beyond_tolerance", k.beyond_tolerance}});
+  return {{"commissioned_heldout_gap_mm", round_to(c.commissioned_heldout_mm, 4)},
+          {"commissioned_train_gap_mm", round_to(c.commissioned_train_mm, 4)},
+          {"heldout_gap_after_mm", round_to(c.heldout_after_mm, 4)},
+          {"threshold_pct", kChangeThresholdPct},
+          {"judged", c.judged},
+          {"candidates", candidates}};
+}
+
+void whole_move_verdict(ordered_json& verdict, const GapReport& r) {
+  const WholeMoveGap& w = *r.whole_move;
+  const double before = w.hammerstein_heldout.rms_mm(), after = w.stick_slip_heldout.rms_mm();
+  verdict["unexplained"] = w.unexplained || (w.named.empty() && r.diagnosis.rest_drift.moving);
+  verdict["heldout_gap_before_mm"] = round_to(before, 4);
+  verdict["heldout_gap_after_mm"] = round_to(after, 4);
+  verdict["reduction_pct"] = round_to(w.explained_pct, 2);
+  verdict["heldout_gap_refit_mm"] = round_to(before, 4);
+  ordered_json params = ordered_json::object();
+  for (const auto& [k, measure] : named_effects(r))
+    params[std::string(plant::to_string(k))] = std::string(measure) == "whole_move"
+                                                   ? mechanics_params(k, w.stick_slip, r.diagnosis.nominal.model.Ts)
+                                                   : params_json(r.diagnosis.final_model.effects, k, r.diagnosis.nominal.model.Ts);
+  verdict["params"] = params;
+  verdict["confusable"] = ordered_json::array();
+  verdict["noise_floor_mm"] = round_to(w.noise_floor_mm, 4);
+}
+
+void changes_verdict(ordered_json& verdict, const GapReport& r) {
+  const AxisChanges& c = *r.changes;
+  std::vector<std::string> names;
+  ordered_json detail = ordered_json::array();
+  for (auto k : c.accepted.kinds) {
+    names.emplace_back(plant::to_string(k));
+    detail.push_back({{"effect", std::string(plant::to_string(k))}, {"change", describe_change(k, c.accepted, r.whole_move->stick_slip)},
+                      {"params", change_params_json(k, c.accepted)}});
+  }
+  if (c.sensor_step_mm) {
+    names.emplace_back("sensor_quantization");
+    detail.push_back({{"effect", "sensor_quantization"}, {"change", fmt::format("the readings lie on a grid of {:.4f} mm", *c.sensor_step_mm)},
+                      {"params", {{"step_mm", round_to(*c.sensor_step_mm, 5)}}}});
+  }
+  verdict["changes"] = names;
+  verdict["changes_detail"] = detail;
+  verdict["changes_unexplained"] = c.unexplained;
+  verdict["changes_gap_before_mm"] = round_to(c.commissioned_heldout_mm, 4);
+  verdict["changes_gap_after_mm"] = round_to(c.heldout_after_mm, 4);
+  verdict["changes_reduction_pct"] = round_to(c.reduction_pct, 2);
+}
+
 }  // namespace
 
 GapReport build_report(const Diagnosis& d, const std::vector<NamedRun>& train, const std::vector<NamedRun>& heldout,
@@ -128,7 +246,8 @@ std::string to_json(const GapReport& r) {
   j["candidates"] = candidates;
   ordered_json verdict;
   std::vector<std::string> names;
-  for (auto k : d.effects) names.emplace_back(plant::to_string(k));
+  ordered_json measures = ordered_json::object();
+  for (const auto& [k, measure] : named_effects(r)) names.emplace_back(plant::to_string(k)), measures[std::string(plant::to_string(k))] = measure;
   verdict["effects"] = names;
   verdict["unexplained"] = d.unexplained;
   verdict["heldout_gap_before_mm"] = round_to(d.baseline_gap_mm, 4);
@@ -142,8 +261,14 @@ std::string to_json(const GapReport& r) {
   for (const auto& [a, b] : d.confusable) confusable.push_back({std::string(plant::to_string(a)), std::string(plant::to_string(b))});
   verdict["confusable"] = confusable;
   verdict["noise_floor_mm"] = round_to(d.noise_floor_mm, 4);
+  if (r.judged_on_whole_moves()) whole_move_verdict(verdict, r);
+  verdict["measure"] = r.judged_on_whole_moves() ? "whole_move" : "windowed";
+  verdict["effect_measures"] = measures;
+  if (r.changes) changes_verdict(verdict, r);
   verdict["text"] = verdict_text(r);
   j["verdict"] = verdict;
+  if (r.whole_move) j["whole_move"] = whole_move_json(*r.whole_move);
+  if (r.changes) j["changes"] = changes_json(*r.changes, r.whole_move->stick_slip);
 
   // Beyond the keys docs/formats.md gives: the re-fit, per-run gaps, the selection steps, residual statistics.
   ordered_json refit_params = ordered_json::object();
@@ -178,7 +303,76 @@ std::string to_json(const GapReport& r) {
   return j.dump(1) + "\n";
 }
 
+namespace {
+
+std::string mechanics_text(plant::EffectKind k, const core::StickSlipParams& p) {
+  switch (k) {
+    case plant::EffectKind::kStaticFriction:
+      return fmt::format("static_friction (a stick state that follows the piston: breakaway {:.2f} m/s^2 and sliding {:.2f} m/s^2 "
+                         "per kg of moving mass, {:.2f} and {:.2f} mm of the air spring's wind-up)",
+                         breakaway_m_s2(p), sliding_m_s2(p), p.static_mm, p.coulomb_mm);
+    case plant::EffectKind::kValveLag: return fmt::format("valve_lag (spool lag {:.1f} ms)", p.spool_lag_s * 1e3);
+    case plant::EffectKind::kInputDelay: return fmt::format("input_delay ({} samples)", p.delay_samples);
+    default: return std::string(plant::to_string(k));
+  }
+}
+
+std::string whole_move_text(const GapReport& r) {
+  const WholeMoveGap& w = *r.whole_move;
+  const double before = w.hammerstein_heldout.rms_mm(), after = w.stick_slip_heldout.rms_mm();
+  std::string s;
+  if (!w.named.empty()) {
+    s = "Over whole moves, the law's model lacks the axis's mechanics that the model file's stick-slip model holds: ";
+    for (std::size_t i = 0; i < w.named.size(); ++i) s += (i ? ", " : "") + mechanics_text(w.named[i], w.stick_slip);
+    s += fmt::format(". They explain {:.0f} % of its gap", w.explained_pct);
+    if (w.unexplained) s += "; a significant gap remains unexplained";
+  } else if (w.explained_pct >= kMechanicsThresholdPct) {
+    s = fmt::format("Over whole moves the model file's stick-slip model follows the runs better than the law's model ({:.0f} % of its gap) "
+                    "by its speeds and break points: none of its friction, spool lag or dead time accounts for {:.0f} % of the gap",
+                    w.explained_pct, kMechanicsThresholdPct);
+    if (w.unexplained) s += "; a significant gap remains unexplained";
+  } else if (w.unexplained || r.diagnosis.rest_drift.moving) {
+    s = "Unexplained: over whole moves neither the law's model nor the stick-slip model follows the runs";
+  } else {
+    s = "No effect: over whole moves the law's model follows the runs to the level of sensor noise";
+  }
+  for (const auto& [k, measure] : named_effects(r))
+    if (std::string(measure) == "windowed") s += "; on short windows also " + std::string(plant::to_string(k));
+  s += fmt::format(". Held-out gap over whole moves {:.3f} mm with the law's model, {:.3f} mm with the stick-slip model (noise floor {:.3f} mm; "
+                   "{} segments from rest",
+                   before, after, w.noise_floor_mm, w.segments);
+  if (w.segments_left_out)
+    s += fmt::format(", {} left out: at an end stop{}", w.segments_left_out,
+                     w.scoped_to_identified_drive ? fmt::format(" or driven outside the identified [{:g}, {:g}] V", w.scope.drive_lo_v, w.scope.drive_hi_v) : "");
+  return s + ").";
+}
+
+std::string changes_text(const GapReport& r) {
+  const AxisChanges& c = *r.changes;
+  std::string s = " Since commissioning: ";
+  if (!c.judged) {
+    s += "not judged: the model file does not say how far its stick-slip model's own terms spread (epa identify with --validate "
+         "writes [stick_slip_spread])";
+    if (c.unexplained) s += "; the readings move while the valve rests (a leak, a load or a drifting sensor)";
+  } else if (c.accepted.kinds.empty()) {
+    s += c.unexplained ? "unexplained: the readings move while the valve rests (a leak, a load or a drifting sensor), which no change of "
+                         "the model's terms does"
+                       : "no change beyond the commissioned model's tolerance";
+  } else {
+    for (std::size_t i = 0; i < c.accepted.kinds.size(); ++i)
+      s += (i ? "; " : "") + std::string(plant::to_string(c.accepted.kinds[i])) + ": " +
+           describe_change(c.accepted.kinds[i], c.accepted, r.whole_move->stick_slip);
+    if (c.unexplained) s += "; and the readings move while the valve rests, which none of these does";
+  }
+  if (c.sensor_step_mm) s += fmt::format("; the sensor reads coarser: its readings lie on a grid of {:.4f} mm", *c.sensor_step_mm);
+  return s + fmt::format(" (held-out gap {:.3f} mm against the commissioned model, {:.3f} mm with the changes).", c.commissioned_heldout_mm,
+                         c.heldout_after_mm);
+}
+
+}  // namespace
+
 std::string verdict_text(const GapReport& r) {
+  if (r.judged_on_whole_moves()) return whole_move_text(r) + (r.changes ? changes_text(r) : std::string());
   const Diagnosis& d = r.diagnosis;
   std::string s;
   if (d.effects.empty() && d.rest_drift.moving) {
@@ -201,6 +395,9 @@ std::string verdict_text(const GapReport& r) {
   if (d.windows_at_end_stop)
     s += fmt::format(" {} of {} windows touch an end stop and are left out of every gap.", d.windows_at_end_stop, d.windows);
   if (d.unexplained && !r.hints.empty()) s += " Where: " + r.hints.front() + ".";
+  if (r.whole_move)
+    s += fmt::format(" Over whole moves from rest the gap is {:.3f} mm (noise floor {:.3f} mm).", r.whole_move->hammerstein_heldout.rms_mm(),
+                     r.whole_move->noise_floor_mm);
   return s;
 }
 

@@ -1,0 +1,102 @@
+#include "diag/whole_move.hpp"
+
+#include <algorithm>
+
+namespace epa::diag {
+
+namespace {
+
+using plant::EffectKind;
+
+core::StickSlipParams without(EffectKind term, core::StickSlipParams p) {
+  switch (term) {
+    case EffectKind::kStaticFriction: p.coulomb_mm = p.static_mm = 0.0; break;
+    case EffectKind::kValveLag: p.spool_lag_s = 0.0; break;
+    case EffectKind::kInputDelay: p.delay_samples = 0; break;
+    default: break;
+  }
+  return p;
+}
+
+bool present(EffectKind term, const core::StickSlipParams& p) {
+  switch (term) {
+    case EffectKind::kStaticFriction: return p.static_mm > 0.0;
+    case EffectKind::kValveLag: return p.spool_lag_s > 0.0;
+    case EffectKind::kInputDelay: return p.delay_samples > 0;
+    default: return false;
+  }
+}
+
+GapSum pooled(std::span<const AnchoredRun> runs, auto&& sse_of) {
+  GapSum s;
+  for (const auto& r : runs) s += sse_of(r);
+  return s;
+}
+
+void add_per_run(WholeMoveGap& g, const core::ModelFile& file, std::span<const AnchoredRun> runs, const char* set) {
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    RunWholeMoveGap row{set, i};
+    const GapSum h = from_rest_sse(file.model, runs[i], g.scope);
+    row.hammerstein_mm = h.rms_mm(), row.segments = h.windows, row.segments_left_out = h.windows_at_end_stop;
+    if (g.has_stick_slip) row.stick_slip_mm = from_rest_sse(g.stick_slip, file.model.Ts, runs[i], g.scope).rms_mm();
+    g.per_run.push_back(row);
+  }
+}
+
+// Which terms of the stick-slip model the gap needs, each switched off with the rest as the file has it.
+void judge_terms(WholeMoveGap& g, const core::ModelFile& file, std::span<const AnchoredRun> scored) {
+  const double law_gap = g.hammerstein_heldout.rms_mm(), model_gap = g.stick_slip_heldout.rms_mm();
+  for (const EffectKind term : {EffectKind::kStaticFriction, EffectKind::kValveLag, EffectKind::kInputDelay}) {
+    if (!present(term, g.stick_slip)) continue;
+    MechanicsTerm t{term};
+    t.heldout_without_mm = from_rest_gap_mm(without(term, g.stick_slip), file.model.Ts, scored, g.scope);
+    t.cost_pct = law_gap > 0 ? 100.0 * (t.heldout_without_mm - model_gap) / law_gap : 0.0;
+    g.terms.push_back(t);
+  }
+  const bool significant = law_gap > kSignificantOverFloor * g.noise_floor_mm && g.explained_pct >= kMechanicsThresholdPct;
+  for (auto& t : g.terms) {
+    t.named = significant && t.cost_pct >= kMechanicsThresholdPct;
+    if (t.named) g.named.push_back(t.effect);
+  }
+}
+
+}  // namespace
+
+JudgedScope judged_scope(const core::ModelFile& file, double stroke_mm) {
+  JudgedScope scope{stroke_mm};
+  if (file.identified_drive_v) scope.drive_lo_v = (*file.identified_drive_v)[0], scope.drive_hi_v = (*file.identified_drive_v)[1];
+  return scope;
+}
+
+double breakaway_m_s2(const core::StickSlipParams& p) { return p.static_mm * p.spring_rad_s * p.spring_rad_s * 1e-3; }
+double sliding_m_s2(const core::StickSlipParams& p) { return p.coulomb_mm * p.spring_rad_s * p.spring_rad_s * 1e-3; }
+
+WholeMoveGap whole_move_gap(const core::ModelFile& file, std::span<const AnchoredRun> train_runs, std::span<const AnchoredRun> heldout_runs,
+                            const JudgedScope& scope, double noise_std_mm) {
+  WholeMoveGap g;
+  g.scope = scope;
+  g.scoped_to_identified_drive = file.identified_drive_v.has_value();
+  const std::span<const AnchoredRun> scored = heldout_runs.empty() ? train_runs : heldout_runs;
+  g.noise_floor_mm = from_rest_noise_floor_mm(scored, noise_std_mm);
+  g.hammerstein_train = pooled(train_runs, [&](const AnchoredRun& r) { return from_rest_sse(file.model, r, g.scope); });
+  g.hammerstein_heldout = pooled(scored, [&](const AnchoredRun& r) { return from_rest_sse(file.model, r, g.scope); });
+  g.segments = g.hammerstein_heldout.windows, g.segments_left_out = g.hammerstein_heldout.windows_at_end_stop;
+  g.has_stick_slip = file.stick_slip.has_value();
+  if (g.has_stick_slip) {
+    g.stick_slip = *file.stick_slip;
+    const double Ts = file.model.Ts;
+    g.stick_slip_train = pooled(train_runs, [&](const AnchoredRun& r) { return from_rest_sse(g.stick_slip, Ts, r, g.scope); });
+    g.stick_slip_heldout = pooled(scored, [&](const AnchoredRun& r) { return from_rest_sse(g.stick_slip, Ts, r, g.scope); });
+    const double law_gap = g.hammerstein_heldout.rms_mm();
+    g.explained_pct = law_gap > 0 ? 100.0 * (1.0 - g.stick_slip_heldout.rms_mm() / law_gap) : 0.0;
+    judge_terms(g, file, scored);
+  }
+  const double left = g.has_stick_slip ? g.stick_slip_heldout.rms_mm() : g.hammerstein_heldout.rms_mm();
+  const bool above_floor = left > kSignificantOverFloor * g.noise_floor_mm;
+  g.unexplained = g.named.empty() ? above_floor : above_floor && left > g.hammerstein_heldout.rms_mm() / 3.0;
+  add_per_run(g, file, train_runs, "train");
+  if (!heldout_runs.empty()) add_per_run(g, file, heldout_runs, "heldout");
+  return g;
+}
+
+}  // namespace epa::diag
