@@ -18,7 +18,8 @@ matrix and the score line:
     score: C/N cases correct, false_blame_on_null=F/M, median_reduction_pct=R, median_seconds=S
 
 --check exits 1 unless the issue's thresholds hold (>= 90 % correct, no false blame on the nulls,
-median reduction >= 70 %, median <= 10 s per case).
+median reduction >= 70 %, median <= 10 s per case). --guard exits 1 when a diagnosis failed or a
+null was blamed: what a change must never break (ctest diag.drift_fast).
 """
 import argparse
 import json
@@ -156,10 +157,12 @@ def main():
     ap.add_argument("--matrix", help="write the confusion matrix (Markdown) here")
     ap.add_argument("--check", action="store_true", help="exit 1 unless the issue's thresholds hold")
     ap.add_argument("--only", help="only the cases whose name matches this regular expression")
+    ap.add_argument("--guard", action="store_true", help="exit 1 when a diagnosis failed or a null was blamed")
     args = ap.parse_args()
 
     cases = [(i, *c) for i, c in enumerate(CASES) if (not args.fast or c[0] in FAST) and (not args.only or re.search(args.only, c[0]))]
     results = []
+    failures = 0
     with tempfile.TemporaryDirectory(prefix="epa-drift-") as tmp:
         root = args.keep or tmp
         os.makedirs(root, exist_ok=True)
@@ -175,6 +178,7 @@ def main():
             took = time.monotonic() - t0
             if r.returncode != 0:
                 print(f"FAIL {name}: epa diagnose failed: {r.stderr.strip()[-400:]}")
+                failures += 1
                 results.append((name, category, expected, set(), True, 0.0, took, False))
                 continue
             verdict = json.load(open(out))["verdict"]
@@ -207,6 +211,9 @@ def main():
         open(args.matrix, "w").write(matrix + "\n")
     print(f"score: {correct}/{len(results)} cases correct, false_blame_on_null={false_blame}/{len(nulls)}, "
           f"median_reduction_pct={median_reduction:.1f}, median_seconds={median_seconds:.2f}")
+    if args.guard and (failures or false_blame):
+        print(f"drift guard: {failures} diagnosis failure(s), {false_blame} null(s) blamed")
+        sys.exit(1)
     if args.check:
         ok = correct >= 0.9 * len(results) and false_blame == 0 and median_reduction >= 70.0 and median_seconds <= 10.0
         print("drift check: " + ("thresholds hold" if ok else "thresholds NOT met"))
