@@ -41,6 +41,7 @@ class StickSlipFreeRun {
     if (y < 0.0 || y > stroke_mm_) model_.stop_at(std::clamp(y, 0.0, stroke_mm_));
     return model_.position_mm();
   }
+  bool stuck() const { return model_.stuck(); }
 
  private:
   plant::StickSlipModel model_;
@@ -57,7 +58,7 @@ bool judged(const core::Run& run, std::size_t from, std::size_t to, const Judged
   return true;
 }
 
-// Runs the model over the whole run; calls on_prediction(k, predicted_mm) for each sample counted.
+// Runs the model over the whole run; calls on_prediction(k, predicted_mm, model) for each sample counted.
 template <class FreeRun, class OnPrediction>
 GapSum free_run(FreeRun model, const AnchoredRun& anchored, const JudgedScope& scope, OnPrediction&& on_prediction) {
   const core::Run& run = *anchored.run;
@@ -81,7 +82,7 @@ GapSum free_run(FreeRun model, const AnchoredRun& anchored, const JudgedScope& s
     if (!counting || k + 1 > counted_until) continue;
     const double e = predicted - run.y_mm[k + 1];
     sum.sse_mm2 += e * e, ++sum.n;
-    on_prediction(k + 1, predicted);
+    on_prediction(k + 1, predicted, model);
   }
   return sum;
 }
@@ -95,24 +96,24 @@ std::vector<AnchoredRun> anchor_runs(std::span<const core::Run* const> runs) {
 }
 
 GapSum from_rest_sse(const core::HammersteinModel& model, const AnchoredRun& run, const JudgedScope& scope) {
-  return free_run(HammersteinFreeRun(model, scope.stroke_mm, run.run->y_mm.front()), run, scope, [](std::size_t, double) {});
+  return free_run(HammersteinFreeRun(model, scope.stroke_mm, run.run->y_mm.front()), run, scope, [](std::size_t, double, const auto&) {});
 }
 
 GapSum from_rest_sse(const core::StickSlipParams& params, double Ts, const AnchoredRun& run, const JudgedScope& scope) {
-  return free_run(StickSlipFreeRun(params, Ts, scope.stroke_mm, run.run->y_mm.front()), run, scope, [](std::size_t, double) {});
+  return free_run(StickSlipFreeRun(params, Ts, scope.stroke_mm, run.run->y_mm.front()), run, scope, [](std::size_t, double, const auto&) {});
 }
 
 FreeRunTrace from_rest_trace(const core::StickSlipParams& params, double Ts, const AnchoredRun& run, const JudgedScope& scope) {
   FreeRunTrace t;
   t.sum = free_run(StickSlipFreeRun(params, Ts, scope.stroke_mm, run.run->y_mm.front()), run, scope,
-                   [&](std::size_t k, double p) { t.k.push_back(k), t.predicted_mm.push_back(p); });
+                   [&](std::size_t k, double p, const StickSlipFreeRun& m) { t.k.push_back(k), t.predicted_mm.push_back(p), t.stuck.push_back(m.stuck()); });
   return t;
 }
 
 FreeRunTrace from_rest_trace(const core::HammersteinModel& model, const AnchoredRun& run, const JudgedScope& scope) {
   FreeRunTrace t;
   t.sum = free_run(HammersteinFreeRun(model, scope.stroke_mm, run.run->y_mm.front()), run, scope,
-                   [&](std::size_t k, double p) { t.k.push_back(k), t.predicted_mm.push_back(p); });
+                   [&](std::size_t k, double p, const HammersteinFreeRun&) { t.k.push_back(k), t.predicted_mm.push_back(p); });
   return t;
 }
 

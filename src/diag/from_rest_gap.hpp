@@ -43,6 +43,7 @@ std::vector<AnchoredRun> anchor_runs(std::span<const core::Run* const> runs);
 struct FreeRunTrace {
   std::vector<std::size_t> k;
   std::vector<double> predicted_mm;
+  std::vector<bool> stuck;  // the stick-slip model's piston sticks there (empty for the Hammerstein model)
   GapSum sum;  // windows: segments judged; windows_at_end_stop: segments left out (end stop or drive range)
 };
 

@@ -60,6 +60,7 @@ RestAnchors rest_anchors(const core::Run& run) {
   }
   std::size_t span_end = 0, span_length = 0;  // the current span of samples at rest (window ending there)
   auto close_span = [&] {
+    out.spans.push_back({span_end + 1 - (span_length + kRestWindow - 1), span_end});
     if (span_length + kRestWindow - 1 < kRestWindow + kAnchorMargin) return;
     const std::size_t k = span_end - kAnchorMargin;
     if (!out.anchors.empty() && out.anchors.back().k == 0 && k < kRestWindow) out.anchors.pop_back();  // the same rest

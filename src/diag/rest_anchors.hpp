@@ -27,8 +27,13 @@ struct RestAnchor {
   std::size_t readings = 0;   // how many readings that mean holds
 };
 
+struct RestSpan {
+  std::size_t first = 0, last = 0;  // samples whose readings stand (inclusive)
+};
+
 struct RestAnchors {
   std::vector<RestAnchor> anchors;  // in sample order
+  std::vector<RestSpan> spans;      // every stretch at rest, also those too short for an anchor
   double noise_std_mm = 0.0;        // the readings' scatter about their line at rest
 };
 

@@ -1,12 +1,15 @@
 #include "diag/whole_move.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace epa::diag {
 
 namespace {
 
 using plant::EffectKind;
+
+constexpr double kTraceS = 20.0;
 
 core::StickSlipParams without(EffectKind term, core::StickSlipParams p) {
   switch (term) {
@@ -41,6 +44,33 @@ void add_per_run(WholeMoveGap& g, const core::ModelFile& file, std::span<const A
     if (g.has_stick_slip) row.stick_slip_mm = from_rest_sse(g.stick_slip, file.model.Ts, runs[i], g.scope).rms_mm();
     g.per_run.push_back(row);
   }
+}
+
+// The scored run with the most judged readings, from its first judged segment for kTraceS at most.
+WholeMoveTrace trace_of(const WholeMoveGap& g, const core::ModelFile& file, std::span<const AnchoredRun> scored, const char* set) {
+  std::size_t best = 0, most = 0;
+  for (std::size_t i = 0; i < scored.size(); ++i)
+    if (const auto n = from_rest_sse(file.model, scored[i], g.scope).n; n > most) most = n, best = i;
+  const AnchoredRun& r = scored[best];
+  const core::Run& run = *r.run;
+  WholeMoveTrace t{set, best, run.t_s, run.y_mm, {}, {}, {}, {}};
+  const std::size_t n = run.size();
+  t.law_model_mm.assign(n, NAN), t.stick_slip_mm.assign(n, NAN), t.model_stuck.assign(n, NAN), t.recorded_rest.assign(n, 0.0);
+  const auto law = from_rest_trace(file.model, r, g.scope);
+  for (std::size_t i = 0; i < law.k.size(); ++i) t.law_model_mm[law.k[i]] = law.predicted_mm[i];
+  if (g.has_stick_slip) {
+    const auto ss = from_rest_trace(g.stick_slip, file.model.Ts, r, g.scope);
+    for (std::size_t i = 0; i < ss.k.size(); ++i) t.stick_slip_mm[ss.k[i]] = ss.predicted_mm[i], t.model_stuck[ss.k[i]] = ss.stuck[i] ? 1.0 : 0.0;
+  }
+  for (const auto& span : r.rests.spans)
+    for (std::size_t k = span.first; k <= span.last && k < n; ++k) t.recorded_rest[k] = 1.0;
+  // Only kTraceS from the first judged reading: a 90 s run would be a smear.
+  const auto first = std::find_if(t.law_model_mm.begin(), t.law_model_mm.end(), [](double v) { return std::isfinite(v); });
+  const std::size_t from = first == t.law_model_mm.end() ? 0 : static_cast<std::size_t>(first - t.law_model_mm.begin()) - 1;
+  const std::size_t to = std::min(n, from + static_cast<std::size_t>(std::lround(kTraceS / run.Ts)));
+  for (auto* v : {&t.t_s, &t.measured_mm, &t.law_model_mm, &t.stick_slip_mm, &t.recorded_rest, &t.model_stuck})
+    *v = std::vector<double>(v->begin() + static_cast<std::ptrdiff_t>(from), v->begin() + static_cast<std::ptrdiff_t>(to));
+  return t;
 }
 
 // Which terms of the stick-slip model the gap needs, each switched off with the rest as the file has it.
@@ -96,6 +126,7 @@ WholeMoveGap whole_move_gap(const core::ModelFile& file, std::span<const Anchore
   g.unexplained = g.named.empty() ? above_floor : above_floor && left > g.hammerstein_heldout.rms_mm() / 3.0;
   add_per_run(g, file, train_runs, "train");
   if (!heldout_runs.empty()) add_per_run(g, file, heldout_runs, "heldout");
+  if (!scored.empty()) g.trace = trace_of(g, file, scored, heldout_runs.empty() ? "train" : "heldout");
   return g;
 }
 

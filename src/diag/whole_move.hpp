@@ -34,6 +34,15 @@ struct RunWholeMoveGap {
   std::size_t segments = 0, segments_left_out = 0;
 };
 
+// The first scored run as the report draws it: the readings, both models' free runs from rest (NaN
+// where no segment is judged), and where the piston stands, by its readings (1) and in the
+// stick-slip model (1: stuck), NaN where not judged.
+struct WholeMoveTrace {
+  std::string set;
+  std::size_t index = 0;
+  std::vector<double> t_s, measured_mm, law_model_mm, stick_slip_mm, recorded_rest, model_stuck;
+};
+
 struct WholeMoveGap {
   JudgedScope scope;
   bool scoped_to_identified_drive = false;
@@ -48,6 +57,7 @@ struct WholeMoveGap {
   std::vector<plant::EffectKind> named;
   bool unexplained = false;
   std::vector<RunWholeMoveGap> per_run;
+  WholeMoveTrace trace;
 };
 
 inline constexpr double kMechanicsThresholdPct = 8.0;  // as the effects' chance thresholds

@@ -6,6 +6,7 @@
 #include "report/effect_shapes.hpp"
 #include "report/html.hpp"
 #include "report/svg_chart.hpp"
+#include "report/whole_move_report.hpp"
 
 namespace epa::report {
 
@@ -32,6 +33,9 @@ std::string render_diagnosis_html(const diag::GapReport& r) {
                   "td,th{border:1px solid #bbb;padding:2px 8px;text-align:right}td:first-child{text-align:left}"
                   ".yes{background:#d8f0d8}</style></head><body>\n<h1>Sim-to-real gap</h1>\n";
   h += "<p><b>" + escape_html(diag::verdict_text(r)) + "</b></p>\n";
+  if (r.judged_on_whole_moves())
+    h += "<p>The verdict is judged over whole moves (below), the measure on which friction shows. The windowed gap further "
+         "down restarts the model from the readings and breaks the gap down by regime.</p>\n";
   h += "<p>Gap: RMS of the windowed prediction error, restarting the model from the measured state every " +
        std::to_string(d.horizon) + " samples. " + (d.cross_validated ? "Cross-validated by run." : "Scored on held-out runs.") + "</p>\n";
   if (!r.hints.empty()) {
@@ -50,6 +54,7 @@ std::string render_diagnosis_html(const diag::GapReport& r) {
     u.bands.push_back({d.nominal.model.dead_zone.b_l, d.nominal.model.dead_zone.b_r, "dead band"});
     h += inline_svg(render_svg("Recorded vs nominal vs augmented model", {p, u}, 1, 1100, 320));
   }
+  h += render_whole_move_html(r);
   if (const auto shapes = effect_shape_panels(d); !shapes.empty()) {
     h += "<h2>What was fitted: the named effects' shapes</h2>\n";
     h += inline_svg(render_svg("Fitted shapes, in physical units", shapes, 2, 540, 280));
