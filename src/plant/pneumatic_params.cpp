@@ -49,6 +49,8 @@ constexpr std::array kFields{
     Field{"friction", "coulomb_friction_n", &PneumaticParams::coulomb_friction_n, 0.0, 1e5, false},
     Field{"friction", "stribeck_velocity_mps", &PneumaticParams::stribeck_velocity_mps, 1e-4, 10.0, false},
     Field{"friction", "viscous_friction_n_per_mps", &PneumaticParams::viscous_friction_n_per_mps, 0.0, 1e5, false},
+    Field{"friction", "lugre_stiffness_n_per_m", &PneumaticParams::lugre_stiffness_n_per_m, 0.0, 1e9, false},
+    Field{"friction", "lugre_damping_n_s_per_m", &PneumaticParams::lugre_damping_n_s_per_m, 0.0, 1e6, false},
     Field{"valve", "orifice_area_mm2", &PneumaticParams::orifice_area_mm2, 0.0, 1000.0, true},
     Field{"valve", "discharge_coefficient", &PneumaticParams::discharge_coefficient, 0.0, 1.0, true},
     Field{"valve", "spool_time_constant_s", &PneumaticParams::spool_time_constant_s, 1e-4, 1.0, false},

@@ -6,7 +6,8 @@
 //   [supply]    supply_pressure_bar, atmospheric_pressure_bar, temperature_k
 //   [cylinder]  bore_mm, rod_mm, stroke_mm, dead_volume_a_cm3, dead_volume_b_cm3, piston_mass_kg,
 //               polytropic_index, leak_a_mm2, leak_b_mm2
-//   [friction]  static_friction_n, coulomb_friction_n, stribeck_velocity_mps, viscous_friction_n_per_mps
+//   [friction]  static_friction_n, coulomb_friction_n, stribeck_velocity_mps, viscous_friction_n_per_mps,
+//               lugre_stiffness_n_per_m, lugre_damping_n_s_per_m
 //   [valve]     orifice_area_mm2, discharge_coefficient, spool_time_constant_s, overlap_pos_v, overlap_neg_v
 //
 // A key left out keeps its default; an unknown key is refused with its name and line.
@@ -41,6 +42,11 @@ struct PneumaticParams {
   double coulomb_friction_n = 25.0;          // Fc, sliding force at speed (<= Fs)
   double stribeck_velocity_mps = 0.02;       // vs, how fast friction falls from Fs to Fc
   double viscous_friction_n_per_mps = 40.0;  // b
+  // LuGre bristles instead of the stick test when > 0: dz/dt = v - sigma0 |v| z / g(v), friction
+  // sigma0 z + sigma1 dz/dt + b v, g(v) the Stribeck curve above (Canudas de Wit et al. 1995).
+  // The piston never sticks hard: below breakaway it creeps a presliding distance of about F / sigma0.
+  double lugre_stiffness_n_per_m = 0.0;    // sigma0; 0: the stick test (the default)
+  double lugre_damping_n_s_per_m = 0.0;    // sigma1
 
   // [valve] 5/3 closed-centre proportional valve, spool position in command volts (-10..10)
   double orifice_area_mm2 = 4.0;         // each metering edge's area at full opening (+-10 V)

@@ -82,6 +82,8 @@ core::Result<PneumaticPlant> PneumaticPlant::make(const PneumaticParams& params,
   p.Fc_ = params.coulomb_friction_n;
   p.vs_ = params.stribeck_velocity_mps;
   p.b_ = params.viscous_friction_n_per_mps;
+  p.sigma0_ = params.lugre_stiffness_n_per_m;
+  p.sigma1_ = params.lugre_damping_n_s_per_m;
   p.orifice_eff_m2_ = params.discharge_coefficient * params.orifice_area_mm2 * 1e-6;
   p.leak_a_m2_ = params.leak_a_mm2 * 1e-6;
   p.leak_b_m2_ = params.leak_b_mm2 * 1e-6;
@@ -118,6 +120,8 @@ core::Result<PneumaticPlant> PneumaticPlant::make(const PneumaticParams& params,
       {"[friction] viscous_friction_n_per_mps against [cylinder] piston_mass_kg", p.b_ / p.mass_kg_},
       {"the Stribeck slope ([friction] stribeck_velocity_mps)",
        (p.Fs_ - p.Fc_) * std::sqrt(2.0 / std::numbers::e) / (p.vs_ * p.mass_kg_)},
+      {"the LuGre bristles against the mass ([friction] lugre_stiffness_n_per_m)", std::sqrt(p.sigma0_ / p.mass_kg_)},
+      {"the LuGre bristles' damping ([friction] lugre_damping_n_s_per_m)", p.sigma1_ / p.mass_kg_},
   };
   for (const Mode& m : modes) {
     if (p.h_ * m.rate <= 2.0) continue;
@@ -186,6 +190,11 @@ PneumaticPlant::Deriv PneumaticPlant::derivative(const State& s, double u, bool 
   d.pb = n_ / Vb * (RT_ * mdot_b + pb * area_b_m2_ * v);
   if (held) return d;  // x and v stay put
   d.x = v;
+  if (lugre()) {  // bristles: no hard stick, the friction follows their deflection
+    d.z = v - sigma0_ * std::abs(v) * s.bristle_m / stribeck_n(v);
+    d.v = (pressure_force_n(pa, pb) - (sigma0_ * s.bristle_m + sigma1_ * d.z + b_ * v)) / mass_kg_;
+    return d;
+  }
   // Friction opposes the motion the sub-step started with (at v = 0, breaking away: the net
   // force). Not the sign of this stage's velocity: stages either side of v = 0 would cancel it
   // in the RK4 sum, and a piston pushed by less than the sliding friction would creep on.
@@ -197,7 +206,9 @@ PneumaticPlant::Deriv PneumaticPlant::derivative(const State& s, double u, bool 
 void PneumaticPlant::substep(double u) noexcept {
   State& s = state_;
   const double force = pressure_force_n(s.pressure_a_pa, s.pressure_b_pa);
-  const bool held = s.velocity_mps == 0.0 && is_held(s.position_m, force);
+  // With LuGre bristles only an end stop holds the piston: at rest in mid-stroke they decide.
+  const bool at_end = s.position_m <= 0.0 || s.position_m >= stroke_m_;
+  const bool held = s.velocity_mps == 0.0 && (!lugre() || at_end) && is_held(s.position_m, force);
   const double v0 = s.velocity_mps;
   // The direction of motion over this sub-step: the velocity's, or at rest the net force's.
   const double direction = v0 != 0.0 ? (v0 > 0.0 ? 1.0 : -1.0) : (force >= 0.0 ? 1.0 : -1.0);
@@ -211,6 +222,7 @@ void PneumaticPlant::substep(double u) noexcept {
     t.pressure_b_pa += f * k.pb;
     t.position_m += f * k.x;
     t.velocity_mps += f * k.v;
+    t.bristle_m += f * k.z;
     return t;
   };
   const double h = h_;
@@ -224,9 +236,10 @@ void PneumaticPlant::substep(double u) noexcept {
   if (held) return;
   s.position_m += h / 6 * (k1.x + 2 * k2.x + 2 * k3.x + k4.x);
   s.velocity_mps += h / 6 * (k1.v + 2 * k2.v + 2 * k3.v + k4.v);
+  s.bristle_m += h / 6 * (k1.z + 2 * k2.z + 2 * k3.z + k4.z);
 
   // Events, resolved at the end of the sub-step.
-  if (s.velocity_mps * direction <= 0.0) s.velocity_mps = 0.0;  // reversal (or stop): the stick test decides next
+  if (!lugre() && s.velocity_mps * direction <= 0.0) s.velocity_mps = 0.0;  // reversal (or stop): the stick test decides next
   if (s.position_m <= 0.0) {
     s.position_m = 0.0;  // inelastic end stops: the piston never leaves the stroke
     s.velocity_mps = std::max(s.velocity_mps, 0.0);

@@ -28,6 +28,7 @@
 // Timing, like HammersteinPlant: step(u) holds u(k) over [k Ts, (k+1) Ts) and advances to k+1;
 // measured_v() is the sensor at k (0-10 V over the stroke, seeded noise, then ADC quantisation).
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -60,6 +61,7 @@ class PneumaticPlant {
     double pressure_b_pa = 0.0;
     double position_m = 0.0;     // 0 .. stroke
     double velocity_mps = 0.0;
+    double bristle_m = 0.0;      // LuGre's mean bristle deflection (0 with the stick test)
     double measured_v = 0.0;     // sensor reading at k
     core::Random rng;
     std::array<double, kMaxCommandDelay> command_line{};  // commands in transit (command_delay_samples)
@@ -101,7 +103,7 @@ class PneumaticPlant {
   PneumaticPlant() = default;
 
   struct Deriv {
-    double spool, pa, pb, x, v;
+    double spool, pa, pb, x, v, z;
   };
   Deriv derivative(const State& s, double u, bool held, double direction) const noexcept;
   bool is_held(double x_m, double force_n) const noexcept;
@@ -113,6 +115,9 @@ class PneumaticPlant {
   double area_a_m2_ = 0, area_b_m2_ = 0, area_rod_m2_ = 0, stroke_m_ = 0, dead_a_m3_ = 0, dead_b_m3_ = 0;
   double supply_pa_ = 0, atm_pa_ = 0, RT_ = 0, sqrt_T_ = 0, n_ = 0, mass_kg_ = 0;
   double Fs_ = 0, Fc_ = 0, vs_ = 0, b_ = 0;
+  double sigma0_ = 0, sigma1_ = 0;  // LuGre; sigma0_ == 0: the stick test
+  bool lugre() const noexcept { return sigma0_ > 0.0; }
+  double stribeck_n(double v) const noexcept { return Fc_ + (Fs_ - Fc_) * std::exp(-(v / vs_) * (v / vs_)); }
   double leak_a_m2_ = 0, leak_b_m2_ = 0;  // leaks to atmosphere, effective areas
   double orifice_eff_m2_ = 0, tau_s_ = 0, overlap_pos_v_ = 0, overlap_neg_v_ = 0;
   double laminar_alpha_ = 0, laminar_beta_ = 0;  // psi = alpha d + beta d^2, d = 1 - r, near r = 1

@@ -83,6 +83,39 @@ TEST_P(ChokedFilling, ClampedChamberPressureRisesLinearlyAtTheChokedRate) {
 
 INSTANTIATE_TEST_SUITE_P(AdiabaticAndIsothermal, ChokedFilling, ::testing::Values(1.4, 1.0));
 
+// LuGre bristles: pushed by half the breakaway force the piston does not slide but creeps its
+// presliding distance and stops. At presliding speeds g(v) = Fs, so dz/dx = 1 - sigma0 z / Fs and
+// the bristles carry F = sigma0 z after x = (Fs / sigma0) ln(1 / (1 - F / Fs)): ln 2 Fs / sigma0; pushed by twice the breakaway it slides. With the
+// stick test the same half push moves it not at all.
+TEST(PneumaticPlant, LuGreBristlesPreslideBelowBreakawayAndSlideAbove) {
+  PneumaticParams params;
+  params.lugre_stiffness_n_per_m = 1e5;
+  params.lugre_damping_n_s_per_m = 2.0 * std::sqrt(1e5 * params.piston_mass_kg);
+  const double area_a = area_m2(params.bore_mm), area_b = area_a - area_m2(params.rod_mm);
+  const double atm = params.atmospheric_pressure_bar * kBar;
+  // Chamber B at 3 bar gauge, chamber A set for a net push of `push_n` towards the stroke end.
+  auto pushed = [&](const PneumaticParams& p, double push_n) {
+    auto plant = make_plant(p, {.initial_position_mm = 250.0});
+    auto s = plant.state();
+    s.pressure_b_pa = atm + 3.0 * kBar;
+    s.pressure_a_pa = (push_n + s.pressure_b_pa * area_b + atm * area_m2(p.rod_mm)) / area_a;
+    plant.set_state(s);
+    for (int k = 0; k < 200; ++k) plant.step(0.0);  // 1 s, valve centred
+    return plant;
+  };
+  const double half = 0.5 * params.static_friction_n;
+  const auto creeping = pushed(params, half);
+  const double presliding_m = params.static_friction_n / params.lugre_stiffness_n_per_m * std::log(2.0);
+  EXPECT_NEAR((creeping.position_mm() - 250.0) * 1e-3, presliding_m, 0.05 * presliding_m);
+  EXPECT_LT(std::abs(creeping.velocity_mps()), 1e-4);
+  const auto sliding = pushed(params, 2.0 * params.static_friction_n);
+  EXPECT_GT(sliding.position_mm() - 250.0, 5.0);
+  PneumaticParams stick = params;
+  stick.lugre_stiffness_n_per_m = stick.lugre_damping_n_s_per_m = 0.0;
+  EXPECT_EQ(pushed(stick, half).position_mm(), 250.0);
+  RecordProperty("lugre_presliding_mm", figure(creeping.position_mm() - 250.0));
+}
+
 // A command delay of d samples is the undelayed plant driven by the command of d samples ago.
 TEST(PneumaticPlant, ACommandDelayShiftsTheCommandBySamples) {
   const int d = 3;
