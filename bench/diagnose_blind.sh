@@ -6,6 +6,9 @@
 #   bench/diagnose_blind.sh [SEEDS=2] [BUILD_DIR=build/release]     (38 cases per seed)
 #   bench/diagnose_blind.sh fast                                    (11 cases: one per phenomenon)
 #
+# Then the friction rigs on the physics plant (5 per seed; fast: one LuGre rig), with their own
+# score line ("physics friction score").
+#
 # Exit 0 when it ran; the thresholds (tests/diag/blind/blind_diagnosis.py --check) are reported
 # on the "blind check" line.
 set -euo pipefail
@@ -20,3 +23,9 @@ else
   set -- --seeds "$arg"
 fi
 /usr/bin/python3 tests/diag/blind/blind_diagnosis.py "$build/src/app/epa" "$@" --check || true
+# The friction rigs on the physics plant (Karnopp and LuGre), commissioned with epa identify.
+if [ "$arg" = fast ]; then
+  /usr/bin/python3 tests/diag/blind/physics_friction_rigs.py "$build/src/app/epa" --fast
+else
+  /usr/bin/python3 tests/diag/blind/physics_friction_rigs.py "$build/src/app/epa" --seeds "$arg"
+fi
