@@ -17,6 +17,7 @@
 #include "diag/gap_report.hpp"
 #include "diag/selection.hpp"
 #include "diag/windowed_gap.hpp"
+#include "plant/stick_slip_model.hpp"
 #include "report/diagnose_report.hpp"
 
 namespace epa::app {
@@ -88,6 +89,10 @@ int run_diagnose(const DiagnoseOptions& o, std::ostream& out, std::ostream& err)
     if (!m) return fail(m.error().message);
     model_file = *m;
   }
+  // The stick-slip model runs at the model's Ts: a spring too stiff for it is refused here, by name.
+  if (model_file.stick_slip)
+    if (auto ss = plant::StickSlipModel::make(*model_file.stick_slip, model_file.model.Ts); !ss)
+      return fail(o.model_path + ": [stick_slip] " + ss.error().message);
   diag::ReplayModel nominal{model_file.model, {}, o.stroke_mm};
   if (o.holdout.empty() && o.runs.size() < 2)
     return fail("without --holdout the runs are cross-validated one against the others: give at least 2 runs, or --holdout FILE");

@@ -54,7 +54,7 @@ AxisChanges select_axis_changes(const ChangeFitData& data, const std::optional<c
   }
   out.heldout_after_mm = current;
   out.reduction_pct = reduction_pct(base, current, base);
-  out.unexplained = rest_drift_significant && out.accepted.kinds.empty();
+  out.unexplained = rest_drift_significant;  // whatever else changed, no change of the model's terms does that
   return out;
 }
 

@@ -9,10 +9,12 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <set>
 #include <sstream>
 
 #include "../support/run_epa.hpp"
+#include "core/model_file.hpp"
 #include "core/run_file.hpp"
 #include "diag_test_data.hpp"
 
@@ -215,6 +217,34 @@ TEST_F(DiagnoseCli, BadInputIsNamed) {
   o = epa::testing::run_epa("diagnose " + a + " --holdout " + write(other, "slow.csv") + " --json -");
   EXPECT_EQ(o.exit_code, 1);
   EXPECT_NE(o.output.find("slow.csv"), std::string::npos) << o.output;
+}
+
+// A model file with a stick-slip model: the verdict is judged over whole moves, the JSON holds the
+// whole-move gap and the changes, and without the model's spread no change is named and the text
+// says why. A stick-slip model too stiff for the model's Ts is refused naming the table.
+TEST_F(DiagnoseCli, AModelFileWithAStickSlipModelIsJudgedOverWholeMoves) {
+  const auto& d = fixture().data;
+  const std::string stick_slip =
+      "\n[stick_slip]\nbreak_right_v = 1.2\nbreak_left_v = -1.7\nspeed_right_mm_s_per_v = 200.0\nspeed_left_mm_s_per_v = 130.0\n"
+      "spring_rad_s = 50.0\ndamping_ratio = 0.3\ncoulomb_mm = 1.0\nstatic_mm = 1.5\nspool_lag_s = 0.01\ndelay_samples = 0\n";
+  const std::string paper = epa::core::format_model_toml({epa::core::paper::model(), "paper"});
+  std::ofstream(path("ss.toml")) << paper << stick_slip;
+  const std::string runs = write(d.train[0], "a.csv") + " " + write(d.train[1], "b.csv") + " --holdout " + write(d.heldout[0], "c.csv");
+  auto o = epa::testing::run_epa("diagnose " + runs + " --model " + path("ss.toml") + " --json " + path("ss.json"));
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  std::ifstream in(path("ss.json"));
+  const json j = json::parse(in);
+  EXPECT_EQ(j.at("verdict").at("measure"), "whole_move") << j.dump(1);
+  EXPECT_TRUE(j.contains("whole_move"));
+  EXPECT_EQ(j.at("changes").at("judged"), false);
+  EXPECT_EQ(j.at("verdict").at("changes"), json::array());
+  EXPECT_NE(j.at("verdict").at("text").get<std::string>().find("not judged"), std::string::npos) << j.dump(1);
+
+  std::ofstream(path("stiff.toml")) << paper << std::regex_replace(stick_slip, std::regex("spring_rad_s = 50.0"), "spring_rad_s = 900.0");
+  o = epa::testing::run_epa("diagnose " + runs + " --model " + path("stiff.toml") + " --json -");
+  EXPECT_EQ(o.exit_code, 1) << o.output;
+  EXPECT_NE(o.output.find("[stick_slip]"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("too stiff"), std::string::npos) << o.output;
 }
 
 }  // namespace
