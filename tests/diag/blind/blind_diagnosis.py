@@ -28,7 +28,9 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 import truth_rigs as tr  # noqa: E402
+from confusion_table import confusion_table  # noqa: E402
 
 DELAY_COMPANIONS = {"input_delay", "valve_lag"}
 
@@ -159,18 +161,7 @@ def main():
     pairs = [r for r in results if r[1] == "pair"]
     pairs_both = sum(1 for r in pairs if r[2] <= r[3])
 
-    categories = []
-    for r in results:
-        if r[1] not in categories:
-            categories.append(r[1])
-    lines = ["| truth (cases) | correct | " + " | ".join(NAMES) + " | unexplained |",
-             "| --- | --- | " + " | ".join("---" for _ in NAMES) + " | --- |"]
-    for c in categories:
-        rs = [r for r in results if r[1] == c]
-        counts = [sum(1 for r in rs if n in r[3]) for n in NAMES]
-        lines.append(f"| {c} ({len(rs)}) | {sum(r[7] for r in rs)} | " + " | ".join(str(x) for x in counts) +
-                     f" | {sum(1 for r in rs if r[4])} |")
-    matrix = "\n".join(lines)
+    matrix = confusion_table(results, NAMES, "truth")
     print(matrix)
     if args.matrix:
         open(args.matrix, "w").write(matrix + "\n")

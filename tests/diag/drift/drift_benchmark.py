@@ -31,6 +31,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from confusion_table import confusion_table  # noqa: E402
+
 NAMES = ["gain_change", "deadzone_shift", "input_delay", "valve_lag", "static_friction", "sensor_quantization"]
 TIMING = {"input_delay", "valve_lag"}  # a spool lag and a line delay are confusable: either may come beside the other
 
@@ -197,15 +200,7 @@ def main():
     median_reduction = statistics.median(r[5] for r in scored) if scored else 0.0
     median_seconds = statistics.median(r[6] for r in results) if results else 0.0
 
-    categories = list(dict.fromkeys(r[1] for r in results))
-    lines = ["| change (cases) | correct | " + " | ".join(NAMES) + " | unexplained |",
-             "| --- | --- | " + " | ".join("---" for _ in NAMES) + " | --- |"]
-    for c in categories:
-        rs = [r for r in results if r[1] == c]
-        counts = [sum(1 for r in rs if n in r[3]) for n in NAMES]
-        lines.append(f"| {c} ({len(rs)}) | {sum(r[7] for r in rs)} | " + " | ".join(str(x) for x in counts) +
-                     f" | {sum(1 for r in rs if r[4])} |")
-    matrix = "\n".join(lines)
+    matrix = confusion_table(results, NAMES, "change")
     print(matrix)
     if args.matrix:
         open(args.matrix, "w").write(matrix + "\n")
