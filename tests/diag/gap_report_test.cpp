@@ -230,8 +230,14 @@ TEST_F(DiagnoseCli, AModelFileWithAStickSlipModelIsJudgedOverWholeMoves) {
   const std::string paper = epa::core::format_model_toml({epa::core::paper::model(), "paper"});
   std::ofstream(path("ss.toml")) << paper << stick_slip;
   const std::string runs = write(d.train[0], "a.csv") + " " + write(d.train[1], "b.csv") + " --holdout " + write(d.heldout[0], "c.csv");
-  auto o = epa::testing::run_epa("diagnose " + runs + " --model " + path("ss.toml") + " --json " + path("ss.json"));
+  auto o = epa::testing::run_epa("diagnose " + runs + " --model " + path("ss.toml") + " --json " + path("ss.json") + " --report " +
+                                  path("ss.html"));
   ASSERT_EQ(o.exit_code, 0) << o.output;
+  std::ifstream html(path("ss.html"));
+  std::stringstream h;
+  h << html.rdbuf();
+  for (const char* drawn : {"Over whole moves", "stick events", "stick-slip friction against the piston", "Since commissioning"})
+    EXPECT_NE(h.str().find(drawn), std::string::npos) << drawn;
   std::ifstream in(path("ss.json"));
   const json j = json::parse(in);
   EXPECT_EQ(j.at("verdict").at("measure"), "whole_move") << j.dump(1);
