@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <utility>
 #include <string>
+#include <utility>
 
 #include "core/format.hpp"
 
@@ -198,7 +198,7 @@ PneumaticPlant::Deriv PneumaticPlant::derivative(const State& s, double u, bool 
   // Friction opposes the motion the sub-step started with (at v = 0, breaking away: the net
   // force). Not the sign of this stage's velocity: stages either side of v = 0 would cancel it
   // in the RK4 sum, and a piston pushed by less than the sliding friction would creep on.
-  const double friction = direction * (Fc_ + (Fs_ - Fc_) * std::exp(-(v / vs_) * (v / vs_))) + b_ * v;
+  const double friction = direction * stribeck_n(v) + b_ * v;
   d.v = (pressure_force_n(pa, pb) - friction) / mass_kg_;
   return d;
 }

@@ -117,6 +117,7 @@ class PneumaticPlant {
   double Fs_ = 0, Fc_ = 0, vs_ = 0, b_ = 0;
   double sigma0_ = 0, sigma1_ = 0;  // LuGre; sigma0_ == 0: the stick test
   bool lugre() const noexcept { return sigma0_ > 0.0; }
+  // Friction at speed v (m/s) on the Stribeck curve, N: Fs at rest falling to Fc.
   double stribeck_n(double v) const noexcept { return Fc_ + (Fs_ - Fc_) * std::exp(-(v / vs_) * (v / vs_)); }
   double leak_a_m2_ = 0, leak_b_m2_ = 0;  // leaks to atmosphere, effective areas
   double orifice_eff_m2_ = 0, tau_s_ = 0, overlap_pos_v_ = 0, overlap_neg_v_ = 0;
