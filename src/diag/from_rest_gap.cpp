@@ -51,10 +51,9 @@ class StickSlipFreeRun {
 // Whether the segment's readings from `from` to `to` stay off the end stops and its commands
 // inside the identified range.
 bool judged(const core::Run& run, std::size_t from, std::size_t to, const JudgedScope& scope) {
-  for (std::size_t k = from; k <= to && k < run.size(); ++k) {
-    if (run.y_mm[k] < kEndStopMarginMm || run.y_mm[k] > scope.stroke_mm - kEndStopMarginMm) return false;
+  if (touches_end_stop(run, from, to, scope.stroke_mm)) return false;
+  for (std::size_t k = from; k <= to && k < run.size(); ++k)
     if (!scope.drive_inside(run.u_V[k])) return false;
-  }
   return true;
 }
 

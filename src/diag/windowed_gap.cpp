@@ -24,13 +24,6 @@ double measured_where_mm(const core::Run& run, std::size_t k, std::size_t sample
   return sum / static_cast<double>(samples);
 }
 
-// Whether a measurement in samples [from, to] lies within kEndStopMarginMm of an end stop.
-bool touches_end_stop(const core::Run& run, std::size_t from, std::size_t to, double stroke_mm) {
-  for (std::size_t k = from; k <= to && k < run.size(); ++k)
-    if (run.y_mm[k] < kEndStopMarginMm || run.y_mm[k] > stroke_mm - kEndStopMarginMm) return true;
-  return false;
-}
-
 struct WindowCount {
   std::size_t replayed = 0, at_end_stop = 0;
 };
@@ -99,6 +92,12 @@ WindowCount replay(const ReplayModel& m, const core::Run& run, std::size_t horiz
 }
 
 }  // namespace
+
+bool touches_end_stop(const core::Run& run, std::size_t from, std::size_t to, double stroke_mm) {
+  for (std::size_t k = from; k <= to && k < run.size(); ++k)
+    if (run.y_mm[k] < kEndStopMarginMm || run.y_mm[k] > stroke_mm - kEndStopMarginMm) return true;
+  return false;
+}
 
 GapSum windowed_sse(const ReplayModel& model, const core::Run& run, std::size_t horizon) {
   GapSum s;

@@ -56,6 +56,9 @@ struct WindowedReplay {
   GapSum sum;
 };
 
+// Whether a reading in samples [from, to] lies within kEndStopMarginMm of an end stop (0 or stroke_mm).
+bool touches_end_stop(const core::Run& run, std::size_t from, std::size_t to, double stroke_mm);
+
 // The first sample a window may start at: the ARX part needs that much measured past.
 std::size_t first_window_start(const core::HammersteinModel& model);
 
