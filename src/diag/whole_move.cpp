@@ -30,27 +30,36 @@ bool present(EffectKind term, const core::StickSlipParams& p) {
   }
 }
 
-GapSum pooled(std::span<const AnchoredRun> runs, auto&& sse_of) {
+// Both models' gaps on one run. Each run is run once per model: the pooled gaps, the per-run
+// rows and the trace's choice all come from these.
+struct RunSums {
+  GapSum law, stick_slip;
+};
+
+std::vector<RunSums> run_sums(const WholeMoveGap& g, const core::ModelFile& file, std::span<const AnchoredRun> runs) {
+  std::vector<RunSums> out;
+  for (const auto& r : runs)
+    out.push_back({from_rest_sse(file.model, r, g.scope), g.has_stick_slip ? from_rest_sse(g.stick_slip, file.model.Ts, r, g.scope) : GapSum{}});
+  return out;
+}
+
+GapSum pooled(const std::vector<RunSums>& sums, GapSum RunSums::*model) {
   GapSum s;
-  for (const auto& r : runs) s += sse_of(r);
+  for (const auto& r : sums) s += r.*model;
   return s;
 }
 
-void add_per_run(WholeMoveGap& g, const core::ModelFile& file, std::span<const AnchoredRun> runs, const char* set) {
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    RunWholeMoveGap row{set, i};
-    const GapSum h = from_rest_sse(file.model, runs[i], g.scope);
-    row.hammerstein_mm = h.rms_mm(), row.segments = h.windows, row.segments_left_out = h.windows_at_end_stop;
-    if (g.has_stick_slip) row.stick_slip_mm = from_rest_sse(g.stick_slip, file.model.Ts, runs[i], g.scope).rms_mm();
-    g.per_run.push_back(row);
-  }
+void add_per_run(WholeMoveGap& g, const std::vector<RunSums>& sums, const char* set) {
+  for (std::size_t i = 0; i < sums.size(); ++i)
+    g.per_run.push_back({set, i, sums[i].law.rms_mm(), sums[i].stick_slip.rms_mm(), sums[i].law.windows, sums[i].law.windows_at_end_stop});
 }
 
 // The scored run with the most judged readings, from its first judged segment for kTraceS at most.
-WholeMoveTrace trace_of(const WholeMoveGap& g, const core::ModelFile& file, std::span<const AnchoredRun> scored, const char* set) {
-  std::size_t best = 0, most = 0;
-  for (std::size_t i = 0; i < scored.size(); ++i)
-    if (const auto n = from_rest_sse(file.model, scored[i], g.scope).n; n > most) most = n, best = i;
+WholeMoveTrace trace_of(const WholeMoveGap& g, const core::ModelFile& file, std::span<const AnchoredRun> scored,
+                        const std::vector<RunSums>& sums, const char* set) {
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < sums.size(); ++i)
+    if (sums[i].law.n > sums[best].law.n) best = i;
   const AnchoredRun& r = scored[best];
   const core::Run& run = *r.run;
   WholeMoveTrace t{set, best, run.t_s, run.y_mm, {}, {}, {}, {}};
@@ -108,15 +117,16 @@ WholeMoveGap whole_move_gap(const core::ModelFile& file, std::span<const Anchore
   g.scoped_to_identified_drive = file.identified_drive_v.has_value();
   const std::span<const AnchoredRun> scored = heldout_runs.empty() ? train_runs : heldout_runs;
   g.noise_floor_mm = from_rest_noise_floor_mm(scored, noise_std_mm);
-  g.hammerstein_train = pooled(train_runs, [&](const AnchoredRun& r) { return from_rest_sse(file.model, r, g.scope); });
-  g.hammerstein_heldout = pooled(scored, [&](const AnchoredRun& r) { return from_rest_sse(file.model, r, g.scope); });
-  g.segments = g.hammerstein_heldout.windows, g.segments_left_out = g.hammerstein_heldout.windows_at_end_stop;
   g.has_stick_slip = file.stick_slip.has_value();
+  if (g.has_stick_slip) g.stick_slip = *file.stick_slip;
+  const auto train_sums = run_sums(g, file, train_runs), heldout_sums = run_sums(g, file, heldout_runs);
+  const auto& scored_sums = heldout_runs.empty() ? train_sums : heldout_sums;
+  g.hammerstein_train = pooled(train_sums, &RunSums::law);
+  g.hammerstein_heldout = pooled(scored_sums, &RunSums::law);
+  g.segments = g.hammerstein_heldout.windows, g.segments_left_out = g.hammerstein_heldout.windows_at_end_stop;
   if (g.has_stick_slip) {
-    g.stick_slip = *file.stick_slip;
-    const double Ts = file.model.Ts;
-    g.stick_slip_train = pooled(train_runs, [&](const AnchoredRun& r) { return from_rest_sse(g.stick_slip, Ts, r, g.scope); });
-    g.stick_slip_heldout = pooled(scored, [&](const AnchoredRun& r) { return from_rest_sse(g.stick_slip, Ts, r, g.scope); });
+    g.stick_slip_train = pooled(train_sums, &RunSums::stick_slip);
+    g.stick_slip_heldout = pooled(scored_sums, &RunSums::stick_slip);
     const double law_gap = g.hammerstein_heldout.rms_mm();
     g.explained_pct = law_gap > 0 ? 100.0 * (1.0 - g.stick_slip_heldout.rms_mm() / law_gap) : 0.0;
     judge_terms(g, file, scored);
@@ -124,9 +134,9 @@ WholeMoveGap whole_move_gap(const core::ModelFile& file, std::span<const Anchore
   const double left = g.has_stick_slip ? g.stick_slip_heldout.rms_mm() : g.hammerstein_heldout.rms_mm();
   const bool above_floor = left > kSignificantOverFloor * g.noise_floor_mm;
   g.unexplained = g.named.empty() ? above_floor : above_floor && left > g.hammerstein_heldout.rms_mm() / 3.0;
-  add_per_run(g, file, train_runs, "train");
-  if (!heldout_runs.empty()) add_per_run(g, file, heldout_runs, "heldout");
-  if (!scored.empty()) g.trace = trace_of(g, file, scored, heldout_runs.empty() ? "train" : "heldout");
+  add_per_run(g, train_sums, "train");
+  if (!heldout_runs.empty()) add_per_run(g, heldout_sums, "heldout");
+  if (!scored.empty()) g.trace = trace_of(g, file, scored, scored_sums, heldout_runs.empty() ? "train" : "heldout");
   return g;
 }
 
