@@ -14,6 +14,11 @@ double reduction_pct(double before_mm, double after_mm, double base_mm) {
   return base_mm > 0 ? 100.0 * (before_mm - after_mm) / base_mm : 0.0;
 }
 
+// The first round of the forward selection is the candidates' own fits, each change alone.
+const ChangeFit& alone(const std::vector<ChangeCandidate>& candidates, EffectKind kind) {
+  return std::find_if(candidates.begin(), candidates.end(), [&](const ChangeCandidate& c) { return c.effect == kind; })->fit;
+}
+
 std::vector<EffectKind> with(std::vector<EffectKind> kinds, EffectKind kind) {
   kinds.push_back(kind);
   return kinds;
@@ -43,8 +48,8 @@ AxisChanges select_axis_changes(const ChangeFitData& data, const std::optional<c
     std::optional<ChangeFit> best;
     for (const EffectKind kind : kAxisChanges) {
       if (out.accepted.has(kind)) continue;
-      ChangeFit fit = fit_change(data, with(out.accepted.kinds, kind), out.accepted);
-      out.evaluations += fit.evaluations;
+      ChangeFit fit = out.accepted.kinds.empty() ? alone(out.candidates, kind) : fit_change(data, with(out.accepted.kinds, kind), out.accepted);
+      if (!out.accepted.kinds.empty()) out.evaluations += fit.evaluations;
       if (!beyond_tolerance(kind, fit.change, data.commissioned, tolerance)) continue;
       if (!best || fit.heldout_gap_mm < best->heldout_gap_mm) best = fit;
     }
