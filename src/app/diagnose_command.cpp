@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <fmt/format.h>
 #include <functional>
-#include <filesystem>
 #include <map>
 #include <optional>
 

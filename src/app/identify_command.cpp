@@ -1,7 +1,6 @@
 #include "app/identify_command.hpp"
 
 #include <array>
-
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>

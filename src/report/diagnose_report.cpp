@@ -18,12 +18,6 @@ std::string num(double v, const char* fmt = "%.3f") {
   return b;
 }
 
-// The SVG document without its XML prolog, to inline in HTML.
-std::string inline_svg(const std::string& svg) {
-  const auto p = svg.find("<svg");
-  return p == std::string::npos ? svg : svg.substr(p);
-}
-
 }  // namespace
 
 std::string render_diagnosis_html(const diag::GapReport& r) {

@@ -20,4 +20,9 @@ std::string escape(std::string_view text, bool quotes) {
 std::string escape_html(std::string_view text) { return escape(text, false); }
 std::string escape_html_attribute(std::string_view text) { return escape(text, true); }
 
+std::string inline_svg(const std::string& svg) {
+  const auto p = svg.find("<svg");
+  return p == std::string::npos ? svg : svg.substr(p);
+}
+
 }  // namespace epa::report

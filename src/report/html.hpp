@@ -1,6 +1,6 @@
 #pragma once
-// Text that goes into the HTML reports as written: a name, a message or a log line may hold
-// characters HTML reads as markup.
+// Text and pictures that go into the HTML reports: a name, a message or a log line may hold
+// characters HTML reads as markup; an SVG document carries a prolog HTML does not take.
 #include <string>
 #include <string_view>
 
@@ -10,5 +10,7 @@ namespace epa::report {
 std::string escape_html(std::string_view text);
 // The same and " as &quot;: text that may also stand inside a quoted attribute.
 std::string escape_html_attribute(std::string_view text);
+// An SVG document without its XML prolog, to inline in an HTML page.
+std::string inline_svg(const std::string& svg);
 
 }  // namespace epa::report

@@ -9,11 +9,6 @@ namespace epa::report {
 
 namespace {
 
-std::string inline_svg(const std::string& svg) {
-  const auto p = svg.find("<svg");
-  return p == std::string::npos ? svg : svg.substr(p);
-}
-
 std::vector<Panel> trace_panels(const diag::WholeMoveGap& w) {
   const auto& t = w.trace;
   Panel p{fmt::format("position over whole moves ({} run {})", t.set, t.index + 1), "time (s)", "position (mm)", {}, {}, {}, {}, {}, {}};
