@@ -23,6 +23,8 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "web/round_robin_by_key.hpp"
+
 namespace epa::web {
 
 namespace {
@@ -31,6 +33,9 @@ using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
 
 constexpr milliseconds kScanPeriod{50};        // how often deadlines are looked at
+// How long a worker waits for bytes the front end's framing did not see coming: a chunked body
+// whose end marker came early (inside a chunk's data). Short, so no client holds a worker.
+constexpr milliseconds kWorkerReadGrace{100};
 constexpr std::size_t kAcceptsPerWake = 256;   // then the connections get their turn
 constexpr std::size_t kReservedDescriptors = 256;  // left to the rest of the process (Modbus, store, logs)
 constexpr auto kTallyPeriod = std::chrono::minutes(1);
@@ -180,11 +185,12 @@ namespace {
 enum class Cut { kNone, kDeadline, kTooLarge };
 
 // A connection as httplib's Stream, on a worker: the request is read from the bytes the front end
-// buffered (usually all of it), and only a body the front end could not frame (chunked) from the
-// socket, each wait ending at the request's deadline.
+// buffered (usually all of it), and only a body the front end framed wrongly (chunked) from the
+// socket, by the request's deadline or kWorkerReadGrace after the worker took it, whichever is first.
 class BufferedStream final : public httplib::Stream {
  public:
-  BufferedStream(DeadlineHttpServer::Connection& c, const RequestLimits& limits) : c_(c), limits_(limits) {}
+  BufferedStream(DeadlineHttpServer::Connection& c, const RequestLimits& limits)
+      : c_(c), limits_(limits), read_until_(std::min(c.deadline, Clock::now() + kWorkerReadGrace)) {}
 
   Cut cut() const { return cut_; }
   // Forgets the bytes of the request just answered.
@@ -229,7 +235,7 @@ class BufferedStream final : public httplib::Stream {
 
  private:
   milliseconds left() const {
-    return std::max(milliseconds(0), std::chrono::duration_cast<milliseconds>(c_.deadline - Clock::now()));
+    return std::max(milliseconds(0), std::chrono::duration_cast<milliseconds>(read_until_ - Clock::now()));
   }
   void endpoint(int (*get)(int, sockaddr*, socklen_t*), std::string& ip, int& port) const {
     sockaddr_storage a{};
@@ -253,6 +259,7 @@ class BufferedStream final : public httplib::Stream {
 
   DeadlineHttpServer::Connection& c_;
   const RequestLimits& limits_;
+  const Clock::time_point read_until_;  // this request's bytes from the socket, if any, come by then
   std::size_t pos_ = 0;
   Cut cut_ = Cut::kNone;
 };
@@ -267,6 +274,7 @@ struct DeadlineHttpServer::Front {
   std::atomic<std::size_t> open{0};
   std::size_t max_connections = 0;
   httplib::TaskQueue* queue = nullptr;
+  RoundRobinByKey<std::shared_ptr<Connection>> ready;  // whole requests for the workers, by peer in turn
   Clock::time_point next_scan{}, accept_paused_until{};
   bool accept_paused = false;
   Tally no_descriptors{"accept refused: out of file descriptors"};
@@ -333,29 +341,28 @@ void DeadlineHttpServer::hand_back(std::shared_ptr<Connection> c, bool close) {
   front_->wake();
 }
 
+// One request per turn: a pipelined request that is already whole goes back through the front end
+// to wait for its turn behind one answer of each other address. A worker that answered every
+// pipelined request at once held it for as many answers as the socket's buffer takes (megabytes on
+// loopback), while the page's poll waited for a worker.
 void DeadlineHttpServer::answer(std::shared_ptr<Connection> c) {
   BufferedStream stream(*c, limits_);
-  for (;;) {
-    bool connection_closed = false;
-    const bool served = process_request(stream, c->requests_left <= 1, connection_closed, nullptr);
-    --c->requests_left;
-    if (stream.cut() != Cut::kNone) {
-      const bool late = stream.cut() == Cut::kDeadline;
-      send_refusal(c->fd, late ? 408 : 431, late ? "Request Timeout" : "Request Header Fields Too Large",
-                   late ? "request not complete within its deadline" : "request too large", answer_headers_);
-      return hand_back(std::move(c), true);
-    }
-    // After a request it could not parse, httplib answers 400 and would read on from the next line:
-    // the rest of a malformed request must not be taken as a new one (request smuggling).
-    const bool malformed = c->out.starts_with("HTTP/1.1 400 ");
-    if (!stream.flush()) return hand_back(std::move(c), true);
-    if (!served || connection_closed || malformed || c->requests_left == 0) return hand_back(std::move(c), true);  // after `out`
-    stream.consume();
-    // An answer the client has not taken goes to the front end to write; a pipelined request that is
-    // already whole is answered here; any other goes back to wait.
-    if (!c->out.empty() || framing(c->buffer, limits_, payload_max_length_) != Framing::kWhole) return hand_back(std::move(c), false);
-    c->deadline = Clock::now() + limits_.request_deadline;
+  bool connection_closed = false;
+  const bool served = process_request(stream, c->requests_left <= 1, connection_closed, nullptr);
+  --c->requests_left;
+  if (stream.cut() != Cut::kNone) {
+    const bool late = stream.cut() == Cut::kDeadline;
+    send_refusal(c->fd, late ? 408 : 431, late ? "Request Timeout" : "Request Header Fields Too Large",
+                 late ? "request not complete within its deadline" : "request too large", answer_headers_);
+    return hand_back(std::move(c), true);
   }
+  // After a request it could not parse, httplib answers 400 and would read on from the next line:
+  // the rest of a malformed request must not be taken as a new one (request smuggling).
+  const bool malformed = c->out.starts_with("HTTP/1.1 400 ");
+  if (!stream.flush()) return hand_back(std::move(c), true);
+  if (!served || connection_closed || malformed || c->requests_left == 0) return hand_back(std::move(c), true);  // after `out`
+  stream.consume();
+  hand_back(std::move(c), false);  // the front end writes what the client has not taken, or frames the next request
 }
 
 // Accepts what the listening socket holds. Out of descriptors, the reserve descriptor is given up to
@@ -457,7 +464,11 @@ void DeadlineHttpServer::dispatch(const std::shared_ptr<Connection>& c) {
   Front& f = *front_;
   ::epoll_ctl(f.epoll_fd, EPOLL_CTL_DEL, c->fd, nullptr);
   f.waiting.erase(c->fd);
-  f.queue->enqueue([this, c] { answer(c); });
+  // A worker takes the next connection by address in turn, not this one: one per enqueue, so none is left.
+  f.ready.push(c->peer, c);
+  f.queue->enqueue([this] {
+    if (auto next = front_->ready.pop()) answer(std::move(*next));
+  });
 }
 
 // Connections the workers have answered: closed, or waiting again for their next request (which
