@@ -30,8 +30,14 @@ std::string apply_module_command(const std::string& line, rig::RemoteIoSimulator
     else if (how == "frozen") f.sensor = S::kFrozen;
     else if (how == "fixed" && (in >> f.sensor_v)) f.sensor = S::kFixed;
     else return "error: sensor takes normal, nan, frozen or fixed VOLTS, not '" + line + "'";
+  } else if (what == "physics") {
+    double value = 0.0;
+    std::string rest;
+    if (how.empty() || !(in >> value) || (in >> rest)) return "error: physics takes KEY VALUE (an epa-pneumatic/1 key and a number), not '" + line + "'";
+    if (auto s = sim.change_physics(how, value); !s) return "error: " + s.error().message;
+    return "ok " + line;
   } else {
-    return "error: unknown command '" + line + "' (answers, sensor, status)";
+    return "error: unknown command '" + line + "' (answers, sensor, physics, status)";
   }
   sim.inject(f);
   return "ok " + line;

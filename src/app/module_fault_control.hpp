@@ -3,6 +3,9 @@
 // per line on standard input, answered with one line on standard output:
 //   answers normal | silent | garbage | late MS     how the module answers Modbus requests
 //   sensor normal | nan | frozen | fixed VOLTS      what its sensor reads
+//   physics KEY VALUE   a key of the physics plant's epa-pneumatic/1 file, from the next step on
+//                       (e.g. "physics supply_pressure_bar 4.5"; a drifting axis); the Hammerstein
+//                       plant refuses it
 //   status      "valve V position MM steps_to_safe N watchdog ok|tripped" (N: plant steps from the
 //               last sensor fault to the first 0 V valve command; -1: none yet)
 // Anything else is answered "error: ..." naming what was wrong.

@@ -39,8 +39,9 @@ void add_plant_server_command(CLI::App& app, PlantServerOptions& o) {
                                                  "long without a request (0: off)")
       ->capture_default_str()->check(CLI::Range(0, 60000));
   cmd->add_flag("--control-stdin", o.control_stdin,
-                "Fault injection for tests: read 'answers silent|garbage|late MS|normal', 'sensor nan|frozen|fixed V|normal' "
-                "and 'status' lines on standard input");
+                "Fault injection for tests: read 'answers silent|garbage|late MS|normal', 'sensor nan|frozen|fixed V|normal', "
+                "'physics KEY VALUE' (physics plant: a key of epa-pneumatic/1, from the next step on) and 'status' lines "
+                "on standard input");
   cmd->add_option("--effect", o.effects, "Hammerstein plant: hide an effect in it, e.g. valve_lag=0.02 or static_friction=0.6,0.3 "
                                          "(repeatable; names and parameters as epa diagnose reports them)");
   cmd->add_option("--initial-position", o.initial_position_mm, "Piston position at start, mm")

@@ -1,7 +1,9 @@
 #pragma once
 // The plants behind the PlantSimulator interface, and factories that make them so.
 #include <memory>
+#include <optional>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 
 #include "core/hammerstein_model.hpp"
@@ -27,9 +29,23 @@ class PlantAdapter final : public PlantSimulator {
   std::string_view kind() const noexcept override { return kind_; }
   std::unique_ptr<PlantSimulator> clone() const override { return std::make_unique<PlantAdapter>(*this); }
 
+  std::optional<PneumaticParams> physics_params() const override {
+    if constexpr (kPhysics) return plant_.params();
+    else return std::nullopt;
+  }
+  core::Status check_physics_params(const PneumaticParams& next) const override {
+    if constexpr (kPhysics) return plant_.check_params(next);
+    else return PlantSimulator::check_physics_params(next);
+  }
+  core::Status set_physics_params(const PneumaticParams& next) override {
+    if constexpr (kPhysics) return plant_.set_params(next);
+    else return PlantSimulator::check_physics_params(next);
+  }
+
   const Plant& plant() const { return plant_; }
 
  private:
+  static constexpr bool kPhysics = std::is_same_v<Plant, PneumaticPlant>;
   Plant plant_;
   double Ts_;
   std::string_view kind_;  // a string literal

@@ -4,7 +4,12 @@
 // Timing as in both plants: step(u) holds valve command u(k) over one sample period and advances
 // to k+1; measured_v() is the sensor reading at k.
 #include <memory>
+#include <optional>
+#include <string>
 #include <string_view>
+
+#include "core/result.hpp"
+#include "plant/pneumatic_params.hpp"
 
 namespace epa::plant {
 
@@ -20,6 +25,19 @@ class PlantSimulator {
   virtual std::string_view kind() const noexcept = 0;   // "Hammerstein" or "physics", for logs
   // A copy with the same state (noise generator included), so holders keep value semantics.
   virtual std::unique_ptr<PlantSimulator> clone() const = 0;
+
+  // The physics plant's parameters (epa-pneumatic/1), so a test rig can change them while it runs
+  // (`epa plant-server`'s `physics KEY VALUE`); none for a plant without them.
+  virtual std::optional<PneumaticParams> physics_params() const { return std::nullopt; }
+  // Checks `next` for this plant without changing it; a plant without physics parameters refuses.
+  virtual core::Status check_physics_params(const PneumaticParams& next) const;
+  // Takes checked parameters from the next step on; the state carries over.
+  virtual core::Status set_physics_params(const PneumaticParams& next) { return check_physics_params(next); }
 };
+
+inline core::Status PlantSimulator::check_physics_params(const PneumaticParams&) const {
+  return core::invalid_argument("the " + std::string(kind()) +
+                                " plant has no physical parameters to change: 'physics' lines need the physics plant (--plant physics)");
+}
 
 }  // namespace epa::plant

@@ -142,6 +142,25 @@ core::Result<PneumaticParams> parse_pneumatic_toml(const std::string& text, cons
   return p;
 }
 
+core::Status set_pneumatic_key(PneumaticParams& params, std::string_view key, double value) {
+  const std::size_t dot = key.find('.');
+  const std::string_view table = dot == std::string_view::npos ? std::string_view() : key.substr(0, dot);
+  const std::string_view name = dot == std::string_view::npos ? key : key.substr(dot + 1);
+  const Field* field = nullptr;
+  for (const Field& f : kFields)
+    if (name == f.key && (table.empty() || table == f.table)) field = &f;
+  if (field == nullptr) {
+    std::string known;
+    for (const Field& f : kFields) known += (known.empty() ? "" : ", ") + std::string(f.key);
+    return core::invalid_argument("pneumatic plant: unknown key '" + std::string(key) + "' (known: " + known + ")");
+  }
+  PneumaticParams next = params;
+  next.*field->member = value;
+  if (auto s = next.validate(); !s) return s;
+  params = next;
+  return core::ok();
+}
+
 core::Result<PneumaticParams> read_pneumatic_file(const std::string& path) {
   auto text = core::read_text_file(path, "pneumatic plant file", core::kSmallFileCapBytes);
   if (!text) return text.error();

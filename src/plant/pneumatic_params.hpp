@@ -15,6 +15,7 @@
 // Enfield 5/3 proportional valve): about 0.9 m/s at full command, and a valve-command dead zone
 // of [-1.7, +1.2] V like the paper's identified b_l = -1.722 V, b_r = +1.232 V.
 #include <string>
+#include <string_view>
 
 #include "core/result.hpp"
 
@@ -67,6 +68,10 @@ struct PneumaticParams {
 core::Result<PneumaticParams> parse_pneumatic_toml(const std::string& text, const std::string& source_name);
 core::Result<PneumaticParams> read_pneumatic_file(const std::string& path);
 std::string format_pneumatic_toml(const PneumaticParams& params);  // reads back to the same values
+// Sets one key of the file, named bare ("supply_pressure_bar") or with its table
+// ("supply.supply_pressure_bar"), and validates the result. On an error (an unknown key, listing
+// the known ones; a value out of range, as validate() names it) `params` is left as it was.
+core::Status set_pneumatic_key(PneumaticParams& params, std::string_view key, double value);
 core::Status write_pneumatic_file(const std::string& path, const PneumaticParams& params);
 
 }  // namespace epa::plant

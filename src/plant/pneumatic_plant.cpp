@@ -65,6 +65,7 @@ core::Result<PneumaticPlant> PneumaticPlant::make(const PneumaticParams& params,
 
   PneumaticPlant p;
   p.params_ = params;
+  p.options_ = o;
   const double pi = std::numbers::pi;
   p.area_a_m2_ = pi / 4.0 * std::pow(params.bore_mm * 1e-3, 2);
   p.area_rod_m2_ = pi / 4.0 * std::pow(params.rod_mm * 1e-3, 2);
@@ -138,6 +139,33 @@ core::Result<PneumaticPlant> PneumaticPlant::make(const PneumaticParams& params,
   p.state_.rng = core::Random(o.seed);
   p.sample_sensor();
   return p;
+}
+
+namespace {
+// make()'s options for a plant that takes `next` while running: its start values within `next`'s
+// ranges (they are not used, the state carries over).
+PneumaticOptions options_for(PneumaticOptions o, const PneumaticParams& next) {
+  o.initial_position_mm = std::clamp(o.initial_position_mm, 0.0, next.stroke_mm);
+  o.initial_pressure_bar = std::clamp(o.initial_pressure_bar, 0.0, next.supply_pressure_bar);
+  return o;
+}
+}  // namespace
+
+core::Status PneumaticPlant::check_params(const PneumaticParams& next) const {
+  auto made = make(next, options_for(options_, next));
+  if (!made) return made.error();
+  return core::ok();
+}
+
+core::Status PneumaticPlant::set_params(const PneumaticParams& next) {
+  auto made = make(next, options_for(options_, next));
+  if (!made) return made.error();
+  const State running = state_;
+  const PneumaticOptions options = options_;
+  *this = std::move(*made);
+  options_ = options;
+  set_state(running);
+  return core::ok();
 }
 
 void PneumaticPlant::set_state(const State& s) {

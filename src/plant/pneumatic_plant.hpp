@@ -88,6 +88,12 @@ class PneumaticPlant {
   double Ts() const { return Ts_; }
   int substeps() const { return substeps_; }
   const PneumaticParams& params() const { return params_; }
+  // A change of parameters while the plant runs (a worn seal, a lower supply): checks `next` as
+  // make() would, for this plant's options, without changing anything ...
+  core::Status check_params(const PneumaticParams& next) const;
+  // ... and takes it from the next step on. The state carries over (the position clamped to a
+  // shorter stroke); on an error nothing changes. Allocates nothing when `next` passed the check.
+  core::Status set_params(const PneumaticParams& next);
 
   // Net pressure force on the piston (N, + towards the stroke end), before friction.
   double pressure_force_n(double pressure_a_pa, double pressure_b_pa) const noexcept;
@@ -111,6 +117,7 @@ class PneumaticPlant {
   void sample_sensor() noexcept;
 
   PneumaticParams params_;
+  PneumaticOptions options_;
   // Derived constants in SI units, computed once in make().
   double area_a_m2_ = 0, area_b_m2_ = 0, area_rod_m2_ = 0, stroke_m_ = 0, dead_a_m3_ = 0, dead_b_m3_ = 0;
   double supply_pa_ = 0, atm_pa_ = 0, RT_ = 0, sqrt_T_ = 0, n_ = 0, mass_kg_ = 0;

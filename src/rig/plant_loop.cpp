@@ -23,6 +23,27 @@ PlantLoop::PlantLoop(const Setup& setup, std::unique_ptr<plant::PlantSimulator> 
       faults_(faults),
       activity_(activity) {
   position_mm_.store(plant_->position_mm());
+  physics_ = plant_->physics_params();
+}
+
+core::Status PlantLoop::change_physics(std::string_view key, double value) {
+  std::lock_guard lock(physics_mutex_);
+  if (!physics_) return plant_->check_physics_params(plant::PneumaticParams{});  // refuses, naming the plant
+  plant::PneumaticParams next = *physics_;
+  if (auto s = plant::set_pneumatic_key(next, key, value); !s) return s;
+  // The check reads only the plant's options, which never change once it runs.
+  if (auto s = plant_->check_physics_params(next); !s) return s;
+  physics_ = next;
+  physics_pending_.store(true);
+  return core::ok();
+}
+
+void PlantLoop::take_physics_change() noexcept {
+  if (!physics_pending_.load()) return;
+  std::unique_lock lock(physics_mutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return;  // being changed right now: taken a step later
+  (void)plant_->set_physics_params(*physics_);  // checked in change_physics
+  physics_pending_.store(false);
 }
 
 void PlantLoop::run(const std::atomic<bool>& running) noexcept {
@@ -66,6 +87,7 @@ double PlantLoop::valve_command(std::int64_t step_ns) noexcept {
 }
 
 void PlantLoop::step(double valve_v) noexcept {
+  take_physics_change();
   plant_->step(valve_v);
   last_valve_v_.store(valve_v);
   faults_.count_step(steps_.load(), valve_v);

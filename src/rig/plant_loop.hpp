@@ -16,9 +16,16 @@
 //
 // The module's comms watchdog (watchdog_ms > 0): no request for that long, after the first,
 // centres the valve until requests come back.
+//
+// A physics plant's parameters can change while it runs (change_physics, from another thread):
+// checked there, handed over, and taken by the plant thread before its next step, which never
+// waits for the other thread (it tries the hand-over's lock and looks again a step later).
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
+#include <optional>
+#include <string_view>
 
 #include "hal/remote_io_layout.hpp"
 #include "plant/plant_simulator.hpp"
@@ -51,10 +58,16 @@ class PlantLoop {
   // The plant thread's loop, until `running` is false.
   void run(const std::atomic<bool>& running) noexcept;
 
+  // Sets one epa-pneumatic/1 key (plant::set_pneumatic_key) from the next step on; thread-safe.
+  // Errors: a plant without physical parameters, an unknown key, a value out of range or one the
+  // plant's sub-steps cannot integrate; nothing changes then.
+  core::Status change_physics(std::string_view key, double value);
+
  private:
   std::int64_t next_step_ns(std::int64_t last_step_ns, std::int64_t& step_before_ns) const noexcept;
   double valve_command(std::int64_t step_ns) noexcept;  // the register's, or 0 V while the watchdog trips
   void step(double valve_v) noexcept;
+  void take_physics_change() noexcept;
 
   const Setup setup_;
   std::unique_ptr<plant::PlantSimulator> plant_;  // never null; the plant thread's alone once started
@@ -67,6 +80,9 @@ class PlantLoop {
   std::atomic<double> last_valve_v_{0.0};
   std::atomic<std::int64_t> next_step_due_ns_{0};  // when the step the plant thread waits for is due
   std::atomic<bool> watchdog_tripped_{false};
+  std::mutex physics_mutex_;                      // the hand-over below
+  std::optional<plant::PneumaticParams> physics_;  // the parameters asked for last (none: not a physics plant)
+  std::atomic<bool> physics_pending_{false};      // physics_ holds a change the plant has not taken
 };
 
 }  // namespace epa::rig

@@ -119,4 +119,6 @@ bool RemoteIoSimulator::watchdog_tripped() const { return impl_->plant->watchdog
 
 void RemoteIoSimulator::inject(const ModuleFaults& f) { impl_->faults.inject(f, impl_->plant->steps()); }
 
+core::Status RemoteIoSimulator::change_physics(std::string_view key, double value) { return impl_->plant->change_physics(key, value); }
+
 }  // namespace epa::rig

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "core/hammerstein_model.hpp"
 #include "core/result.hpp"
@@ -70,6 +71,9 @@ class RemoteIoSimulator {
 
   // Takes effect at the next request (answers) or plant step (sensor); thread-safe.
   void inject(const ModuleFaults& faults);
+  // A physics plant's parameter, changed from the next plant step on (PlantLoop::change_physics);
+  // thread-safe. A Hammerstein plant refuses, naming itself.
+  core::Status change_physics(std::string_view key, double value);
 
   // Stops both threads and closes every socket; idempotent. Returns within 50 ms + Ts, or 150 ms
   // + Ts while a client stalls mid-frame.

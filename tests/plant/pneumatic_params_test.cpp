@@ -113,5 +113,34 @@ TEST(PneumaticParams, BadValuesNameFileLineAndKey) {
   EXPECT_NE(parse_message("schema = \"epa-model/1\"\n").find("not supported"), std::string::npos);
 }
 
+// `epa plant-server`'s `physics KEY VALUE` line: one key at a time, bare or with its table.
+TEST(PneumaticParams, OneKeyIsSetBareOrWithItsTable) {
+  PneumaticParams p;
+  ASSERT_TRUE(set_pneumatic_key(p, "supply_pressure_bar", 4.5));
+  EXPECT_EQ(p.supply_pressure_bar, 4.5);
+  ASSERT_TRUE(set_pneumatic_key(p, "friction.static_friction_n", 80.0));
+  EXPECT_EQ(p.static_friction_n, 80.0);
+  PneumaticParams expected;
+  expected.supply_pressure_bar = 4.5, expected.static_friction_n = 80.0;
+  EXPECT_EQ(p, expected);  // nothing else moved
+}
+
+TEST(PneumaticParams, ABadKeyOrValueIsRefusedNamingItAndChangesNothing) {
+  PneumaticParams p;
+  const PneumaticParams before = p;
+  auto s = set_pneumatic_key(p, "supply_presure_bar", 4.5);
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().message.find("unknown key 'supply_presure_bar'"), std::string::npos) << s.error().message;
+  EXPECT_NE(s.error().message.find("supply_pressure_bar"), std::string::npos);  // the known keys are listed
+  s = set_pneumatic_key(p, "valve.supply_pressure_bar", 4.5);                   // a key in another table
+  EXPECT_FALSE(s);
+  s = set_pneumatic_key(p, "coulomb_friction_n", 60.0);  // above the breakaway force of 40 N
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().message.find("coulomb_friction_n = 60"), std::string::npos) << s.error().message;
+  s = set_pneumatic_key(p, "spool_time_constant_s", std::numeric_limits<double>::quiet_NaN());
+  EXPECT_FALSE(s);
+  EXPECT_EQ(p, before);
+}
+
 }  // namespace
 }  // namespace epa::plant

@@ -501,6 +501,37 @@ TEST(PneumaticPlant, StepAllocatesNothing) {
   RecordProperty("step_ns", figure(ns));
 }
 
+// A drifting axis in a test rig: parameters changed while the plant runs take effect from the next
+// step, the state carries over, and a change the sub-steps cannot integrate changes nothing.
+TEST(PneumaticPlant, ParametersChangedWhileRunningKeepTheStateAndChangeTheMotion) {
+  auto plant = make_plant({}, {.initial_position_mm = 100.0});
+  auto twin = plant;
+  for (int k = 0; k < 40; ++k) plant.step(5.0), twin.step(5.0);
+  PneumaticParams lower = plant.params();
+  lower.supply_pressure_bar = 3.0;
+  ASSERT_TRUE(plant.check_params(lower));
+  const PneumaticPlant::State before = plant.state();
+  ASSERT_TRUE(plant.set_params(lower));
+  EXPECT_EQ(plant.state().position_m, before.position_m);
+  EXPECT_EQ(plant.state().pressure_a_pa, before.pressure_a_pa);
+  EXPECT_EQ(plant.params().supply_pressure_bar, 3.0);
+  const double start_mm = plant.position_mm();
+  for (int k = 0; k < 20; ++k) plant.step(5.0), twin.step(5.0);
+  const double moved_low = plant.position_mm() - start_mm, moved_nominal = twin.position_mm() - start_mm;
+  RecordProperty("moved_3bar_mm", figure(moved_low));
+  RecordProperty("moved_6bar_mm", figure(moved_nominal));
+  EXPECT_LT(moved_low, 0.9 * moved_nominal);  // less supply, slower
+  EXPECT_GT(moved_low, 0.0);
+
+  PneumaticParams stiff = plant.params();
+  stiff.static_friction_n = 2000.0;  // a Stribeck slope 50 sub-steps cannot follow
+  const auto refused = plant.set_params(stiff);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("too coarse for the Stribeck slope"), std::string::npos) << refused.error().message;
+  EXPECT_FALSE(plant.check_params(stiff));
+  EXPECT_EQ(plant.params(), lower);
+}
+
 TEST(PneumaticPlant, MakeNamesWhatIsWrong) {
   auto message = [](const PneumaticParams& p, const PneumaticOptions& o) {
     auto r = PneumaticPlant::make(p, o);
