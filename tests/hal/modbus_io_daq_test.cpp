@@ -276,6 +276,37 @@ TEST(ModbusIoDaq, WritingThreeVoltsMovesTheSimulatedPistonUp) {
   modbus_free(raw);
 }
 
+// A physics plant's parameters changed from another thread while the plant thread steps (TSan
+// runs this): friction no drive can overcome stops the piston; the Hammerstein plant refuses.
+TEST(RemoteIoSimulator, PhysicsChangedWhileRunningTakeEffectAndTheHammersteinPlantRefuses) {
+  auto physics = plant::make_pneumatic_simulator({}, {.initial_position_mm = 100.0});
+  ASSERT_TRUE(physics);
+  auto started = RemoteIoSimulator::start(sim_config(), std::move(*physics));
+  ASSERT_TRUE(started) << started.error().message;
+  auto& sim = **started;
+  ModbusIoDaq daq(daq_config(sim.port()));
+  ASSERT_TRUE(daq.open().has_value());
+  ASSERT_EQ(daq.write_valve(5.0), IoStatus::kOk);
+  EXPECT_TRUE(poll_until([&] { return sim.position_mm() > 110.0; })) << sim.position_mm();
+  ASSERT_EQ(daq.write_valve(0.0), IoStatus::kOk);
+  for (const auto& [key, value] : {std::pair{"stribeck_velocity_mps", 0.2}, {"static_friction_n", 2000.0}, {"coulomb_friction_n", 2000.0}}) {
+    const auto s = sim.change_physics(key, value);
+    ASSERT_TRUE(s) << key << ": " << s.error().message;
+  }
+  EXPECT_FALSE(sim.change_physics("supply_pressure_bar", 40.0));  // out of range: refused, nothing changes
+  const std::uint64_t steps_then = sim.steps();
+  ASSERT_TRUE(poll_until([&] { return sim.steps() >= steps_then + 2; }));  // taken at the next step
+  const double held_mm = sim.position_mm();
+  ASSERT_EQ(daq.write_valve(-5.0), IoStatus::kOk);
+  EXPECT_FALSE(poll_until([&] { return std::abs(sim.position_mm() - held_mm) > 0.5; }, 300ms)) << sim.position_mm();
+
+  auto hammerstein = start_sim(sim_config());
+  ASSERT_NE(hammerstein, nullptr);
+  const auto refused = hammerstein->change_physics("supply_pressure_bar", 4.5);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("Hammerstein"), std::string::npos) << refused.error().message;
+}
+
 TEST(ModbusIoDaq, FailsFastWhenTheModuleGoesAwayAndReconnectsWithinTheInterval) {
   auto sim = start_sim(sim_config());
   ASSERT_NE(sim, nullptr);
