@@ -48,6 +48,7 @@ core::Result<ControllerParams> ControllerParams::make(const ControllerConfig& c)
   p.valve_limit_v_ = c.valve_limit_v;
   p.safe_valve_v_ = c.safe_valve_v;
   p.trajectory_config_ = c.trajectory;
+  p.hunting_ = hunting_limits_for(c.Ts);
   if (c.kind == ControllerKind::kPpTraj) {
     auto t = make_trajectory_params(c.trajectory, c.A, c.B, c.dead_zone, c.valve_limit_v, c.Ts);
     if (!t) return core::invalid_argument("controller: " + t.error().message);
@@ -98,6 +99,8 @@ ControllerOutput controller_step(const ControllerParams& p, ControllerState& sta
     out.fault = true;
     return out;
   }
+  out.hunting = p.watched_for_hunting() && hunting_step(p.hunting(), state.hunting, r_v, y_v);
+  if (out.hunting) valve = 0.0;  // centred: inside the dead band, the piston stays
   out.controller_v = u;
   out.valve_v = std::clamp(valve, -p.valve_limit_v(), p.valve_limit_v());
   out.saturated = out.valve_v != valve;

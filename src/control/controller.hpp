@@ -3,6 +3,7 @@
 // explicit ControllerState, and controller_step() which allocates nothing, reads no clock and does
 // no I/O. All signals are in the model's units: reference and position in sensor volts, valve in V.
 #include "control/controller_kind.hpp"
+#include "control/hunting_guard.hpp"
 #include "control/rst_law.hpp"
 #include "control/trajectory_law.hpp"
 #include "core/dead_zone.hpp"
@@ -19,8 +20,9 @@ struct ControllerConfig {
   double lc_v = 0.1;         // FF-IDZ switch-off band l_c, sensor volts (5 mm at 50 mm/V)
   double valve_limit_v = 5.0;  // final valve command saturates at +-limit (paper section 4.1)
   double safe_valve_v = 0.0;   // command on a fault (non-finite input): 5/3 valve centred
-  // pp-traj only: the model it computes its feed-forward from, its sample period and its own
-  // parameters (trajectory_law.hpp). The other laws ignore them.
+  // pp-traj: the model it computes its feed-forward from, its sample period and its own
+  // parameters (trajectory_law.hpp); the other laws ignore them but Ts, which sets the hunting
+  // watch's rests and window (hunting_guard.hpp).
   core::Polynomial A, B;
   double Ts = 0.005;
   TrajectoryConfig trajectory;
@@ -43,6 +45,10 @@ class ControllerParams {
   double safe_valve_v() const { return safe_valve_v_; }
   const TrajectoryParams& trajectory() const { return trajectory_; }
   const TrajectoryConfig& trajectory_config() const { return trajectory_config_; }  // what pp-traj was made from
+  const HuntingLimits& hunting() const { return hunting_; }
+  // pp-traj's arrival while sliding re-approaches a target at most max_retries times, from either
+  // side: bounded by itself, and not to be taken for a limit cycle.
+  bool watched_for_hunting() const { return !(kind_ == ControllerKind::kPpTraj && trajectory_.sliding_approach); }
 
  private:
   ControllerKind kind_ = ControllerKind::kPp;
@@ -51,12 +57,14 @@ class ControllerParams {
   double lc_v_ = 0.0, valve_limit_v_ = 5.0, safe_valve_v_ = 0.0;
   TrajectoryParams trajectory_;
   TrajectoryConfig trajectory_config_;
+  HuntingLimits hunting_;
 };
 
 // A default-constructed state is "not started": pp-traj starts its profile at the first y it reads.
 struct ControllerState {
   RstState rst;
   TrajectoryState trajectory;
+  HuntingState hunting;
   int saturated_sign = 0;  // sign of the last command's saturation, 0: not saturated (anti-windup)
 };
 
@@ -65,6 +73,7 @@ struct ControllerOutput {
   double controller_v = 0.0;  // pole-placement output u before compensation (uc_V in run files)
   bool saturated = false;     // the valve command hit its limit
   bool fault = false;         // non-finite input or output: valve_v is the safe command, state kept
+  bool hunting = false;       // a limit cycle about the standing target: the valve is held at 0 V until the target changes
 };
 
 // Starts a law on a piston at y_v moving at speed_v_s (V/s), as when RUN begins or another law
@@ -72,7 +81,9 @@ struct ControllerOutput {
 void controller_start(const ControllerParams& params, ControllerState& state, double y_v, double speed_v_s) noexcept;
 
 // One sample: reads r(k), y(k) (sensor volts), returns the valve command to hold until k+1.
-// No anti-windup: the paper's law runs on the unsaturated u (its F has no pole at 1).
+// No anti-windup: the paper's law runs on the unsaturated u (its F has no pole at 1). Every law
+// but pp-traj's sliding arrival is watched for hunting (hunting_guard.hpp); the law keeps running
+// under the hold, so it takes the next target from where it stands.
 ControllerOutput controller_step(const ControllerParams& params, ControllerState& state, double r_v,
                                  double y_v) noexcept;
 

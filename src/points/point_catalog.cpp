@@ -43,7 +43,7 @@ constexpr std::string_view kControlBitText[runtime::kControlBits] = {
     "control word bit 4: rising edge clears a latched fault"};
 constexpr std::string_view kStatusBitNames[runtime::kStatusBits] = {"ready", "run_enabled", "moving", "in_position", "target_reached",
                                                                     "following_error", "warning", "fault_latched", "ack", "halted",
-                                                                    "jogging", "manual_mode", "off_target"};
+                                                                    "jogging", "manual_mode", "off_target", "hunting"};
 constexpr std::string_view kStatusBitText[runtime::kStatusBits] = {
     "status bit 0: no fault latched and the I/O works",
     "status bit 1: mode RUN (the law holds or moves the axis)",
@@ -53,14 +53,16 @@ constexpr std::string_view kStatusBitText[runtime::kStatusBits] = {
     "status bit 4: the last started move came into position (RUN; cleared by the next start, from its write on)",
     "status bit 5: the piston beyond following_error_mm from the motion it is asked to follow (a speed-limited move's "
     "profile, or for a step the model's planned motion, up to the target) for 0.2 s; the fault follows after following_error_time_s",
-    "status bit 6: following error, off target, I/O errors, the store not saving or its disk low",
+    "status bit 6: following error, off target, hunting, I/O errors, the store not saving or its disk low",
     "status bit 7: a fault is latched (fault_code)",
     "status bit 8: acknowledge: mirrors the control word's start bit once the loop applied it",
     "status bit 9: the last task was a halt (in_position then says whether it stopped at the move's target)",
     "status bit 10: a jog (or its braking) is under way",
     "status bit 11: mode MANUAL",
     "status bit 12: the move stopped outside its window: the piston has stood within one window's width for standstill_time_s (RUN); "
-    "clears if it comes in, or at the next start"};
+    "clears if it comes in, or at the next start",
+    "status bit 13: the law hunted (a limit cycle about the standing target: the piston came to rest on alternating "
+    "sides of it twice within 2 s): the valve is held centred where the piston stands (RUN; also a warning); clears at the next target"};
 
 // Names of the coefficient points (F0..H6), kept alive for the string_views in the catalog.
 const std::vector<std::string>& coefficient_names() {
@@ -247,7 +249,7 @@ std::vector<PointDef> build() {
                            0, 1, true, true, [](const Ctx& c, int bit) { return b(c.snapshot.axis.control_word & (1u << bit)); }, i});
   positioning.push_back({P::kStatusWord, "status_word", "", "bits 0 ready, 1 enabled, 2 moving, 3 in_position, 4 target_reached, "
                                                               "5 following_error, 6 warning, 7 fault, 8 ack, 9 halted, 10 jogging, 11 manual, "
-                                                              "12 off_target",
+                                                              "12 off_target, 13 hunting",
                          A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(status_word(c.snapshot, c.status.saving && !c.status.disk_low)); }});
   for (int i = 0; i < runtime::kStatusBits; ++i)
     positioning.push_back({indexed_id(P::kStatusBit0, static_cast<std::size_t>(i)), kStatusBitNames[i], "", kStatusBitText[i], A::kRead, 0, 0,
@@ -345,10 +347,10 @@ const std::vector<PointDef>& catalog() {
 std::uint16_t status_word(const runtime::Snapshot& s, bool store_well) {
   using namespace runtime;
   const bool fault = s.mode == Mode::kFault;
-  const bool warning = s.axis.following_error || s.axis.off_target || !s.io_ok || !store_well;
+  const bool warning = s.axis.following_error || s.axis.off_target || s.axis.hunting || !s.io_ok || !store_well;
   const bool bits[kStatusBits] = {!fault && s.io_ok, s.mode == Mode::kRun, s.axis.moving, s.axis.in_position, s.axis.target_reached,
                                   s.axis.following_error, warning, fault, s.axis.ack, s.axis.halted, s.axis.jogging, s.mode == Mode::kManual,
-                                  s.axis.off_target};
+                                  s.axis.off_target, s.axis.hunting};
   std::uint16_t w = 0;
   for (int i = 0; i < kStatusBits; ++i)
     if (bits[i]) w = static_cast<std::uint16_t>(w | (1u << i));

@@ -32,7 +32,8 @@ enum StatusBit : int {
   kStatusJogging = 10,        // a jog (or its braking) is under way
   kStatusManual = 11,         // mode MANUAL
   kStatusOffTarget = 12,      // the move stopped outside its window: the piston stands there (also a warning)
+  kStatusHunting = 13,        // a limit cycle about the standing target: the valve is held centred until the next target (also a warning)
 };
-inline constexpr int kStatusBits = 13;
+inline constexpr int kStatusBits = 14;
 
 }  // namespace epa::runtime

@@ -469,6 +469,7 @@ void ScanCycle::step_law(double reference_mm, double y_v) noexcept {
   valve_v_ = std::clamp(transfer_.apply(out.valve_v), -limit_v, limit_v);
   controller_v_ = out.controller_v;
   saturated_ = out.saturated;
+  hunting_ = out.hunting;
 }
 
 void ScanCycle::publish(bool full_stats) noexcept {
@@ -506,7 +507,8 @@ void ScanCycle::publish(bool full_stats) noexcept {
   const bool axis_active = mode_ == Mode::kRun || (mode_ == Mode::kManual && jog_law_);
   s.axis = {axis_active && motion.moving, mode_ == Mode::kRun && motion.in_position, mode_ == Mode::kRun && motion.target_reached,
             mode_ == Mode::kRun && detector_.following_error_shown(), (control_word_ & kControlStart) != 0, motion.halted, axis_active && motion.jogging,
-            control_word_, axis_active ? motion_.reference_mm() : position_mm_, speed_mm_s_, mode_ == Mode::kRun && motion.off_target};
+            control_word_, axis_active ? motion_.reference_mm() : position_mm_, speed_mm_s_, mode_ == Mode::kRun && motion.off_target,
+            mode_ == Mode::kRun && hunting_};
   s.last_sequence = last_sequence_;
   if (cycle_ % 200 == 0 || full_stats) s.loop = stats_.view();  // percentiles scan the bins: a few times a second
   s.loop.overruns = stats_.overruns;

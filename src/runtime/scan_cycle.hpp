@@ -112,6 +112,7 @@ class ScanCycle {
   double setpoint_mm_ = 0.0, manual_valve_v_ = 0.0;
   double sensor_v_ = 0.0, position_mm_ = 0.0, valve_v_ = 0.0, controller_v_ = 0.0;
   bool saturated_ = false, io_ok_ = true;
+  bool hunting_ = false;  // the law's last output held the valve against a limit cycle
   FaultDetector detector_;  // the checks, and the I/O failures they count
   std::uint32_t heartbeat_ = 0;
   std::int64_t heartbeat_changed_ns_ = 0;

@@ -50,6 +50,7 @@ struct AxisView {
   double reference_mm = 0;         // what the control law follows (a halt's or jog's profile, or the target)
   double speed_mm_s = 0;           // measured, filtered (20 ms)
   bool off_target = false;         // the last move or halt stopped outside its window (RUN)
+  bool hunting = false;            // the law's hunting watch holds the valve centred (RUN; control/hunting_guard.hpp)
 };
 
 struct Snapshot {

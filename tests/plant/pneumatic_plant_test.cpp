@@ -556,21 +556,30 @@ TEST(PneumaticPlant, MakeNamesWhatIsWrong) {
 struct LoopResult {
   double final_mm = 0.0, max_mm = 0.0, min_mm = 0.0, final_speed_mps = 0.0;
   std::size_t faults = 0;
+  std::size_t late_sign_changes = 0;  // of the valve command, over the last 5 s
+  bool hunting = false;               // the law's hunting watch held the valve at the end
 };
 
 // The paper's PP FF-IDZ controller against this plant, timed like sim::simulate_step: read y(k),
 // compute u(k), hold it while the plant advances to k+1.
-LoopResult closed_loop(double start_mm, double step_mm, double noise_mm, double duration_s = 10.0) {
-  auto params = control::ControllerParams::make(control::paper_controller_config(control::ControllerKind::kPpFfidz));
+LoopResult closed_loop(double start_mm, double step_mm, double noise_mm, double duration_s = 10.0,
+                       control::ControllerKind law = control::ControllerKind::kPpFfidz) {
+  auto params = control::ControllerParams::make(control::paper_controller_config(law));
   EXPECT_TRUE(params.has_value());
   auto plant = make_plant({}, {.initial_position_mm = start_mm, .noise_std_mm = noise_mm, .seed = 3});
   control::ControllerState state;
   const double r_v = core::mm_to_sensor_v(start_mm + step_mm);
   LoopResult out{.max_mm = start_mm, .min_mm = start_mm};
   const int n = static_cast<int>(duration_s / plant.Ts());
+  int last_sign = 0;
   for (int k = 0; k < n; ++k) {
     const auto u = control::controller_step(*params, state, r_v, plant.measured_v());
     out.faults += u.fault ? 1 : 0;
+    if (k * plant.Ts() >= duration_s - 5.0 && u.valve_v != 0.0) {
+      if (last_sign != 0 && (u.valve_v > 0.0 ? 1 : -1) != last_sign) ++out.late_sign_changes;
+      last_sign = u.valve_v > 0.0 ? 1 : -1;
+    }
+    out.hunting = u.hunting;
     plant.step(u.valve_v);
     out.max_mm = std::max(out.max_mm, plant.position_mm());
     out.min_mm = std::min(out.min_mm, plant.position_mm());
@@ -592,6 +601,20 @@ TEST(PneumaticPlant, PaperFfidzControllerMovesIt25MmAndSettles) {
   EXPECT_LT(r.max_mm, 25.0 + 15.0);  // bounded overshoot
   EXPECT_GE(r.min_mm, 0.0);
   EXPECT_EQ(r.final_speed_mps, 0.0);  // settled and stuck, not oscillating
+}
+
+// pp-traj with the paper's model knows nothing of this plant's stiction: its integrator sticks the
+// piston short, breaks it away past the target, and so on for ever (16-26 valve sign changes over
+// 20 s without the watch). The hunting watch holds the valve once it sees the cycle.
+TEST(PneumaticPlant, PpTrajWithoutAFrictionModelEndsMovesWithoutALimitCycle) {
+  for (double step : {25.0, 50.0, 100.0, 200.0}) {
+    const LoopResult r = closed_loop(0.0, step, 0.1, 20.0, control::ControllerKind::kPpTraj);
+    RecordProperty("pp_traj_" + figure(step) + "mm_error_mm", figure(r.final_mm - step));
+    EXPECT_EQ(r.faults, 0u);
+    EXPECT_EQ(r.late_sign_changes, 0u) << step << " mm";
+    EXPECT_EQ(r.final_speed_mps, 0.0) << step << " mm";
+    EXPECT_NEAR(r.final_mm, step, 10.0) << step << " mm";
+  }
 }
 
 TEST(PneumaticPlant, PaperFfidzControllerStaysStableOverTheTableSteps) {

@@ -271,6 +271,37 @@ TEST(ScanCycle, SwitchingLawsOnThePhysicsPlantDoesNotStepTheValve) {
   }
 }
 
+// pp-traj with the paper's model hunts on the physics plant's stiction; the loop shows the law's
+// hold against it (the axis view's hunting, status bit 13), with the valve centred, until the next target.
+TEST(ScanCycle, AHuntingLawIsHeldAndTheStatusSaysSoUntilTheNextTarget) {
+  auto plant = plant::make_pneumatic_simulator({}, {.initial_position_mm = 0.0, .noise_std_mm = 0.1, .seed = 3});
+  ASSERT_TRUE(plant);
+  auto daq = *hal::SimDaq::make(std::move(*plant));
+  VirtualClock clock;
+  RuntimeConfig config;
+  config.controller = ControllerKind::kPpTraj;
+  config.start_mode = Mode::kRun;
+  config.start_moves_to_setpoint = true;
+  config.start_setpoint_mm = 100.0;
+  LoopChannels ch(8000);
+  ScanCycle loop(config, paper_tuning(), daq, clock, ch);
+  int held_at = -1;
+  for (int k = 0; k < 4000 && held_at < 0; ++k) {  // 20 s
+    run_cycles(loop, clock, 1);
+    if (loop.last_snapshot().axis.hunting) held_at = k;
+  }
+  ASSERT_GE(held_at, 0) << "pp-traj without a friction model was expected to hunt here";
+  RecordProperty("hunting_held_after_s", std::to_string(held_at * config.period_s));
+  run_cycles(loop, clock, 200);
+  const Snapshot held = loop.last_snapshot();
+  EXPECT_TRUE(held.axis.hunting);
+  EXPECT_EQ(held.valve_v, 0.0);
+  EXPECT_EQ(held.mode, Mode::kRun);  // a warning (the status word: WebServerTest), never a fault
+  ASSERT_TRUE(ch.commands.try_push(setpoint_command(150.0)));
+  run_cycles(loop, clock, 2);
+  EXPECT_FALSE(loop.last_snapshot().axis.hunting);
+}
+
 TEST(ScanCycle, ShutDownPutsTheValveSafe) {
   RuntimeConfig config;
   config.start_mode = Mode::kRun;

@@ -187,7 +187,7 @@ TEST_F(WebServerTest, StatusCarriesTheStatusWordPackedAndBitByBit) {
   const std::map<std::string, bool> expected = {
       {"ready", true}, {"run_enabled", true}, {"moving", false}, {"in_position", true}, {"target_reached", true},
       {"following_error", false}, {"warning", false}, {"fault_latched", false}, {"ack", false}, {"halted", false},
-      {"jogging", false}, {"manual_mode", false}, {"off_target", false}};
+      {"jogging", false}, {"manual_mode", false}, {"off_target", false}, {"hunting", false}};
   ASSERT_EQ(s["status_bits"].size(), expected.size()) << s["status_bits"];
   for (const auto& [bit, on] : expected) EXPECT_EQ(s["status_bits"][bit], on) << bit;
 
@@ -200,6 +200,14 @@ TEST_F(WebServerTest, StatusCarriesTheStatusWordPackedAndBitByBit) {
   EXPECT_FALSE(m["status_bits"]["run_enabled"].get<bool>());
   EXPECT_TRUE(m["status_bits"]["jogging"].get<bool>());
   EXPECT_TRUE(m["status_bits"]["manual_mode"].get<bool>());
+
+  snap_.mode = epa::runtime::Mode::kRun;
+  snap_.axis = {};
+  snap_.axis.hunting = true;  // the law holds the valve against a limit cycle: a warning too
+  channels_.snapshot.publish(snap_);
+  const json h = get_json("/api/status");
+  EXPECT_EQ(h["status_word"], (1 << 0) | (1 << 1) | (1 << 6) | (1 << 13));
+  EXPECT_TRUE(h["status_bits"]["hunting"].get<bool>());
 }
 
 TEST_F(WebServerTest, StatusNamesALatchedFaultInWords) {
