@@ -460,7 +460,7 @@ void DeadlineHttpServer::read_from(int fd) {
   }
 }
 
-void DeadlineHttpServer::dispatch(const std::shared_ptr<Connection>& c) {
+void DeadlineHttpServer::dispatch(std::shared_ptr<Connection> c) {
   Front& f = *front_;
   ::epoll_ctl(f.epoll_fd, EPOLL_CTL_DEL, c->fd, nullptr);
   f.waiting.erase(c->fd);
@@ -500,13 +500,13 @@ void DeadlineHttpServer::take_back() {
   }
 }
 
-void DeadlineHttpServer::wait_for_request(const std::shared_ptr<Connection>& c) {
+void DeadlineHttpServer::wait_for_request(std::shared_ptr<Connection> c) {
   c->in_request = !c->buffer.empty();
   c->deadline = Clock::now() + (c->in_request ? limits_.request_deadline : limits_.keep_alive_timeout);
   if (c->in_request) read_from(c->fd);  // frames what is buffered, and reads anything new
 }
 
-void DeadlineHttpServer::write_to(const std::shared_ptr<Connection>& c) {
+void DeadlineHttpServer::write_to(std::shared_ptr<Connection> c) {
   Front& f = *front_;
   while (!c->out.empty()) {
     const ssize_t n = ::send(c->fd, c->out.data(), c->out.size(), MSG_NOSIGNAL | MSG_DONTWAIT);

@@ -68,9 +68,12 @@ class DeadlineHttpServer final : public httplib::Server {
   void accept_waiting(int listen_fd);
   void admit(int fd, const std::string& peer);
   void read_from(int fd);
-  void write_to(const std::shared_ptr<Connection>& c);  // the rest of an answer, as the client reads it
-  void wait_for_request(const std::shared_ptr<Connection>& c);  // back to reading: the next request
-  void dispatch(const std::shared_ptr<Connection>& c);
+  // These take the connection by value: each may erase the `waiting` entry it was called with,
+  // and a reference to that entry's pointer would then dangle (a client that reset its connection
+  // while its answer was being written crashed the appliance).
+  void write_to(std::shared_ptr<Connection> c);  // the rest of an answer, as the client reads it
+  void wait_for_request(std::shared_ptr<Connection> c);  // back to reading: the next request
+  void dispatch(std::shared_ptr<Connection> c);
   void take_back();
   void end_waits(int listen_fd);
 

@@ -12,6 +12,7 @@
 #include <httplib.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -863,6 +864,46 @@ TEST_F(WebServerTest, PipelinedRequestsOnOneConnectionAreEachAnswered) {
   ::close(fd);
   EXPECT_EQ(count_of(answers, "HTTP/1.1 200 OK"), 3u) << answers.substr(0, 300);
   EXPECT_EQ(count_of(answers, "\"mode\":\"run\""), 2u);
+}
+
+// Clients that pipeline requests, do not read, and then reset their connections while the front end
+// is writing their answers: each such connection is closed and erased where it was found, and the
+// server serves on (it once used the erased entry: a crash under such a crowd, a report under ASan).
+TEST_F(WebServerTest, ClientsThatResetWhileTheirAnswersAreWrittenAreClosedAndTheServerServesOn) {
+  start();
+  std::string pipelined;
+  for (int i = 0; i < 200; ++i) pipelined += "GET /api/trend HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
+  for (int round = 0; round < 3; ++round) {
+    std::vector<int> fds;
+    for (int i = 0; i < 24; ++i) {
+      const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+      const int small = 4096;
+      setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof small);  // before connect: a small window
+      sockaddr_in addr{};
+      addr.sin_family = AF_INET;
+      addr.sin_port = htons(static_cast<std::uint16_t>(server_->port()));
+      addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+      ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+      (void)::send(fd, pipelined.data(), pipelined.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+      fds.push_back(fd);
+    }
+    // Until each client holds answers it has not read: the rest, far more than its window, waits
+    // at the server's front end.
+    for (int fd : fds) {
+      int unread = 0;
+      for (int k = 0; k < 200 && unread == 0; ++k) {
+        if (::ioctl(fd, FIONREAD, &unread) != 0) break;
+        if (unread == 0) std::this_thread::sleep_for(10ms);
+      }
+      ASSERT_GT(unread, 0) << "no answer came within 2 s";
+    }
+    for (int fd : fds) {
+      const linger reset{1, 0};  // close with RST: the server's next send fails
+      setsockopt(fd, SOL_SOCKET, SO_LINGER, &reset, sizeof reset);
+      ::close(fd);
+    }
+  }
+  EXPECT_EQ(get_json("/api/status")["mode"], "run");
 }
 
 TEST_F(WebServerTest, ARequestNotCompleteWithinItsDeadlineIs408AndClosed) {
