@@ -80,6 +80,10 @@ struct ControllerOutput {
 // hands over: the RST laws with no error or output history, pp-traj with its profile there.
 void controller_start(const ControllerParams& params, ControllerState& state, double y_v, double speed_v_s) noexcept;
 
+// A move starts, to a new target or the same one again: the hunting watch forgets the last move
+// and releases its hold (the next target releases it too, by itself).
+inline void controller_new_move(ControllerState& state) noexcept { state.hunting = {}; }
+
 // One sample: reads r(k), y(k) (sensor volts), returns the valve command to hold until k+1.
 // No anti-windup: the paper's law runs on the unsaturated u (its F has no pole at 1). Every law
 // but pp-traj's sliding arrival is watched for hunting (hunting_guard.hpp); the law keeps running

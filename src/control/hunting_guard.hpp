@@ -9,7 +9,8 @@
 // readings within rest_band_v for rest_samples) farther than side_band_v from the target, on the
 // other side than its last rest; rest_reversals such rests within window_samples are a limit cycle. A slow smooth oscillation
 // counts too, its peaks dwelling like rests. The valve is then held centred (0 V, inside the dead
-// band: the piston stays where it stands) until the target changes, and the law's output says so.
+// band: the piston stays where it stands) until the target changes or a move to it starts again
+// (controller_new_move), and the law's output says so.
 // Not watched: crossings of the target as such. The printed model swings its output tens of
 // millimetres a sample (docs/paper.md) and crosses its target several times in a move that then
 // settles; a rest there lasts a sample or two. A move that overshoots once and comes back changes
@@ -44,7 +45,7 @@ struct HuntingState {
   int last_rest_side = 0;         // -1 below the target, +1 above it, 0 none yet
   std::array<std::uint32_t, kEvents> reversals_at{};  // sample numbers of the reversals, a ring
   std::size_t reversals = 0;                          // noted so far
-  bool hunting = false;           // latched until the target changes
+  bool hunting = false;           // latched until the target changes (or the state is reset)
 };
 
 // One sample: the standing target r(k) and the reading y(k), in sensor volts. True while the valve

@@ -279,6 +279,7 @@ void ScanCycle::start_move(double target_mm, double speed_limit_mm_s, double win
   const bool usable = record_law && (*record_law != control::ControllerKind::kPpTraj || tuning_.traj_available);
   move_law_ = usable && *record_law != controller_ ? record_law : std::nullopt;
   take_over_from(before);
+  control::controller_new_move(state_);  // a start to the same target is a new try, watched afresh
   moves_.start(position_mm_, target_mm, law(), ch_.samples.written());
   motion_.move(target_mm, speed_limit_mm_s, window_mm, position_mm_, speed_mm_s_);
   if (speed_limit_mm_s > 0.0) {

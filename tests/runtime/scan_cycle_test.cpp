@@ -272,7 +272,8 @@ TEST(ScanCycle, SwitchingLawsOnThePhysicsPlantDoesNotStepTheValve) {
 }
 
 // pp-traj with the paper's model hunts on the physics plant's stiction; the loop shows the law's
-// hold against it (the axis view's hunting, status bit 13), with the valve centred, until the next target.
+// hold against it (the axis view's hunting, status bit 13), with the valve centred, until the next
+// start or target.
 TEST(ScanCycle, AHuntingLawIsHeldAndTheStatusSaysSoUntilTheNextTarget) {
   auto plant = plant::make_pneumatic_simulator({}, {.initial_position_mm = 0.0, .noise_std_mm = 0.1, .seed = 3});
   ASSERT_TRUE(plant);
@@ -297,7 +298,17 @@ TEST(ScanCycle, AHuntingLawIsHeldAndTheStatusSaysSoUntilTheNextTarget) {
   EXPECT_TRUE(held.axis.hunting);
   EXPECT_EQ(held.valve_v, 0.0);
   EXPECT_EQ(held.mode, Mode::kRun);  // a warning (the status word: WebServerTest), never a fault
-  ASSERT_TRUE(ch.commands.try_push(setpoint_command(150.0)));
+
+  // A start to the same target is a new try: the hold is released.
+  Command start = control_command(kControlStart);
+  start.value = 100.0;
+  ASSERT_TRUE(ch.commands.try_push(start));
+  run_cycles(loop, clock, 2);
+  EXPECT_FALSE(loop.last_snapshot().axis.hunting);
+  ASSERT_TRUE(ch.commands.try_push(control_command(0)));
+  for (int k = 0; k < 4000 && !loop.last_snapshot().axis.hunting; ++k) run_cycles(loop, clock, 1);
+  ASSERT_TRUE(loop.last_snapshot().axis.hunting);  // and hunts again, and is held again
+  ASSERT_TRUE(ch.commands.try_push(setpoint_command(150.0)));  // so does a new target
   run_cycles(loop, clock, 2);
   EXPECT_FALSE(loop.last_snapshot().axis.hunting);
 }
