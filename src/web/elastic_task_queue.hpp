@@ -1,10 +1,9 @@
 #pragma once
-// cpp-httplib serves a connection on one worker from start to end, so a fixed pool of N workers
-// is taken by N clients that send their request head a byte at a time (the page then answered
-// nothing for 25 s behind 200 of them). This queue starts a worker for each connection that finds
-// none idle, up to `max_threads`, and lets a worker that has been idle for `idle_exit` end: slow
-// clients cost a thread each (512 KiB of stack, not locked, a few pages touched), never the
-// service of the others, and an idle appliance keeps only `min_threads`.
+// The web server's workers (DeadlineHttpServer hands them whole requests, one per job): a worker
+// starts for each job that finds none idle, up to `max_threads`, and a worker idle for `idle_exit`
+// ends, so an idle appliance keeps only `min_threads`. Workers never wait for clients (the front
+// end reads requests and writes answers), so `max_threads` is a few per core: more would only
+// share the CPU (web_server.hpp).
 #include <httplib.h>
 
 #include <chrono>
