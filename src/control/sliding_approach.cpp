@@ -53,9 +53,15 @@ void start_leg(const ApproachLimits& l, ApproachState& s, double target_v, doubl
   s.samples_in_phase = 0;
 }
 
-// The back-off before an approach: to one approach length before the target, from where the piston is.
+// Where an approach starts: one approach length before the target, or as far as the travel
+// allows when the target lies nearer than that to its end (the approach is then shorter).
+double back_off_point_v(const ApproachLimits& l, const ApproachState& s) noexcept {
+  return std::clamp(s.planned_r_v - s.final_direction * l.length_v, l.travel_min_v, l.travel_max_v);
+}
+
+// The back-off before an approach, from where the piston is.
 void back_off(const ApproachLimits& l, ApproachState& s, double y_v) noexcept {
-  const double to_v = s.planned_r_v - s.final_direction * l.length_v;
+  const double to_v = back_off_point_v(l, s);
   start_leg(l, s, to_v, y_v < to_v ? 1.0 : -1.0, false, y_v);
 }
 
@@ -69,15 +75,16 @@ void plan(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noe
     hold(s, y_v);
     return;
   }
-  s.final_direction = move > 0.0 ? 1.0 : -1.0;
+  s.final_direction = s.next_direction != 0.0 ? s.next_direction : move > 0.0 ? 1.0 : -1.0;
+  s.next_direction = 0.0;
   // Straight in when the move is a whole approach long, or when the piston already slides towards
   // the target (a setpoint that moved and stopped ahead of it): the back-off is for starts from rest.
+  // Straight in too when the travel leaves no room to back off (a target near an end, the piston
+  // between it and that end): the approach never comes from the target's far side, where a gripper
+  // or a part may stand.
   const bool sliding_towards = s.final_direction * reading_slope(s, l.Ts) >= 0.5 * l.speed_v_s;
-  const bool straight_in = std::abs(move) >= l.length_v || sliding_towards;
-  if (!straight_in) {
-    const double back_off_v = r_v - s.final_direction * l.length_v;
-    if (back_off_v < l.travel_min_v || back_off_v > l.travel_max_v) s.final_direction = -s.final_direction;
-  }
+  const bool no_room = s.final_direction * (back_off_point_v(l, s) - y_v) >= -l.retry_band_v;
+  const bool straight_in = s.final_direction * move >= l.length_v || sliding_towards || no_room;
   if (straight_in)
     start_leg(l, s, r_v, s.final_direction, true, y_v);
   else

@@ -28,9 +28,10 @@
 //            that a retry does not chase one stop's scatter
 //   short    a move shorter than length_v backs off first (unless the piston already slides
 //            towards the target), so that every final approach is a steady slide, not the
-//            breakaway jump of a start from rest; from the far
-//            side of the target when the near side's back-off point lies outside
-//            [travel_min_v, travel_max_v] (the loop's setpoint range: a target near an end)
+//            breakaway jump of a start from rest; near an end of [travel_min_v, travel_max_v]
+//            (the loop's setpoint range) it backs off only as far as that end, or goes straight
+//            in when the piston stands between the target and that end. An approach never comes
+//            from the target's far side: a gripper or a part may stand there
 //   hold     the valve stays centred until the setpoint changes or the piston is pushed more than
 //            4 retry bands from where it stopped
 //
@@ -64,6 +65,7 @@ struct ApproachState {
   double leg_target_v = 0.0;
   double leg_direction = 1.0;  // +1 / -1
   double final_direction = 1.0;  // the move's approach direction
+  double next_direction = 0.0;   // +1 / -1: the next plan approaches this way (a move's side kept), 0: from where the piston is
   bool final_leg = false;
   int retries = 0;
   double path_v = 0.0, path_speed_v_s = 0.0;  // the leg's reference and its speed (>= 0, along leg_direction)

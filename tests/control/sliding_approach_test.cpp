@@ -87,14 +87,36 @@ TEST(SlidingApproach, AShortMoveBacksOffFirstSoThatItsFinalApproachIsAWholeAppro
   EXPECT_LE(*std::max_element(t.y.begin(), t.y.end()), 2.5 + l.retry_band_v);
 }
 
-TEST(SlidingApproach, AShortMoveNearAnEndApproachesFromTheFarSideRatherThanBackOffBeyondTheEnd) {
+TEST(SlidingApproach, AShortMoveNearAnEndBacksOffOnlyToTheEndAndNeverComesFromTheFarSide) {
+  auto l = limits();
+  l.dead_length_v = 1e6;  // the kinematic piston coasts the same near an end (coast_at_s: no stiffer air spring there)
+  ApproachState s;
+  const Trace t = run(l, s, 0.3, 0.6, 5.0);  // 15 mm up from 15 mm: a whole approach would start at -20 mm
+  EXPECT_NEAR(*std::min_element(t.y.begin(), t.y.end()), l.travel_min_v, 0.05) << "backed off as far as the travel allows";
+  EXPECT_LE(*std::max_element(t.y.begin(), t.y.end()), 0.6 + l.retry_band_v) << "passed the target";
+  EXPECT_NEAR(t.y.back(), 0.6, l.retry_band_v);
+  EXPECT_EQ(s.final_direction, 1.0);
+}
+
+TEST(SlidingApproach, APistonBetweenTheTargetAndTheEndGoesStraightIn) {
+  auto l = limits();
+  l.dead_length_v = 1e6;  // the kinematic piston coasts the same near an end (coast_at_s: no stiffer air spring there)
+  ApproachState s;
+  const Trace t = run(l, s, 0.0, 0.4, 5.0);  // 20 mm up from the end: no room to back off at all
+  EXPECT_GE(*std::min_element(t.y.begin(), t.y.end()), -0.01);
+  EXPECT_LE(*std::max_element(t.y.begin(), t.y.end()), 0.4 + l.retry_band_v) << "passed the target";
+  EXPECT_NEAR(t.y.back(), 0.4, l.retry_band_v);
+}
+
+TEST(SlidingApproach, ASideAskedForIsTheSideTheNextPlanApproachesFrom) {
   const auto l = limits();
   ApproachState s;
-  const Trace t = run(l, s, 0.3, 0.6, 5.0);  // 15 mm up from 15 mm: the near side's back-off point is -20 mm
-  EXPECT_GE(*std::min_element(t.y.begin(), t.y.end()), l.travel_min_v);
-  EXPECT_NEAR(*std::max_element(t.y.begin(), t.y.end()), 0.6 + l.length_v, 0.05) << "backed off beyond the target";
-  EXPECT_NEAR(t.y.back(), 0.6, l.retry_band_v);
-  EXPECT_EQ(s.final_direction, -1.0);
+  s.next_direction = 1.0;                    // the move came from below ...
+  const Trace t = run(l, s, 4.2, 4.0, 5.0);  // ... and the piston stands 10 mm past its target
+  EXPECT_NEAR(*std::min_element(t.y.begin(), t.y.end()), 4.0 - l.length_v, 0.05) << "backed off below the target";
+  EXPECT_NEAR(t.y.back(), 4.0, l.retry_band_v);
+  EXPECT_EQ(s.final_direction, 1.0);
+  EXPECT_EQ(s.next_direction, 0.0) << "asked for once";
 }
 
 TEST(SlidingApproach, ASetpointChangedMidMoveContinuesFromThePistonsSpeed) {
