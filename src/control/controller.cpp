@@ -99,8 +99,17 @@ ControllerOutput controller_step(const ControllerParams& p, ControllerState& sta
     out.fault = true;
     return out;
   }
-  out.hunting = p.watched_for_hunting() && hunting_step(p.hunting(), state.hunting, r_v, y_v);
-  if (out.hunting) valve = 0.0;  // centred: inside the dead band, the piston stays
+  const bool watched = p.watched_for_hunting() && !state.trajectory.sliding_fallback;
+  if (watched && hunting_step(p.hunting(), state.hunting, r_v, y_v)) {
+    if (p.kind() == ControllerKind::kPpTraj) {  // pp-traj arrives while sliding from now on (trajectory_law.hpp)
+      trajectory_fall_back_to_sliding(state.trajectory, -state.hunting.start_side);  // from the side the move came from
+      state.hunting = {};
+      out.sliding_fallback_started = true;
+    } else {
+      out.hunting = true;
+    }
+  }
+  if (out.hunting || out.sliding_fallback_started) valve = 0.0;  // centred: inside the dead band, the piston stays
   out.controller_v = u;
   out.valve_v = std::clamp(valve, -p.valve_limit_v(), p.valve_limit_v());
   out.saturated = out.valve_v != valve;

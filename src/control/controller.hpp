@@ -74,6 +74,8 @@ struct ControllerOutput {
   bool saturated = false;     // the valve command hit its limit
   bool fault = false;         // non-finite input or output: valve_v is the safe command, state kept
   bool hunting = false;       // a limit cycle about the standing target: the valve is held at 0 V until the target changes
+  // pp-traj hunted: from this sample on it arrives while sliding (trajectory_fall_back_to_sliding)
+  bool sliding_fallback_started = false;
 };
 
 // Starts a law on a piston at y_v moving at speed_v_s (V/s), as when RUN begins or another law
@@ -86,8 +88,9 @@ inline void controller_new_move(ControllerState& state) noexcept { state.hunting
 
 // One sample: reads r(k), y(k) (sensor volts), returns the valve command to hold until k+1.
 // No anti-windup: the paper's law runs on the unsaturated u (its F has no pole at 1). Every law
-// but pp-traj's sliding arrival is watched for hunting (hunting_guard.hpp); the law keeps running
-// under the hold, so it takes the next target from where it stands.
+// but pp-traj's sliding arrival is watched for hunting (hunting_guard.hpp). The RST laws are then
+// held, and keep running under the hold, so they take the next target from where they stand;
+// pp-traj falls back to arriving while sliding, whose retries are bounded.
 ControllerOutput controller_step(const ControllerParams& params, ControllerState& state, double r_v,
                                  double y_v) noexcept;
 

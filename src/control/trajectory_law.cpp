@@ -126,8 +126,8 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   p.creep_margin_step_v = c.creep_margin_v / std::max(1.0, std::round(c.creep_blend_s / Ts));
   p.integrator_limit = std::max(dz.m_r * (valve_limit_v - dz.b_r), dz.m_l * (valve_limit_v + dz.b_l));
   p.sliding_approach = c.coast_s > 0.0;
-  if (p.sliding_approach) {
-    p.approach.coast_s = c.coast_s;
+  {
+    p.approach.coast_s = p.sliding_approach ? c.coast_s : kFallbackCoastS;
     p.approach.dead_length_v = c.coast_dead_length_v;
     p.approach.speed_v_s = c.approach_speed_v_s;
     p.approach.length_v = c.approach_length_v;
@@ -142,6 +142,8 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
     p.approach.travel_min_v = c.travel_min_v;
     p.approach.travel_max_v = c.travel_max_v;
   }
+  p.fallback_approach = p.approach;
+  p.fallback_approach.coast_s = kFallbackCoastS;
   return p;
 }
 
@@ -176,8 +178,9 @@ double feedback_step(const TrajectoryParams& p, TrajectoryState& s, double e) no
 
 // pp-traj with arrival while sliding: the approach's reference through the same feed-forward and
 // feedback, the valve centred from the cut on.
-TrajectoryOutput approach_trajectory_step(const TrajectoryParams& p, TrajectoryState& s, double r_v, double y_v) noexcept {
-  const ApproachOutput a = approach_step(p.approach, s.approach, r_v, y_v);
+TrajectoryOutput approach_trajectory_step(const TrajectoryParams& p, const ApproachLimits& limits, TrajectoryState& s, double r_v,
+                                          double y_v) noexcept {
+  const ApproachOutput a = approach_step(limits, s.approach, r_v, y_v);
   TrajectoryOutput out;
   if (a.hold) {
     s.holding = true;
@@ -197,23 +200,35 @@ TrajectoryOutput approach_trajectory_step(const TrajectoryParams& p, TrajectoryS
 
 }  // namespace
 
+void trajectory_fall_back_to_sliding(TrajectoryState& s, double approach_direction) noexcept {
+  s.sliding_fallback = true;
+  s.approach.phase = ApproachPhase::kIdle;  // plans from the piston at the next sample; its readings stay
+  s.approach.next_direction = approach_direction;
+  s.last_r_v = NAN;
+  s.reference_changes = 0;
+  s.following_reference = false;
+}
+
 TrajectoryOutput trajectory_step(const TrajectoryParams& p, TrajectoryState& s, double r_v, double y_v,
                                  int saturated_sign_last) noexcept {
   if (!s.profile.started) trajectory_reset(p, s, y_v);
-  if (p.sliding_approach) {
+  if (p.sliding_approach || s.sliding_fallback) {
+    const ApproachLimits& limits = p.sliding_approach ? p.approach : p.fallback_approach;
     s.reference_changes = r_v != s.last_r_v ? std::min(s.reference_changes + 1, 2) : 0;
     s.last_r_v = r_v;
     if (s.reference_changes < 2) {
       if (s.following_reference) {  // the reference stands: arrive from the piston, or hold where it stops
         s.following_reference = false;
-        approach_after_moving_reference(p.approach, s.approach, r_v, y_v);
+        approach_after_moving_reference(limits, s.approach, r_v, y_v);
       }
-      return approach_trajectory_step(p, s, r_v, y_v);
+      return approach_trajectory_step(p, limits, s, r_v, y_v);
     }
     if (!s.following_reference) {  // the reference moves: the profile law from the piston, at its speed
       const ApproachState approach = s.approach;  // its readings and the coast it learned
+      const bool fallback = s.sliding_fallback;
       trajectory_reset(p, s, y_v, approach_speed_v_s(approach, p.limits.Ts));
       s.approach = approach;
+      s.sliding_fallback = fallback;
       s.last_r_v = r_v;
       s.reference_changes = 2;
       s.following_reference = true;

@@ -92,7 +92,14 @@ struct TrajectoryParams {
   double integrator_limit = 0.0;  // |u_i| bound: what the valve limit can deliver
   bool sliding_approach = false;  // coast_s > 0
   ApproachLimits approach;
+  // The sliding arrival a law without it falls back to once it hunts (trajectory_fall_back_to_sliding),
+  // with a first guess of the coast that its stops then correct.
+  ApproachLimits fallback_approach;
 };
+
+// The coast a hunting axis's fallback starts from, s: the physics plant's is 23-24 ms at mid-stroke
+// (plant/stick_slip_model.hpp, coast_time_s); its first stops correct the guess.
+inline constexpr double kFallbackCoastS = 0.02;
 
 struct TrajectoryState {
   MotionProfileState profile;
@@ -108,6 +115,9 @@ struct TrajectoryState {
   double last_r_v = NAN;
   int reference_changes = 0;      // consecutive samples in which r changed (counted to 2)
   bool following_reference = false;
+  // The law hunted (stick-slip its model lacks): it arrives while sliding from then on, with
+  // fallback_approach, until it is started afresh (a new tuning set, a mode change).
+  bool sliding_fallback = false;
 };
 
 // The model's top speed in each direction at the valve limit, V/s, from A = (1 - q) A1 (the plant
@@ -136,6 +146,14 @@ struct TrajectoryOutput {
   bool arrived = false;   // the profile is at the target: correct gently (creeping_idz_command)
   double creep_margin_v = 0.0;  // with this margin (0: NG-IDZ, so the valve does not step at arrival)
 };
+
+// A law that arrives through its integrator hunted about a standing target: from here on it
+// arrives while sliding instead (sliding_approach.hpp), planning afresh from y_v, with the coast
+// first guessed (kFallbackCoastS) and then learned from its stops. Without a stick-slip model the
+// integrator cannot place a sticking piston; a steady slide cut at its predicted stop can, and its
+// retries are bounded, so it cannot hunt.
+// approach_direction: +1 from below, -1 from above (the side the move came from), 0: from where the piston is.
+void trajectory_fall_back_to_sliding(TrajectoryState& s, double approach_direction) noexcept;
 
 // One sample; `saturated_last` is whether the previous valve command hit its limit (anti-windup).
 TrajectoryOutput trajectory_step(const TrajectoryParams& p, TrajectoryState& s, double r_v, double y_v,

@@ -62,7 +62,8 @@ constexpr std::string_view kStatusBitText[runtime::kStatusBits] = {
     "status bit 12: the move stopped outside its window: the piston has stood within one window's width for standstill_time_s (RUN); "
     "clears if it comes in, or at the next start",
     "status bit 13: the law hunted (a limit cycle about the standing target: the piston came to rest on alternating "
-    "sides of it twice within 2 s): the valve is held centred where the piston stands (RUN; also a warning); clears at the next start or target"};
+    "sides of it twice within 2 s) under pp, pp-ngidz or pp-ffidz: the valve is held centred where the piston stands (RUN; also a warning); "
+    "clears at the next start or target. pp-traj is not held: it arrives while sliding instead"};
 
 // Names of the coefficient points (F0..H6), kept alive for the string_views in the catalog.
 const std::vector<std::string>& coefficient_names() {

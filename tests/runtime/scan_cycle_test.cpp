@@ -159,6 +159,7 @@ TEST(ScanCycle, SetpointOutsideTheRangeIsRejectedWhole) {
 // boundary" means: the first cycle after the command uses the new parameters, whole.
 TEST(ScanCycle, TuningSwappedMidRunTakesEffectAtTheNextCycleWithTheStateCarriedOver) {
   RuntimeConfig config;
+  config.controller = ControllerKind::kPpFfidz;  // the RST history replayed by hand below
   config.start_mode = Mode::kRun;
   config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
   config.start_setpoint_mm = 150.0;
@@ -189,6 +190,7 @@ TEST(ScanCycle, TuningSwappedMidRunTakesEffectAtTheNextCycleWithTheStateCarriedO
 
 TEST(ScanCycle, ControllerSwitchIsBumplessTheHistoryCarriesOver) {
   RuntimeConfig config;
+  config.controller = ControllerKind::kPpFfidz;  // the RST history replayed by hand below
   config.start_mode = Mode::kRun;
   config.start_moves_to_setpoint = true;  // --mode run --setpoint: drive there at start
   config.start_setpoint_mm = 150.0;
@@ -271,7 +273,7 @@ TEST(ScanCycle, SwitchingLawsOnThePhysicsPlantDoesNotStepTheValve) {
   }
 }
 
-// pp-traj with the paper's model hunts on the physics plant's stiction; the loop shows the law's
+// pp-ngidz with the paper's model hunts on the physics plant's stiction; the loop shows the law's
 // hold against it (the axis view's hunting, status bit 13), with the valve centred, until the next
 // start or target.
 TEST(ScanCycle, AHuntingLawIsHeldAndTheStatusSaysSoUntilTheNextTarget) {
@@ -280,7 +282,7 @@ TEST(ScanCycle, AHuntingLawIsHeldAndTheStatusSaysSoUntilTheNextTarget) {
   auto daq = *hal::SimDaq::make(std::move(*plant));
   VirtualClock clock;
   RuntimeConfig config;
-  config.controller = ControllerKind::kPpTraj;
+  config.controller = ControllerKind::kPpNgidz;
   config.start_mode = Mode::kRun;
   config.start_moves_to_setpoint = true;
   config.start_setpoint_mm = 100.0;
@@ -291,7 +293,7 @@ TEST(ScanCycle, AHuntingLawIsHeldAndTheStatusSaysSoUntilTheNextTarget) {
     run_cycles(loop, clock, 1);
     if (loop.last_snapshot().axis.hunting) held_at = k;
   }
-  ASSERT_GE(held_at, 0) << "pp-traj without a friction model was expected to hunt here";
+  ASSERT_GE(held_at, 0) << "pp-ngidz without a friction model was expected to hunt here";
   RecordProperty("hunting_held_after_s", std::to_string(held_at * config.period_s));
   run_cycles(loop, clock, 200);
   const Snapshot held = loop.last_snapshot();
@@ -311,6 +313,32 @@ TEST(ScanCycle, AHuntingLawIsHeldAndTheStatusSaysSoUntilTheNextTarget) {
   ASSERT_TRUE(ch.commands.try_push(setpoint_command(150.0)));  // so does a new target
   run_cycles(loop, clock, 2);
   EXPECT_FALSE(loop.last_snapshot().axis.hunting);
+}
+
+// pp-traj with the paper's model hunts there too, and then arrives while sliding instead of
+// being held: it ends within the in-position window, the status saying neither hunting nor off target.
+TEST(ScanCycle, AHuntingPpTrajArrivesWhileSlidingInsteadAndEndsInPosition) {
+  auto plant = plant::make_pneumatic_simulator({}, {.initial_position_mm = 0.0, .noise_std_mm = 0.1, .seed = 3});
+  ASSERT_TRUE(plant);
+  auto daq = *hal::SimDaq::make(std::move(*plant));
+  VirtualClock clock;
+  RuntimeConfig config;
+  config.controller = ControllerKind::kPpTraj;
+  config.start_mode = Mode::kRun;
+  config.start_moves_to_setpoint = true;
+  config.start_setpoint_mm = 100.0;
+  LoopChannels ch(8000);
+  ScanCycle loop(config, paper_tuning(), daq, clock, ch);
+  bool ever_held = false;
+  for (int k = 0; k < 3000; ++k) {  // 15 s
+    run_cycles(loop, clock, 1);
+    ever_held = ever_held || loop.last_snapshot().axis.hunting;
+  }
+  const Snapshot end = loop.last_snapshot();
+  EXPECT_FALSE(ever_held);
+  EXPECT_NEAR(end.position_mm, 100.0, config.in_position_window_mm);
+  EXPECT_EQ(end.valve_v, 0.0);
+  EXPECT_TRUE(end.axis.in_position);
 }
 
 TEST(ScanCycle, ShutDownPutsTheValveSafe) {

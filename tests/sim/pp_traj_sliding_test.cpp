@@ -224,15 +224,22 @@ TEST(PpTrajSliding, AfterAHaltsBrakingThePistonIsHeldWhereItStopsWithoutANewMove
   EXPECT_EQ(run.state.trajectory.approach.phase, control::ApproachPhase::kHolding);
 }
 
-TEST(PpTrajSliding, TheSameLawWithoutTheCoastHuntsOnThisPlant) {
-  // The reason the sliding arrival exists: pp-traj's integrator, correcting from rest, hunts here.
+TEST(PpTrajSliding, TheSameLawWithoutTheCoastHuntsThenFallsBackToArrivingWhileSliding) {
+  // pp-traj's integrator, correcting from rest, hunts here; once the hunting watch sees the cycle
+  // the law arrives while sliding, from the side the move came from, with a guessed coast.
   auto f = identified();
   f.axis_model = core::AxisModel::kHammerstein;
   const auto params = pp_traj_for(f);
-  int ended_off = 0;
-  for (double step : {25.0, 50.0, -25.0, -50.0})
-    if (std::abs(physics_move(params, 250.0, step).run.y_mm.back() - (250.0 + step)) > 0.3) ++ended_off;
-  EXPECT_GE(ended_off, 2);
+  ASSERT_FALSE(params.trajectory().sliding_approach);
+  for (double step : {25.0, 50.0, -25.0, -50.0}) {
+    auto plant = plant::make_pneumatic_simulator(plant::PneumaticParams{}, {.initial_position_mm = 250.0});
+    ASSERT_TRUE(plant.has_value());
+    const auto r = simulate_step_on(**plant, 50.0, params, {.step_mm = step, .initial_mm = 250.0, .duration_s = 12.0});
+    ASSERT_TRUE(r.has_value());
+    EXPECT_NEAR(r->run.y_mm.back(), 250.0 + step, 0.3) << "step " << step;
+    EXPECT_GE(r->valve_sign_changes, 2u) << "step " << step << ": it was expected to hunt before it fell back";
+    EXPECT_EQ(valve_sign_changes_in_last(*r, 6.0), 0u) << "step " << step << ": held still at the end";
+  }
 }
 
 }  // namespace
