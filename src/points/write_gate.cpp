@@ -318,6 +318,17 @@ GateResult WriteGate::add_commands(std::span<const PointWrite> writes, const run
     // after this write is refused), last in the group.
     auto t = runtime::make_tuning(out.tuning);
     if (!t) return refuse(Refusal::kInvalidValue, fmt::format("the tuning would not validate: {}", t.error().message));
+    // The loop does not take a set that the selected pp-traj cannot run on (kControllerUnavailable):
+    // said here, before the answer, with the law's own reason.
+    control::ControllerKind law = snap.controller;
+    for (const runtime::Command& c : out.commands)
+      if (c.kind == runtime::CommandKind::kController) law = c.controller;
+    if (law == control::ControllerKind::kPpTraj && !t->traj_available) {
+      control::ControllerConfig traj = out.tuning;
+      traj.kind = control::ControllerKind::kPpTraj;
+      const auto p = control::ControllerParams::make(traj);
+      return refuse(Refusal::kInvalidValue, fmt::format("pp-traj runs and could not run on this tuning: {}", p ? "" : p.error().message));
+    }
     out.tuning_changed = true;
     out.commands.push_back(runtime::tuning_command(*t));
     out.command_point.push_back(first_tuning_point);
