@@ -101,7 +101,7 @@ TEST_F(EpaCli, ATimedServeThatEndsInFaultExitsFourAndSaysWhy) {
     ASSERT_NE(at, std::string::npos) << line;
     config.replace(at, line.size(), replacement);
   };
-  set("kind = \"pp-ffidz\"", "kind = \"pp\"");
+  set("kind = \"pp-traj\"", "kind = \"pp\"");
   set("following_error_mm = 50.0", "following_error_mm = 10.0");
   set("following_error_time_s = 2.0", "following_error_time_s = 0.5");
   set("register_map = \"../registers/epa.csv\"", "register_map = \"" + std::string(EPA_SOURCE_DIR) + "/registers/epa.csv\"");
@@ -189,7 +189,7 @@ TEST_F(EpaCli, ServeRefusesABadConfigurationNamingFileLineAndKey) {
 TEST_F(EpaCli, ServeOnTheSimPlantMovesRecordsAndStopsCleanly) {
   // move_window_s 0.5 so that the move is judged (FF-IDZ rings on the paper's plant: a timeout) and
   // recorded within the 1.5 s run.
-  std::ofstream(path("fast.toml")) << "[recorder]\nmove_window_s = 0.5\n[log]\nstatus_interval_s = 0\n"
+  std::ofstream(path("fast.toml")) << "[controller]\nkind = \"pp-ffidz\"\n[recorder]\nmove_window_s = 0.5\n[log]\nstatus_interval_s = 0\n"
                                     << "[modbus]\nport = 0\nregister_map = \"" << EPA_SOURCE_DIR << "/registers/epa.csv\"\n"
                                     << "[web]\naddress = \"127.0.0.1\"\nport = 0\nstatic_dir = \"" << EPA_SOURCE_DIR << "/web\"\n";
   const auto o = run_epa("serve --config " + path("fast.toml") + " --mode run --setpoint 100 --duration 1.5 --record-dir " +
@@ -205,7 +205,7 @@ TEST_F(EpaCli, ServeOnTheSimPlantMovesRecordsAndStopsCleanly) {
 }
 
 TEST_F(EpaCli, ServeOnThePhysicsPlantMovesAndRecords) {
-  std::ofstream(path("phys.toml")) << "[recorder]\nmove_window_s = 1.0\n[log]\nstatus_interval_s = 0\n[modbus]\nenabled = false\n"
+  std::ofstream(path("phys.toml")) << "[controller]\nkind = \"pp-ffidz\"\n[recorder]\nmove_window_s = 1.0\n[log]\nstatus_interval_s = 0\n[modbus]\nenabled = false\n"
                                     << "[web]\nenabled = false\n[hal.sim]\nplant = \"physics\"\nphysics_config = \""
                                     << EPA_SOURCE_DIR << "/config/pneumatic-plant.toml\"\n";
   const auto o = run_epa("serve --config " + path("phys.toml") + " --mode run --setpoint 100 --duration 2 --record-dir " +

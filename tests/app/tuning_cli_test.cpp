@@ -47,7 +47,7 @@ TEST_F(TuningCli, TheFirstStartSeedsThePaperSetAndMarksItActive) {
   EXPECT_NE(s.output.find("tuning set 'paper'"), std::string::npos) << s.output;
   const auto list = tuning("list");
   ASSERT_EQ(list.exit_code, 0) << list.output;
-  EXPECT_TRUE(std::regex_search(list.output, std::regex(R"(\*\s+1\s+paper\s+pp-ffidz)"))) << list.output;
+  EXPECT_TRUE(std::regex_search(list.output, std::regex(R"(\*\s+1\s+paper\s+pp-traj)"))) << list.output;
   const auto show = tuning("show paper");
   EXPECT_NE(show.output.find("F: [1, -1.778, 0.7828]"), std::string::npos) << show.output;
   EXPECT_NE(show.output.find("(active)"), std::string::npos) << show.output;

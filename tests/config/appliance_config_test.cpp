@@ -29,7 +29,8 @@ TEST(ApplianceConfig, ShippedFileParsesToTheDocumentedDefaults) {
   EXPECT_EQ(c->runtime.soft_max_mm, defaults.soft_max_mm);
   EXPECT_EQ(c->runtime.following_error_time_s, defaults.following_error_time_s);
   EXPECT_EQ(c->runtime.move_window_s, defaults.move_window_s);
-  EXPECT_EQ(c->runtime.controller, control::ControllerKind::kPpFfidz);
+  EXPECT_EQ(c->runtime.controller, defaults.controller);
+  EXPECT_EQ(c->runtime.controller, control::ControllerKind::kPpTraj);
   EXPECT_EQ(c->runtime.start_mode, runtime::Mode::kStop);
   EXPECT_EQ(c->backend, HalBackend::kSim);
   EXPECT_EQ(c->modbus_io.port, 1502);

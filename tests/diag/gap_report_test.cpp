@@ -181,7 +181,7 @@ TEST_F(DiagnoseCli, WithoutHeldOutRunsItCrossValidatesByRun) {
 // The whole loop as a commissioning engineer would run it: the appliance on a sim plant with a
 // spool lag hidden in it records three moves; epa diagnose, not told, names the lag.
 TEST_F(DiagnoseCli, RunsRecordedByTheApplianceWithAHiddenLagAreDiagnosed) {
-  std::ofstream(path("hidden.toml")) << "[hal.sim]\neffects = [\"valve_lag=0.015\"]\nnoise_mm = 0.1\n[modbus]\nenabled = false\n"
+  std::ofstream(path("hidden.toml")) << "[controller]\nkind = \"pp-ffidz\"\n[hal.sim]\neffects = [\"valve_lag=0.015\"]\nnoise_mm = 0.1\n[modbus]\nenabled = false\n"
                                      << "[web]\nenabled = false\n[log]\nstatus_interval_s = 0\n[recorder]\nmove_window_s = 2.0\n";
   std::vector<std::string> files;
   for (const int setpoint : {60, 150, 250}) {

@@ -545,7 +545,7 @@ TEST(Recorder, AManualRecordingIsOpenLoopAndOneThatHoldsRunSamplesNamesTheContro
   ASSERT_EQ(recorder.process_pending(), 1u);
   auto mixed = core::read_run_file(recorder.last_file(), kTs);
   ASSERT_TRUE(mixed.has_value()) << mixed.error().message;
-  EXPECT_EQ(mixed->meta("controller"), "pp-ffidz");
+  EXPECT_EQ(mixed->meta("controller"), "pp-traj");  // the default law
   EXPECT_EQ(mixed->r_mm.size(), mixed->size());
 }
 

@@ -183,6 +183,7 @@ TEST_F(Faults, HeartbeatLostWhenTheClientStopsCounting) {
 
 TEST_F(Faults, AReadingThatStopsChangingWhileTheValveDrivesIsAFrozenSensor) {
   RuntimeConfig c;
+  c.controller = control::ControllerKind::kPpFfidz;  // the paper's law opens the valve fully at once
   c.sensor_frozen_time_s = 0.5;
   c.following_error_time_s = 0.0;
   start(c);  // RUN to 300 mm from 100 mm: the valve drives hard, the fake reading stays at 2.0 V
