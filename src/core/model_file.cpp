@@ -57,26 +57,13 @@ Result<Polynomial> array_at(const toml::table& t, const char* key, const std::st
 // The [stick_slip] table: every field, by its name (a reader that knows the table wants it whole).
 Result<StickSlipParams> stick_slip_at(const toml::table& t, const std::string& src) {
   StickSlipParams p;
-  struct Field {
-    const char* key;
-    double* value;
-  };
-  const Field fields[] = {{"break_right_v", &p.break_right_v},
-                          {"break_left_v", &p.break_left_v},
-                          {"speed_right_mm_s_per_v", &p.speed_right_mm_s_per_v},
-                          {"speed_left_mm_s_per_v", &p.speed_left_mm_s_per_v},
-                          {"spring_rad_s", &p.spring_rad_s},
-                          {"damping_ratio", &p.damping_ratio},
-                          {"coulomb_mm", &p.coulomb_mm},
-                          {"static_mm", &p.static_mm},
-                          {"spool_lag_s", &p.spool_lag_s}};
   std::vector<std::string_view> keys{"delay_samples"};  // the table's keys: the fields and the delay
-  for (const auto& f : fields) keys.push_back(f.key);
+  for (const auto& [key, member] : kStickSlipFields) keys.push_back(key);
   if (auto s = only_keys(t, keys, src, "stick_slip"); !s) return s.error();
-  for (const auto& f : fields) {
-    auto v = number_at(t, "stick_slip", f.key, src);
+  for (const auto& [key, member] : kStickSlipFields) {
+    auto v = number_at(t, "stick_slip", key.data(), src);  // literals: terminated
     if (!v) return v.error();
-    *f.value = *v;
+    p.*member = *v;
   }
   const auto* delay = t.get("delay_samples");
   if (!delay) return parse_error(src + ": [stick_slip] delay_samples is missing");
@@ -94,18 +81,13 @@ Result<StickSlipParams> stick_slip_at(const toml::table& t, const std::string& s
 // The [stick_slip_spread] table: every field, by its name.
 Result<StickSlipSpread> stick_slip_spread_at(const toml::table& t, const std::string& src) {
   StickSlipSpread s;
-  const std::pair<const char*, double*> fields[] = {{"friction_log_ratio", &s.friction_log_ratio},
-                                                    {"flow_gain_log_ratio", &s.flow_gain_log_ratio},
-                                                    {"break_v", &s.break_v},
-                                                    {"spool_lag_s", &s.spool_lag_s},
-                                                    {"delay_samples", &s.delay_samples}};
   std::vector<std::string_view> keys;
-  for (const auto& [key, value] : fields) keys.push_back(key);
+  for (const auto& [key, member] : kStickSlipSpreadFields) keys.push_back(key);
   if (auto st = only_keys(t, keys, src, "stick_slip_spread"); !st) return st.error();
-  for (const auto& [key, value] : fields) {
-    auto v = number_at(t, "stick_slip_spread", key, src);
+  for (const auto& [key, member] : kStickSlipSpreadFields) {
+    auto v = number_at(t, "stick_slip_spread", key.data(), src);  // literals: terminated
     if (!v) return v.error();
-    *value = *v;
+    s.*member = *v;
   }
   if (auto st = s.validate(); !st) return invalid_argument(src + ": [stick_slip_spread] " + st.error().message);
   return s;
@@ -174,22 +156,26 @@ Result<ModelFile> parse_model_toml(const std::string& text, const std::string& s
     auto range = array_at(root, "identified_drive_v", src);
     if (!range) return range.error();
     const auto& v = range->coefficients();
-    if (v.size() != 2 || !(v[0] <= 0.0 && v[1] >= 0.0 && v[0] >= -10.0 && v[1] <= 10.0))
+    if (v.size() != 2 || !identified_drive_v_valid({v[0], v[1]}))
       return parse_error(src + ": identified_drive_v must be [lowest, highest] valve command in V, within [-10, 0] and [0, 10]");
     f.identified_drive_v = std::array<double, 2>{v[0], v[1]};
   }
   if (root.contains("axis_model")) {
-    const auto name = root["axis_model"].value<std::string>();
-    if (name == "hammerstein") {
-      f.axis_model = AxisModel::kHammerstein;
-    } else if (name == "stick-slip") {
-      if (!f.stick_slip) return parse_error(src + ": axis_model = \"stick-slip\" needs a [stick_slip] table");
-      f.axis_model = AxisModel::kStickSlip;
-    } else {
-      return parse_error(src + ": axis_model must be \"hammerstein\" or \"stick-slip\"");
-    }
+    const auto axis = parse_axis_model(root["axis_model"].value<std::string>().value_or(""));
+    if (!axis) return parse_error(src + ": axis_model must be \"hammerstein\" or \"stick-slip\"");
+    if (*axis == AxisModel::kStickSlip && !f.stick_slip)
+      return parse_error(src + ": axis_model = \"stick-slip\" needs a [stick_slip] table");
+    f.axis_model = *axis;
   }
   return f;
+}
+
+std::string_view to_string(AxisModel axis_model) { return axis_model == AxisModel::kStickSlip ? "stick-slip" : "hammerstein"; }
+
+std::optional<AxisModel> parse_axis_model(std::string_view name) {
+  if (name == "hammerstein") return AxisModel::kHammerstein;
+  if (name == "stick-slip") return AxisModel::kStickSlip;
+  return std::nullopt;
 }
 
 Result<ModelFile> read_model_file(const std::string& path) {
@@ -201,19 +187,15 @@ Result<ModelFile> read_model_file(const std::string& path) {
 namespace {
 
 std::string format_stick_slip(const StickSlipParams& p) {
-  auto num = [](double v) { return toml_float(v); };
-  return "\n[stick_slip]\nbreak_right_v = " + num(p.break_right_v) + "\nbreak_left_v = " + num(p.break_left_v) +
-         "\nspeed_right_mm_s_per_v = " + num(p.speed_right_mm_s_per_v) +
-         "\nspeed_left_mm_s_per_v = " + num(p.speed_left_mm_s_per_v) + "\nspring_rad_s = " + num(p.spring_rad_s) +
-         "\ndamping_ratio = " + num(p.damping_ratio) + "\ncoulomb_mm = " + num(p.coulomb_mm) +
-         "\nstatic_mm = " + num(p.static_mm) + "\nspool_lag_s = " + num(p.spool_lag_s) +
-         "\ndelay_samples = " + std::to_string(p.delay_samples) + "\n";
+  std::string table = "\n[stick_slip]\n";
+  for (const auto& [key, member] : kStickSlipFields) table += std::string(key) + " = " + toml_float(p.*member) + "\n";
+  return table + "delay_samples = " + std::to_string(p.delay_samples) + "\n";
 }
 
 std::string format_stick_slip_spread(const StickSlipSpread& s) {
-  auto num = [](double v) { return toml_float(v); };
-  return "\n[stick_slip_spread]\nfriction_log_ratio = " + num(s.friction_log_ratio) + "\nflow_gain_log_ratio = " + num(s.flow_gain_log_ratio) +
-         "\nbreak_v = " + num(s.break_v) + "\nspool_lag_s = " + num(s.spool_lag_s) + "\ndelay_samples = " + num(s.delay_samples) + "\n";
+  std::string table = "\n[stick_slip_spread]\n";
+  for (const auto& [key, member] : kStickSlipSpreadFields) table += std::string(key) + " = " + toml_float(s.*member) + "\n";
+  return table;
 }
 
 }  // namespace

@@ -38,6 +38,15 @@ namespace epa::core {
 // Which model describes the axis: epa identify's verdict, the one that follows held-out runs better.
 enum class AxisModel { kHammerstein, kStickSlip };
 
+// "hammerstein", "stick-slip": the name model files, tuning files and the store give it.
+std::string_view to_string(AxisModel axis_model);
+std::optional<AxisModel> parse_axis_model(std::string_view name);
+
+// identified_drive_v's rule: [lowest, highest] valve command, V, within [-10, 0] and [0, 10].
+inline bool identified_drive_v_valid(const std::array<double, 2>& v) {
+  return v[0] <= 0.0 && v[1] >= 0.0 && v[0] >= -10.0 && v[1] <= 10.0;
+}
+
 // Fits closer than this are equal (as order selection's tolerance holds two orders' to be).
 inline constexpr double kAxisModelMarginPct = 0.5;
 

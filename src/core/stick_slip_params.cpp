@@ -33,13 +33,9 @@ Status StickSlipParams::validate() const {
 }
 
 Status StickSlipSpread::validate() const {
-  const std::pair<const char*, double> fields[] = {{"friction_log_ratio", friction_log_ratio},
-                                                   {"flow_gain_log_ratio", flow_gain_log_ratio},
-                                                   {"break_v", break_v},
-                                                   {"spool_lag_s", spool_lag_s},
-                                                   {"delay_samples", delay_samples}};
-  for (const auto& [name, v] : fields)
-    if (!(std::isfinite(v) && v >= 0.0)) return invalid_argument(std::string("stick-slip spread: ") + name + " must be finite and >= 0");
+  for (const auto& [name, member] : kStickSlipSpreadFields)
+    if (const double v = this->*member; !(std::isfinite(v) && v >= 0.0))
+      return invalid_argument("stick-slip spread: " + std::string(name) + " must be finite and >= 0");
   return ok();
 }
 

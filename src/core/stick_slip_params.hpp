@@ -3,6 +3,10 @@
 // equations and why; ident/stick_slip_fit.hpp fits them; model files carry them as [stick_slip]).
 // Per unit of moving mass, so every value is readable without knowing the mass or the stiffness.
 
+#include <array>
+#include <string_view>
+#include <utility>
+
 #include "core/result.hpp"
 
 namespace epa::core {
@@ -21,7 +25,22 @@ struct StickSlipParams {
 
   static constexpr int kMaxDelay = 8;
   Status validate() const;  // the message names the field
+  bool operator==(const StickSlipParams&) const = default;
 };
+
+// The real-valued fields by the name model files, tuning files and the store give them, in their
+// order there (delay_samples, a whole number, follows them): one list, so the readers and writers agree.
+inline constexpr std::array<std::pair<std::string_view, double StickSlipParams::*>, 9> kStickSlipFields = {{
+    {"break_right_v", &StickSlipParams::break_right_v},
+    {"break_left_v", &StickSlipParams::break_left_v},
+    {"speed_right_mm_s_per_v", &StickSlipParams::speed_right_mm_s_per_v},
+    {"speed_left_mm_s_per_v", &StickSlipParams::speed_left_mm_s_per_v},
+    {"spring_rad_s", &StickSlipParams::spring_rad_s},
+    {"damping_ratio", &StickSlipParams::damping_ratio},
+    {"coulomb_mm", &StickSlipParams::coulomb_mm},
+    {"static_mm", &StickSlipParams::static_mm},
+    {"spool_lag_s", &StickSlipParams::spool_lag_s},
+}};
 
 // How far the stick-slip model's terms move when it is re-fitted on parts of its own
 // identification runs (epa identify: parts of 15 s of the validation runs, diag/stick_slip_spread.hpp).
@@ -35,6 +54,16 @@ struct StickSlipSpread {
   double spool_lag_s = 0.0;
   double delay_samples = 0.0;
   Status validate() const;  // every field finite and >= 0; the message names it
+  bool operator==(const StickSlipSpread&) const = default;
 };
+
+// Every field by its name in files and the store, in their order there.
+inline constexpr std::array<std::pair<std::string_view, double StickSlipSpread::*>, 5> kStickSlipSpreadFields = {{
+    {"friction_log_ratio", &StickSlipSpread::friction_log_ratio},
+    {"flow_gain_log_ratio", &StickSlipSpread::flow_gain_log_ratio},
+    {"break_v", &StickSlipSpread::break_v},
+    {"spool_lag_s", &StickSlipSpread::spool_lag_s},
+    {"delay_samples", &StickSlipSpread::delay_samples},
+}};
 
 }  // namespace epa::core
