@@ -16,6 +16,7 @@
 #include "core/format.hpp"
 #include "core/paper_reference.hpp"
 #include "plant/stick_slip_model.hpp"
+#include "store/model_record.hpp"
 
 namespace epa::app {
 
@@ -206,8 +207,9 @@ core::Result<store::TuningSet> tuning_set_of(const DesignOptions& o, const core:
 
 core::Status save_design(const DesignOptions& o, const core::ModelFile& model_file, const Design& d, std::ostream& out) {
   const bool paper_model = o.model_path.empty();
-  store::ModelRecord model{.id = 0, .name = paper_model ? "paper" : std::filesystem::path(o.model_path).stem().string(),
-                           .created_ms = 0, .source = model_file.source, .model = model_file.model, .fit_json = "{}"};
+  // The whole model file, its stick-slip model too: the set's model as the appliance will know it.
+  const store::ModelRecord model =
+      store::model_record_of(model_file, paper_model ? "paper" : std::filesystem::path(o.model_path).stem().string());
   auto set = tuning_set_of(o, model_file, d);
   if (!set) return set.error();
   if (set->trajectory.coast_s > 0.0)

@@ -19,6 +19,7 @@
 #include "ident/ramp_reading.hpp"
 #include "ident/stick_slip_fit.hpp"
 #include "report/identify_report.hpp"
+#include "store/model_record.hpp"
 #include "store/store_file.hpp"
 
 namespace epa::app {
@@ -233,8 +234,8 @@ std::string model_source(const IdentifyOptions& o, const ident::ArxOrders& chose
   return source;
 }
 
-core::Status save_identified(const IdentifyOptions& o, const core::HammersteinModel& model, const std::string& source,
-                             const ident::ArxOrders& chosen, const report::ModelFitSummary& summary,
+core::Status save_identified(const IdentifyOptions& o, const core::ModelFile& model_file, const ident::ArxOrders& chosen,
+                             const report::ModelFitSummary& summary,
                              const std::optional<ident::StickSlipIdentification>& stick_slip, std::ostream& out) {
   const nlohmann::json fit_json = {
       {"orders", chosen.to_string()}, {"runs", o.runs}, {"validation_runs", o.validate},
@@ -244,8 +245,7 @@ core::Status save_identified(const IdentifyOptions& o, const core::HammersteinMo
                                        : nlohmann::json(nullptr)},
       {"pso_seed", o.seed}, {"criterion", o.criterion},
       {"stick_slip", stick_slip ? report::stick_slip_json(*stick_slip, summary.validated) : nlohmann::json(nullptr)}};
-  auto id = appliance::save_model(o.db_path, {.id = 0, .name = o.save_name, .created_ms = 0, .source = source, .model = model,
-                                              .fit_json = fit_json.dump()});
+  auto id = appliance::save_model(o.db_path, store::model_record_of(model_file, o.save_name, fit_json.dump()));
   if (!id) return id.error();
   out << "model saved as '" << o.save_name << "' (id " << *id << ") in " << o.db_path << "\n";
   return core::ok();
@@ -316,17 +316,21 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   const std::optional<core::StickSlipParams> stick_slip_params =  // what the model file and the plot take
       *stick_slip ? std::optional((*stick_slip)->fit.params) : std::nullopt;
 
-  const std::string source = model_source(o, chosen, summary, *stick_slip);
+  // What the model file holds is what the store keeps (--out, --save): the same model either way.
+  core::ModelFile model_file{model, model_source(o, chosen, summary, *stick_slip)};
+  if (!o.out_path.empty() || !o.save_name.empty()) {
+    model_file.stick_slip = stick_slip_params;
+    model_file.axis_model = *stick_slip ? report::axis_model_verdict(**stick_slip, summary) : core::AxisModel::kHammerstein;
+    model_file.identified_drive_v = identified_drive_v(*est);
+    model_file.stick_slip_spread =
+        stick_slip_params ? model_spread(*stick_slip_params, *val, model.Ts, *model_file.identified_drive_v, out) : std::nullopt;
+  }
   if (!o.out_path.empty()) {
-    const auto axis = *stick_slip ? report::axis_model_verdict(**stick_slip, summary) : core::AxisModel::kHammerstein;
-    const auto drive = identified_drive_v(*est);
-    const auto spread = stick_slip_params ? model_spread(*stick_slip_params, *val, model.Ts, drive, out) : std::nullopt;
-    if (auto s = core::write_model_file(o.out_path, {model, source, stick_slip_params, axis, drive, spread}); !s)
-      return fail(s.error().message);
+    if (auto s = core::write_model_file(o.out_path, model_file); !s) return fail(s.error().message);
     out << "\nmodel written to " << o.out_path << "\n";
   }
   if (!o.save_name.empty())
-    if (auto s = save_identified(o, model, source, chosen, summary, *stick_slip, out); !s) return fail("--save: " + s.error().message);
+    if (auto s = save_identified(o, model_file, chosen, summary, *stick_slip, out); !s) return fail("--save: " + s.error().message);
   if (!o.plot_path.empty()) {
     const auto& shown = val->empty() ? *est : *val;
     if (auto s = write_output(o.plot_path, report::render_identification_plot(shown, fit, model, !val->empty(), stick_slip_params), out);

@@ -61,6 +61,12 @@ IdentifiedModel keep_cross_validated(std::vector<IdentifiedModel> candidates) {
   return kept;
 }
 
+// The identified models as a model file would hold them (epa identify's --out).
+core::ModelFile identified_model_file(const IdentifiedModel& identified) {
+  return {.model = identified.model, .source = "identified by epa commission", .stick_slip = identified.stick_slip,
+          .axis_model = identified.axis_model, .identified_drive_v = std::nullopt, .stick_slip_spread = std::nullopt};
+}
+
 }  // namespace
 
 std::string_view to_string(Stage s) {
@@ -248,8 +254,7 @@ std::optional<store::TuningSet> CommissionSequence::design_tuning_set(const Iden
   // the valve a cycle late 30-50 % of the time retried stops already within the limit until the
   // last approach fell into the metrics' window, and rolled back 12 runs of 80 that 3/4 deploys
   // (tests/commission/commission_physics_sweep.cpp, docs/commissioning.md).
-  const auto coast = plant::sliding_arrival_coast_s(
-      core::ModelFile{identified.model, "", identified.stick_slip, identified.axis_model}, set.trajectory.approach_speed_mm_s);
+  const auto coast = plant::sliding_arrival_coast_s(identified_model_file(identified), set.trajectory.approach_speed_mm_s);
   if (!coast) return finish(Verdict::kRolledBack, "design: " + coast.error().message, out), std::nullopt;
   set.trajectory.coast_s = *coast;
   set.trajectory.retry_band_mm = 0.75 * spec.limits.ess_mm;
@@ -278,10 +283,9 @@ bool CommissionSequence::verify_by_simulation(const store::TuningSet& set, const
 std::optional<std::int64_t> CommissionSequence::save_and_run(const store::TuningSet& set, const IdentifiedModel& identified,
                                                              CommissionOutcome& out) {
   step(Stage::kSaving, percent_done(), "saving tuning set '" + set.name + "'", out);
-  store::ModelRecord model{.id = 0, .name = set.name, .created_ms = 0, .source = "identified by epa commission",
-                           .model = identified.model, .fit_json = {}};
-  nlohmann::json fit = {{"estimation_fit_pct", identified.estimation_fit_pct}, {"validation_fit_pct", identified.validation_fit_pct}};
-  model.fit_json = fit.dump();
+  const nlohmann::json fit = {{"estimation_fit_pct", identified.estimation_fit_pct}, {"validation_fit_pct", identified.validation_fit_pct}};
+  // The stick-slip model with the Hammerstein one: what the appliance knows of the axis it deploys.
+  const store::ModelRecord model = store::model_record_of(identified_model_file(identified), set.name, fit.dump());
   auto id = axis_.save(model, set);
   if (!id) return finish(Verdict::kRolledBack, "saving the set: " + id.error().message, out), std::nullopt;
   out.new_set = set.name;

@@ -14,8 +14,9 @@ class ModelTable {
 
   // Validates the model first; a duplicate name is refused with the name in the message.
   core::Result<std::int64_t> insert(const ModelRecord& record);
-  // The id of a stored model with the same dynamics (A, B, dead zone, Ts, scale), or of `record`
-  // inserted under its name (with " #2", " #3" ... when the name is taken by another model).
+  // The id of a stored model with the same dynamics (A, B, dead zone, Ts, scale, and the axis_json
+  // fields: the verdict, drive range, stick-slip model and spread), or of `record` inserted under
+  // its name (with " #2", " #3" ... when the name is taken by another model).
   core::Result<std::int64_t> find_or_insert(ModelRecord record);
   core::Result<ModelRecord> get(std::int64_t id);
   core::Result<std::vector<ModelRecord>> all();

@@ -120,6 +120,12 @@ CREATE TRIGGER audit_log_keeps_newest BEFORE DELETE ON audit_log
   WHEN OLD.id > (SELECT max(id) FROM audit_log) - 1000
   BEGIN SELECT RAISE(ABORT, 'the audit log keeps its newest 1000 rows'); END;
 )sql",
+    // 6: what a model knows of the axis beyond the Hammerstein model (store/axis_json.hpp): the
+    // verdict, the drive range, the stick-slip model and its spread. Older models get '{}': nothing
+    // known, so the Hammerstein model describes their axis as before.
+    R"sql(
+ALTER TABLE models ADD COLUMN axis_json TEXT NOT NULL DEFAULT '{}';
+)sql",
 };
 
 }  // namespace

@@ -7,7 +7,7 @@
 
 namespace epa::store {
 
-inline constexpr int kSchemaVersion = 5;
+inline constexpr int kSchemaVersion = 6;
 
 core::Result<int> schema_version(Database& db);
 

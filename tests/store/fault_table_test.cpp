@@ -147,7 +147,16 @@ TEST_F(FaultTableTest, MigrationFromASchemaThreeFileKeepsTheOtherTables) {
     ASSERT_TRUE(db);
     ASSERT_TRUE(configure_connection(*db));
     ASSERT_TRUE(migrate(*db, 3));
-    ASSERT_TRUE(seed_if_empty(*db, paper_seed(), 1000));
+    // The seed as schema 3's own tables held it (today's model table writes columns schema 3 lacks).
+    ASSERT_TRUE(db->exec(
+        "INSERT INTO models (id, name, created_ms, source, a_json, b_json, m_r, m_l, b_r, b_l, ts_s, mm_per_volt) "
+        "VALUES (1, 'paper', 1000, 'paper eq 9-10', '[1.0, -0.9094, -0.611, 0.5204]', '[0.0, 1.024, -2.046, 1.029]', "
+        "1.7627, 1.0707, 1.232, -1.722, 0.005, 50.0)"));
+    ASSERT_TRUE(db->exec(
+        "INSERT INTO tuning_sets (id, name, created_ms, modified_ms, source, model_id, controller, f_json, g_json, h_json, "
+        "m_r, m_l, b_r, b_l, lc_mm, valve_limit_v) VALUES (1, 'paper', 1000, 1000, 'paper eq 12-13', 1, 'pp-ffidz', "
+        "'[1.0, -1.778, 0.7828]', '[-0.1734, 0.577, -0.3958]', '[-0.1734, 0.577, -0.3958]', 1.7627, 1.0707, 1.232, -1.722, 5.0, 5.0)"));
+    ASSERT_TRUE(db->exec("INSERT INTO settings (key, value) VALUES ('active_tuning_set', '1'), ('last_good_tuning_set', '1')"));
     ASSERT_TRUE(AuditLog(*db).append({1500, "cli", "m_r", 1.0, 2.0}));
     ASSERT_TRUE(RunTable(*db).insert({.path = "runs/a.csv", .recorded_ms = 1600, .controller = "pp-ffidz", .samples = 10}));
     ASSERT_TRUE(RetainedPoints(*db).put("setpoint_mm", 120.0, 1700));

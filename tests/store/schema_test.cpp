@@ -88,6 +88,28 @@ TEST(Schema, EachEarlierVersionMigratesWithItsDataKept) {
   }
 }
 
+// Schema 6 adds what a model knows of the axis; a model stored before it knows nothing: '{}', read
+// as the Hammerstein model alone.
+TEST(Schema, ModelsFromSchemaFiveMigrateKnowingNoStickSlipModel) {
+  Database db = memory();
+  ASSERT_TRUE(migrate(db, 5));
+  write_version_rows(db, 5);
+  ASSERT_TRUE(migrate(db));
+  auto column = db.prepare("SELECT axis_json FROM models WHERE id = 1");
+  ASSERT_TRUE(column);
+  ASSERT_TRUE(*column->step());
+  EXPECT_EQ(column->column_text(0), "{}");
+  auto model = ModelTable(db).get(1);
+  ASSERT_TRUE(model) << model.error().message;
+  EXPECT_EQ(model->name, "paper");
+  EXPECT_EQ(model->model.dead_zone.b_r, 1.232);
+  EXPECT_EQ(model->axis_model, core::AxisModel::kHammerstein);
+  EXPECT_FALSE(model->stick_slip);
+  EXPECT_FALSE(model->stick_slip_spread);
+  EXPECT_FALSE(model->identified_drive_v);
+  EXPECT_FALSE(model_file_of(*model).stick_slip);
+}
+
 TEST(Schema, ADatabaseFromANewerEpaIsRefusedAndLeftAlone) {
   Database db = memory();
   ASSERT_TRUE(db.exec("PRAGMA user_version = 99"));

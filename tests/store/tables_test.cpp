@@ -3,7 +3,9 @@
 
 #include <cmath>
 
+#include "core/model_file.hpp"
 #include "store/audit_log.hpp"
+#include "store/axis_json.hpp"
 #include "store/database.hpp"
 #include "store/model_table.hpp"
 #include "store/retained_points.hpp"
@@ -54,6 +56,163 @@ TEST(ModelTable, DuplicateNamesAndInvalidModelsAreRefusedByName) {
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("model 'bad'"), std::string::npos) << r.error().message;
   EXPECT_FALSE(ModelTable(db).get(42));
+}
+
+// Every field a model file can say of the axis, compared exactly.
+void expect_same_axis(const ModelRecord& actual, const ModelRecord& expected) {
+  EXPECT_EQ(actual.axis_model, expected.axis_model);
+  EXPECT_EQ(actual.identified_drive_v, expected.identified_drive_v);
+  EXPECT_EQ(actual.stick_slip, expected.stick_slip);
+  EXPECT_EQ(actual.stick_slip_spread, expected.stick_slip_spread);
+}
+
+TEST(ModelTable, AStickSlipModelRoundTripsWithItsSpreadVerdictAndDriveRange) {
+  Database db = seeded_memory_db();
+  const ModelRecord m = testing::stick_slip_model_record();
+  auto id = ModelTable(db).insert(m);
+  ASSERT_TRUE(id) << id.error().message;
+  auto back = ModelTable(db).get(*id);
+  ASSERT_TRUE(back) << back.error().message;
+  ASSERT_TRUE(back->stick_slip);
+  expect_same_axis(*back, m);
+  EXPECT_EQ(back->stick_slip->delay_samples, 2);
+  EXPECT_EQ(back->model.A.coefficients(), m.model.A.coefficients());
+  auto seeded = ModelTable(db).get(1);  // the paper's, seeded without one
+  ASSERT_TRUE(seeded);
+  EXPECT_FALSE(seeded->stick_slip);
+  EXPECT_EQ(seeded->axis_model, core::AxisModel::kHammerstein);
+  auto column = db.prepare("SELECT axis_json FROM models WHERE id = 1");
+  ASSERT_TRUE(column && *column->step());
+  EXPECT_EQ(column->column_text(0), "{}");  // nothing known, as a model from before schema 6
+}
+
+TEST(ModelTable, AStoredAxisJsonThatDoesNotParseOrValidateIsRefusedNamingTheModelAndTheField) {
+  Database db = seeded_memory_db();
+  const ModelRecord m = testing::stick_slip_model_record();
+  auto id = ModelTable(db).insert(m);
+  ASSERT_TRUE(id) << id.error().message;
+  const std::string good = axis_json_text(m);
+  auto replaced = [&good](const std::string& from, const std::string& to) {
+    std::string text = good;
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from << " not in " << good;
+    return at == std::string::npos ? text : text.replace(at, from.size(), to);
+  };
+  struct Case {
+    std::string axis_json, expected;
+  };
+  const Case cases[] = {
+      {"not json", "axis_json is not a JSON object"},
+      {"[1, 2]", "axis_json is not a JSON object"},
+      {R"({"friction": 1.0})", "unknown key 'friction'"},
+      {replaced("\"coulomb_mm\"", "\"mass_kg\":1.0,\"coulomb_mm\""), "unknown key 'stick_slip.mass_kg'"},
+      {replaced("\"coulomb_mm\":5.0,", ""), "stick_slip.coulomb_mm is missing"},
+      {replaced("\"coulomb_mm\":5.0", "\"coulomb_mm\":\"five\""), "stick_slip.coulomb_mm must be a number"},
+      {replaced("\"coulomb_mm\":5.0", "\"coulomb_mm\":9.0"), "static_mm must be >= coulomb_mm"},
+      {replaced("\"delay_samples\":2", "\"delay_samples\":1.5"), "stick_slip.delay_samples must be a whole number"},
+      {replaced("\"delay_samples\":2", "\"delay_samples\":9"), "stick_slip.delay_samples is outside 0..8"},
+      {replaced("\"break_v\":0.11", "\"break_v\":-0.11"), "stick_slip_spread: stick-slip spread: break_v"},
+      {replaced("\"stick-slip\"", "\"friction\""), "axis_model must be"},
+      {R"({"axis_model": "stick-slip"})", "axis_model \"stick-slip\" needs a stick_slip model"},
+      {R"({"stick_slip_spread": {"friction_log_ratio": 0.3, "flow_gain_log_ratio": 0.1, "break_v": 0.1, "spool_lag_s": 0.01,
+          "delay_samples": 1.0}})",
+       "stick_slip_spread needs a stick_slip model"},
+      {R"({"identified_drive_v": [1.0, 2.0]})", "identified_drive_v must be"},
+      {R"({"identified_drive_v": [-1.0]})", "identified_drive_v must be"},
+  };
+  const std::string what = "model " + std::to_string(*id) + " ('rig-2'): axis_json";
+  for (const auto& c : cases) {
+    auto update = db.prepare("UPDATE models SET axis_json = ? WHERE id = ?");
+    ASSERT_TRUE(update);
+    update->bind(1, c.axis_json).bind(2, *id);
+    ASSERT_TRUE(update->run());
+    auto got = ModelTable(db).get(*id);
+    ASSERT_FALSE(got) << c.axis_json;
+    EXPECT_NE(got.error().message.find(what), std::string::npos) << got.error().message;
+    EXPECT_NE(got.error().message.find(c.expected), std::string::npos) << got.error().message;
+    EXPECT_FALSE(ModelTable(db).all()) << "every model is read the same way";
+  }
+}
+
+TEST(ModelTable, AnInsertRefusesWhatAModelFileWouldRefuseNamingTheField) {
+  Database db = seeded_memory_db();
+  ModelRecord no_model = testing::stick_slip_model_record();
+  no_model.stick_slip.reset();
+  auto r = ModelTable(db).insert(no_model);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("model 'rig-2': stick_slip_spread needs a stick_slip model"), std::string::npos) << r.error().message;
+  ModelRecord sticky = testing::stick_slip_model_record();
+  sticky.stick_slip->static_mm = 1.0;  // below the sliding friction
+  r = ModelTable(db).insert(sticky);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("static_mm"), std::string::npos) << r.error().message;
+  ModelRecord wide = testing::stick_slip_model_record();
+  wide.identified_drive_v = std::array<double, 2>{-12.0, 3.0};
+  r = ModelTable(db).insert(wide);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("identified_drive_v"), std::string::npos) << r.error().message;
+  EXPECT_EQ(ModelTable(db).all()->size(), 1u) << "nothing stored";
+}
+
+// Two models that differ only in what they say of the axis are two models: a set designed on one
+// must not end up pointing at the other.
+TEST(ModelTable, TheSameDynamicsLookupTellsApartModelsDifferingOnlyInTheirStickSlipModel) {
+  Database db = seeded_memory_db();
+  ModelTable models(db);
+  const ModelRecord m = testing::stick_slip_model_record();
+  auto first = models.find_or_insert(m);
+  ASSERT_TRUE(first) << first.error().message;
+  EXPECT_NE(*first, 1) << "the seeded paper model has the same A, B, dead zone, but no stick-slip model";
+  EXPECT_EQ(*models.find_or_insert(m), *first) << "the identical model is reused";
+
+  ModelRecord other = m;
+  other.stick_slip->coulomb_mm = 4.0;
+  auto second = models.find_or_insert(other);
+  ASSERT_TRUE(second) << second.error().message;
+  EXPECT_NE(*second, *first);
+  EXPECT_EQ(models.get(*second)->name, "rig-2 #2");
+  EXPECT_EQ(models.get(*second)->stick_slip->coulomb_mm, 4.0);
+
+  ModelRecord spread = m;
+  spread.stick_slip_spread->friction_log_ratio = 0.5;
+  ModelRecord verdict = m;
+  verdict.axis_model = core::AxisModel::kHammerstein;
+  ModelRecord drive = m;
+  drive.identified_drive_v = std::array<double, 2>{-3.0, 3.0};
+  for (const ModelRecord* r : {&spread, &verdict, &drive}) {
+    auto id = models.find_or_insert(*r);
+    ASSERT_TRUE(id) << id.error().message;
+    EXPECT_NE(*id, *first);
+    EXPECT_NE(*id, *second);
+  }
+  ModelRecord plain = m;  // the same Hammerstein model, nothing known of the axis: the paper's
+  plain.axis_model = core::AxisModel::kHammerstein;
+  plain.identified_drive_v.reset();
+  plain.stick_slip.reset();
+  plain.stick_slip_spread.reset();
+  EXPECT_EQ(*models.find_or_insert(plain), 1);
+  EXPECT_EQ(models.all()->size(), 6u);
+}
+
+// The epa-model/1 view of a record and the record of a model file carry every field, also through
+// the model file's text (what epa design --save reads, epa identify --save keeps).
+TEST(ModelRecord, TheModelFileViewAndTheRecordOfAModelFileCarryTheStickSlipModel) {
+  const ModelRecord m = testing::stick_slip_model_record();
+  const core::ModelFile file = model_file_of(m);
+  EXPECT_EQ(file.source, m.source);
+  EXPECT_EQ(file.axis_model, core::AxisModel::kStickSlip);
+  EXPECT_EQ(file.stick_slip, m.stick_slip);
+  EXPECT_EQ(file.stick_slip_spread, m.stick_slip_spread);
+  EXPECT_EQ(file.identified_drive_v, m.identified_drive_v);
+  auto parsed = core::parse_model_toml(core::format_model_toml(file), "rig-2.toml");
+  ASSERT_TRUE(parsed) << parsed.error().message;
+  const ModelRecord back = model_record_of(*parsed, "rig-2", R"({"fit_pct":90.0})");
+  EXPECT_EQ(back.name, "rig-2");
+  EXPECT_EQ(back.source, m.source);
+  EXPECT_EQ(back.fit_json, R"({"fit_pct":90.0})");
+  EXPECT_EQ(back.id, 0);
+  EXPECT_EQ(back.model.B.coefficients(), m.model.B.coefficients());
+  expect_same_axis(back, m);
 }
 
 TEST(TuningSetTable, SetsAreFoundByIdOrNameAndUpdatedInPlace) {
