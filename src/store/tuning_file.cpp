@@ -84,7 +84,7 @@ std::string format_tuning_toml(const TuningSet& t, const ModelRecord& m) {
   s += "\n[trajectory]  # pp-traj's parameters (docs/paper.md, \"Beyond the paper: pp-traj\")\n";
   for (const auto& [key, value] : trajectory_setting_values(t.trajectory)) s += key + " = " + toml_float(value) + "\n";
   // The model section is the model file's own text, moved under [model].
-  std::string model_text = core::format_model_toml({m.model, m.source});
+  std::string model_text = core::format_model_toml(model_file_of(m));
   model_text = model_text.substr(model_text.find('\n') + 1);  // drop its schema line
   std::string nested;
   std::istringstream lines(model_text);
@@ -149,7 +149,10 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
 
   const auto* model = root["model"].as_table();
   if (!model) return core::parse_error(src + ": table [model] is missing");
-  if (auto s = core::only_keys(*model, {"name", "fit", "source", "Ts", "mm_per_volt", "arx", "dead_zone"}, src, "model"); !s)
+  if (auto s = core::only_keys(*model, {"name", "fit", "source", "Ts", "mm_per_volt", "axis_model", "identified_drive_v", "arx", "dead_zone",
+                                        "stick_slip", "stick_slip_spread"},
+                               src, "model");
+      !s)
     return s.error();
   f.model.name = (*model)["name"].value_or(std::string());
   if (f.model.name.empty()) return core::parse_error(src + ": [model] name is missing");
@@ -164,8 +167,7 @@ core::Result<TuningFile> parse_tuning_toml(const std::string& text, const std::s
   doc << model_doc;
   auto parsed = core::parse_model_toml(doc.str(), src + " [model]");
   if (!parsed) return parsed.error();
-  f.model.model = parsed->model;
-  f.model.source = parsed->source;
+  f.model = model_record_of(*parsed, f.model.name, f.model.fit_json);
 
   if (auto s = validate(t, f.model.model); !s) return core::invalid_argument(src + ": " + s.error().message);
   return f;

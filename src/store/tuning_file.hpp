@@ -17,8 +17,11 @@
 //   m_r = 1.7627  m_l = 1.0707  b_r = 1.232  b_l = -1.722
 //   [model]                       # epa-model/1 keys, plus name and fit
 //   name = "paper"  source = "..."  Ts = 0.005  mm_per_volt = 50.0  fit = "{}"
+//   axis_model = "stick-slip"  identified_drive_v = [-3.0, 3.0]   # optional, as in a model file
 //   [model.arx]        A = [...]  B = [...]
 //   [model.dead_zone]  m_r = ...
+//   [model.stick_slip]         break_right_v = ...   # optional, as in a model file
+//   [model.stick_slip_spread]  friction_log_ratio = ...
 #include <string>
 
 #include "core/result.hpp"

@@ -89,6 +89,50 @@ TEST(TuningFile, ThePaperValuesAreWrittenAsPrinted) {
 }
 
 
+// The embedded model carries the stick-slip model, its spread, the verdict and the drive range under
+// the model file's own keys, and they come back exact; a file without them reads as before.
+TEST(TuningFile, TheEmbeddedModelCarriesItsStickSlipModelExactly) {
+  const TuningFile f = example();
+  ModelRecord model = testing::stick_slip_model_record();
+  model.model.B = f.model.model.B;
+  const std::string text = format_tuning_toml(f.set, model);
+  for (const char* expected : {"[model.stick_slip]\n", "[model.stick_slip_spread]\n", "axis_model = \"stick-slip\"\n",
+                               "identified_drive_v = [", "delay_samples = 2\n", "friction_log_ratio = 0.33\n"})
+    EXPECT_NE(text.find(expected), std::string::npos) << expected << " in\n" << text;
+  auto back = parse_tuning_toml(text, "x.toml");
+  ASSERT_TRUE(back) << back.error().message << "\n" << text;
+  EXPECT_EQ(back->model.axis_model, core::AxisModel::kStickSlip);
+  EXPECT_EQ(back->model.identified_drive_v, model.identified_drive_v);
+  EXPECT_EQ(back->model.stick_slip, model.stick_slip);
+  EXPECT_EQ(back->model.stick_slip_spread, model.stick_slip_spread);
+  EXPECT_EQ(back->model.name, "rig-2");
+  EXPECT_EQ(format_tuning_toml(back->set, back->model), text);
+
+  auto plain = parse_tuning_toml(format_tuning_toml(f.set, f.model), "plain.toml");  // none of them
+  ASSERT_TRUE(plain) << plain.error().message;
+  EXPECT_FALSE(plain->model.stick_slip);
+  EXPECT_FALSE(plain->model.stick_slip_spread);
+  EXPECT_FALSE(plain->model.identified_drive_v);
+  EXPECT_EQ(plain->model.axis_model, core::AxisModel::kHammerstein);
+
+  struct Case {
+    std::string text, expected;
+  };
+  const Case cases[] = {
+      {replaced(text, "coulomb_mm = ", "coulomb = "), "unknown key 'coulomb' in [stick_slip]"},
+      {replaced(text, "break_v = ", "break_volts = "), "unknown key 'break_volts' in [stick_slip_spread]"},
+      {replaced(text, "[model.stick_slip]\n", "[model.stick_slip]\nmass_kg = 2.0\n"), "unknown key 'mass_kg' in [stick_slip]"},
+      {replaced(text, "[model]\n", "[model]\naxis = 1.0\n"), "unknown key 'axis' in [model]"},
+      {replaced(text, "delay_samples = 2", "delay_samples = 2.5"), "delay_samples must be a whole number"},
+      {replaced(text, "axis_model = \"stick-slip\"", "axis_model = \"friction\""), "axis_model must be"},
+  };
+  for (const auto& c : cases) {
+    auto r = parse_tuning_toml(c.text, "x.toml");
+    ASSERT_FALSE(r) << c.expected;
+    EXPECT_NE(r.error().message.find(c.expected), std::string::npos) << r.error().message;
+  }
+}
+
 TEST(TuningFile, BadFilesAreRefusedNamingWhatIsWrong) {
   const TuningFile f = example();
   const std::string good = format_tuning_toml(f.set, f.model);
