@@ -14,9 +14,8 @@ namespace epa::appliance {
 store::StoreSeed make_seed(const std::string& name, const core::ModelFile& model, const ControllerPolynomials& polynomials,
                            control::ControllerKind controller, double lc_mm, double valve_limit_v) {
   store::StoreSeed seed;
-  seed.model.name = name;
-  seed.model.source = model.source.empty() ? "the configuration's model" : model.source;
-  seed.model.model = model.model;
+  seed.model = store::model_record_of(model, name);  // with the file's stick-slip model, its spread and verdict
+  if (seed.model.source.empty()) seed.model.source = "the configuration's model";
   seed.tuning.name = name;
   seed.tuning.source = "seeded from the configuration: " + polynomials.source;
   seed.tuning.controller = controller;
