@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "app/identify_command.hpp"
+#include "app/model_scope.hpp"
 #include "core/units.hpp"
 #include "ident/arx_estimator.hpp"
 #include "ident/arx_metrics.hpp"
@@ -69,6 +70,9 @@ commission::Identify identify_for_commissioning(double mm_per_volt) {
     const report::ModelFitSummary fits = report::summarise_fit(identified->fit, est, val, identified->selection.first);
 
     commission::IdentifiedModel out{model, fits.estimation.simulation_pct, fits.validation.simulation_pct, {}, {}};
+    std::vector<const core::Run*> estimation_runs;
+    for (const auto& run : estimation) estimation_runs.push_back(&run);
+    out.identified_drive_v = identified_drive_v(estimation_runs);  // the commands the model was identified on
     // The held-out run's free run, where its first segment lies (NaN elsewhere: end stops).
     out.validation_simulated_mm.assign(validation.size(), std::nan(""));
     const auto ud = ident::through_dead_zone(val, identified->fit.dead_zone);
@@ -94,6 +98,9 @@ commission::Identify identify_for_commissioning(double mm_per_volt) {
     out.stick_slip = stick->fit.params;
     out.stick_slip_validation_fit_pct = stick->validation_pct;
     out.axis_model = report::axis_model_verdict(*stick, fits);
+    // How far its terms move over parts of the held-out run, as epa identify writes it (app/model_scope.hpp).
+    const core::Run* const validation_run[] = {&validation};
+    out.stick_slip_spread = model_spread(*out.stick_slip, Ts, validation_run, *out.identified_drive_v);
     std::snprintf(buf, sizeof buf, "; stick-slip model: free-run fit %.1f %% on the held-out run%s", stick->validation_pct,
                   out.axis_model == core::AxisModel::kStickSlip ? " (describes the axis)" : "");
     out.summary += buf;

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "app/cli_checks.hpp"
+#include "app/model_scope.hpp"
 #include "app/output_file.hpp"
 #include "appliance/store_save.hpp"
 #include "core/format.hpp"
@@ -251,26 +252,20 @@ core::Status save_identified(const IdentifyOptions& o, const core::ModelFile& mo
   return core::ok();
 }
 
-// The valve commands the estimation runs cover: the model file says so, and epa diagnose judges the
-// model inside them (outside, it extrapolates).
-std::array<double, 2> identified_drive_v(const std::vector<report::IdentifiedRun>& runs) {
-  std::array<double, 2> range{0.0, 0.0};
-  for (const auto& r : runs)
-    for (const double u : r.run.u_V) range[0] = std::min(range[0], u), range[1] = std::max(range[1], u);
-  return range;
+std::vector<const core::Run*> runs_of(const std::vector<report::IdentifiedRun>& runs) {
+  std::vector<const core::Run*> out;
+  for (const auto& r : runs) out.push_back(&r.run);
+  return out;
 }
 
 // How far the stick-slip model's terms move over 15 s parts of the validation runs
-// (diag/stick_slip_spread.hpp): epa diagnose names a change of the axis only beyond it. None
-// without validation runs.
-std::optional<core::StickSlipSpread> model_spread(const core::StickSlipParams& params, const std::vector<report::IdentifiedRun>& validation,
-                                                  double Ts, const std::array<double, 2>& drive, std::ostream& out) {
+// (app/model_scope.hpp): epa diagnose names a change of the axis only beyond it. None without
+// validation runs.
+std::optional<core::StickSlipSpread> spread_on_validation(const core::StickSlipParams& params,
+                                                          const std::vector<report::IdentifiedRun>& validation, double Ts,
+                                                          const std::array<double, 2>& drive, std::ostream& out) {
   if (validation.empty()) return std::nullopt;
-  std::vector<const core::Run*> runs;
-  for (const auto& r : validation) runs.push_back(&r.run);
-  diag::JudgedScope scope;
-  scope.drive_lo_v = drive[0], scope.drive_hi_v = drive[1];
-  const auto spread = diag::stick_slip_spread(params, Ts, runs, scope);
+  const auto spread = app::model_spread(params, Ts, runs_of(validation), drive);
   out << "  its terms over " << diag::kSpreadPartS << " s parts of the validation runs spread by: friction x"
       << core::format_number(std::round(std::exp(spread.friction_log_ratio) * 100.0) / 100.0) << ", flow gain x"
       << core::format_number(std::round(std::exp(spread.flow_gain_log_ratio) * 100.0) / 100.0) << ", break points "
@@ -321,9 +316,9 @@ int run_identify(const IdentifyOptions& o, std::ostream& out, std::ostream& err)
   if (!o.out_path.empty() || !o.save_name.empty()) {
     model_file.stick_slip = stick_slip_params;
     model_file.axis_model = *stick_slip ? report::axis_model_verdict(**stick_slip, summary) : core::AxisModel::kHammerstein;
-    model_file.identified_drive_v = identified_drive_v(*est);
+    model_file.identified_drive_v = identified_drive_v(runs_of(*est));
     model_file.stick_slip_spread =
-        stick_slip_params ? model_spread(*stick_slip_params, *val, model.Ts, *model_file.identified_drive_v, out) : std::nullopt;
+        stick_slip_params ? spread_on_validation(*stick_slip_params, *val, model.Ts, *model_file.identified_drive_v, out) : std::nullopt;
   }
   if (!o.out_path.empty()) {
     if (auto s = core::write_model_file(o.out_path, model_file); !s) return fail(s.error().message);

@@ -64,7 +64,8 @@ IdentifiedModel keep_cross_validated(std::vector<IdentifiedModel> candidates) {
 // The identified models as a model file would hold them (epa identify's --out).
 core::ModelFile identified_model_file(const IdentifiedModel& identified) {
   return {.model = identified.model, .source = "identified by epa commission", .stick_slip = identified.stick_slip,
-          .axis_model = identified.axis_model, .identified_drive_v = std::nullopt, .stick_slip_spread = std::nullopt};
+          .axis_model = identified.axis_model, .identified_drive_v = identified.identified_drive_v,
+          .stick_slip_spread = identified.stick_slip_spread};
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 // set; every failure or abort puts the valve safe (Axis::stop) and, once the new set ran, switches
 // the loop back to the previous one. Each step is logged with its reason; the switches are audited
 // by the axis. Runs in the calling thread; abort() and progress() may be called from any other.
+#include <array>
 #include <atomic>
 #include <functional>
 #include <mutex>
@@ -45,6 +46,10 @@ struct IdentifiedModel {
   std::optional<core::StickSlipParams> stick_slip = std::nullopt;
   double stick_slip_validation_fit_pct = 0.0;
   core::AxisModel axis_model = core::AxisModel::kHammerstein;
+  // How far the stick-slip model's terms move over parts of the held-out run, and the valve commands
+  // the estimation runs covered: what epa identify writes into a model file beside them.
+  std::optional<core::StickSlipSpread> stick_slip_spread = std::nullopt;
+  std::optional<std::array<double, 2>> identified_drive_v = std::nullopt;  // V: lowest, highest
 };
 using Identify = std::function<core::Result<IdentifiedModel>(const std::vector<core::Run>& estimation,
                                                              const core::Run& validation)>;

@@ -33,6 +33,13 @@ TEST(CommissioningOnThePhysicsRig, DeploysThroughOnTimeAndLateCommands) {
                                                 << (out->identified ? out->identified->summary : "(no model)");
     ASSERT_TRUE(out->identified) << which;
     EXPECT_EQ(out->identified->axis_model, core::AxisModel::kStickSlip) << which;
+    // Where the model holds, as epa identify --validate writes it beside the model: the drive range
+    // of the estimation run (both directions) and the spread of the terms over the held-out run.
+    ASSERT_TRUE(out->identified->identified_drive_v) << which;
+    EXPECT_LT((*out->identified->identified_drive_v)[0], 0.0) << which;
+    EXPECT_GT((*out->identified->identified_drive_v)[1], 0.0) << which;
+    ASSERT_TRUE(out->identified->stick_slip_spread) << which;
+    EXPECT_TRUE(out->identified->stick_slip_spread->validate()) << which;
     for (const auto& m : out->verification) EXPECT_LE(m.metrics.ess_mm, 1.0) << which << ": " << m.from_mm << " -> " << m.to_mm;
   }
 }
