@@ -7,6 +7,7 @@
 #include "app/output_file.hpp"
 #include "control/branch_stability.hpp"
 #include "core/format.hpp"
+#include "core/model_file.hpp"
 #include "core/printable_name.hpp"
 #include "core/text_file.hpp"
 #include "core/utc_stamp.hpp"
@@ -81,6 +82,11 @@ std::string source_text(const store::TuningSet& t) {
   return t.source + "; edited since (the edits: epa tuning audit --since " + std::to_string(t.created_ms) + ")";
 }
 
+// Whether the set's model has a stick-slip model, and which of the two describes the axis.
+std::string stick_slip_text(const store::ModelRecord& m) {
+  return m.stick_slip ? "yes (axis_model " + std::string(core::to_string(m.axis_model)) + ")" : "none";
+}
+
 // Field name and value, in the order `show` prints and `diff` compares them.
 std::vector<std::pair<std::string, std::string>> fields(const store::TuningSet& t, const store::ModelRecord& m) {
   std::vector<std::pair<std::string, std::string>> out = {{"name", t.name},
@@ -107,6 +113,7 @@ std::vector<std::pair<std::string, std::string>> fields(const store::TuningSet& 
       {"model B", poly_text(m.model.B)},
       {"model Ts s", core::format_number(m.model.Ts)},
       {"model mm_per_volt", core::format_number(m.model.mm_per_volt)},
+      {"stick-slip model", stick_slip_text(m)},
       {"model fit", m.fit_json}};
   out.insert(out.end(), std::begin(model_fields), std::end(model_fields));
   return out;
