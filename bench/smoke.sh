@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 build=${1:-build/release}
 scripts/install-deps.sh bench || exit 1
 cmake --build "$build" --target epa control_bench loop_jitter_bench modbus_load modbus_minimal_server arx_bench \
-  diagnose_data >/dev/null || { echo "smoke: the benchmarks do not build" >&2; exit 1; }
+  diagnose_data health_drift >/dev/null || { echo "smoke: the benchmarks do not build" >&2; exit 1; }
 
 logs=$(mktemp -d)
 trap 'rm -rf "$logs"' EXIT
@@ -44,6 +44,7 @@ smoke idle_memory '^VmRSS [0-9]+ kB' bench/idle_memory.sh 1
 smoke attack '^attack: every row held' bench/attack.sh 1
 smoke diagnose_bench '^epa diagnose, 9 runs x 20 s, all candidates: [0-9.]+ s wall' bench/diagnose_bench.sh "$build"
 smoke pp_traj_tables '^pp-traj against its limits' bench/pp_traj_tables.sh "$build" fast
+smoke health_drift '^health drift: [0-9]+ of [0-9]+ changes named' bench/health_drift.sh "$build" 1 40
 smoke pp_traj_no_pass '^pp-traj no-pass: [0-9]+ moves' bench/pp_traj_no_pass.sh "$build" fast
 smoke diagnose_blind '^physics friction score: [0-9]+/[0-9]+ cases correct' bench/diagnose_blind.sh fast "$build"
 smoke diagnose_drift '^score: [0-9]+/[0-9]+ cases correct' bench/diagnose_drift.sh fast "$build"

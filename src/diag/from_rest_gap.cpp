@@ -62,7 +62,7 @@ template <class FreeRun, class OnPrediction>
 GapSum free_run(FreeRun model, const AnchoredRun& anchored, const JudgedScope& scope, OnPrediction&& on_prediction) {
   const core::Run& run = *anchored.run;
   const auto& anchors = anchored.rests.anchors;
-  const std::size_t span = static_cast<std::size_t>(std::lround(kFromRestSpanS / run.Ts));
+  const std::size_t span = static_cast<std::size_t>(std::lround(scope.span_s / run.Ts));
   GapSum sum;
   std::size_t next = 0;             // the next anchor
   std::size_t counted_until = 0;    // the current segment's last sample (0: none)

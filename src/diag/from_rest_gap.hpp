@@ -28,6 +28,7 @@ inline constexpr double kFromRestSpanS = 4.0;
 struct JudgedScope {
   double stroke_mm = 500.0;  // end stops at 0 and here
   double drive_lo_v = -1e9, drive_hi_v = 1e9;  // the valve commands the model was identified on
+  double span_s = kFromRestSpanS;               // each segment at most this long after its rest
   static constexpr double kDriveToleranceV = 0.05;
   bool drive_inside(double u_V) const { return u_V >= drive_lo_v - kDriveToleranceV && u_V <= drive_hi_v + kDriveToleranceV; }
 };

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# The model-health monitor (src/diag/model_health.*) on the physics plant, faster than real time
+# (bench/health_drift.cpp): an axis commissioned as pp_traj_tables.sh does it (three 30 s
+# `epa excite` runs, `epa identify`), moves between random targets under pp-traj, and one physical
+# change after 24 moves (the monitor learns its baseline on the first 16): friction x2, supply
+# 4.5 bar, a break point of the overlap moved 0.25 V, the spool 3x slower, or none. Prints each
+# case and the summary line.
+#
+#   bench/health_drift.sh [BUILD_DIR=build/release] [SEEDS=3] [MOVES=60] [extra health_drift options]
+#
+# CI's smoke step runs it with one seed and 40 moves.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${1:-build/release}
+seeds=${2:-3}
+moves=${3:-60}
+shift $(($# < 3 ? $# : 3))
+epa="$build/src/app/epa"
+bench="$build/bench/health_drift"
+[ -x "$epa" ] && [ -x "$bench" ] || { echo "health_drift: build $epa and $bench first" >&2; exit 1; }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+for seed in 1 2 3; do "$epa" excite --plant physics --seed "$seed" --duration 30 --out "$work/ex$seed.csv" >/dev/null; done
+"$epa" identify "$work/ex1.csv" "$work/ex2.csv" --validate "$work/ex3.csv" --out "$work/model.toml" >"$work/identify.log" 2>&1 ||
+  { echo "health_drift: epa identify failed:" >&2; cat "$work/identify.log" >&2; exit 1; }
+"$bench" "$work/model.toml" --seeds "$seeds" --moves "$moves" "$@"

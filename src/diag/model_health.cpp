@@ -1,0 +1,315 @@
+#include "diag/model_health.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/format.hpp"
+#include "diag/axis_change_fit.hpp"
+
+namespace epa::diag {
+
+namespace {
+
+using plant::EffectKind;
+
+// The baseline is fitted on every continuous term at once; the dead time stays the commissioned
+// one (searching it whole would multiply the fit's cost by kMaxDelay + 1).
+const std::vector<EffectKind> kBaselineTerms = {EffectKind::kStaticFriction, EffectKind::kGainChange, EffectKind::kDeadzoneShift,
+                                                EffectKind::kValveLag};
+
+// The moves one after the other as one run, so that the model carries what a move leaves in it
+// (the air spring's wind-up above all, which sets when the next breakaway comes) into the next,
+// as the axis does: between moves the valve rests in its dead band and the piston stands.
+core::Run joined(const std::deque<core::Run>& moves) {
+  core::Run out;
+  out.Ts = moves.empty() ? 0.005 : moves.front().Ts;
+  for (const auto& m : moves) {
+    const double t0 = out.t_s.empty() ? 0.0 : out.t_s.back() + out.Ts;
+    for (std::size_t k = 0; k < m.size(); ++k) {
+      out.t_s.push_back(t0 + m.t_s[k] - m.t_s.front());
+      out.y_mm.push_back(m.y_mm[k]);
+      out.u_V.push_back(m.u_V[k]);
+    }
+  }
+  return out;
+}
+
+// The joined run's rests, less those in its first `warm_up` samples: the model runs through the
+// window's first move unjudged, so that its wind-up, unknown at the window's start (a free run
+// starts with the spring unwound, the axis with whatever the last move left), is its own by then.
+std::vector<AnchoredRun> anchored(const core::Run& run, std::size_t warm_up) {
+  const core::Run* runs[] = {&run};
+  auto out = anchor_runs(runs);
+  auto& anchors = out.front().rests.anchors;
+  anchors.erase(anchors.begin(), std::find_if(anchors.begin(), anchors.end(), [&](const RestAnchor& a) { return a.k >= warm_up; }));
+  return out;
+}
+
+std::size_t judged_segments(const core::StickSlipParams& model, double Ts, const std::vector<AnchoredRun>& runs, const JudgedScope& scope) {
+  std::size_t n = 0;
+  for (const auto& r : runs) n += from_rest_sse(model, Ts, r, scope).windows;
+  return n;
+}
+
+// The term an effect changes, in its unit.
+struct Term {
+  double value;
+  const char* unit;
+};
+Term term_of(EffectKind kind, const core::StickSlipParams& p) {
+  switch (kind) {
+    case EffectKind::kStaticFriction: return {p.static_mm, "mm"};
+    case EffectKind::kGainChange: return {p.speed_right_mm_s_per_v, "mm/s/V"};
+    case EffectKind::kDeadzoneShift: return {p.break_right_v, "V"};
+    case EffectKind::kValveLag: return {p.spool_lag_s, "s"};
+    case EffectKind::kInputDelay: return {static_cast<double>(p.delay_samples), "samples"};
+    default: return {0.0, ""};
+  }
+}
+
+// How far `changed` lies from `baseline` in the term of `kind`: a log ratio (friction, flow gain),
+// volts (the break point that moved most), seconds (the spool's lag), samples (the dead time).
+double size_of(EffectKind kind, const core::StickSlipParams& changed, const core::StickSlipParams& baseline) {
+  switch (kind) {
+    case EffectKind::kStaticFriction: return std::abs(std::log(changed.static_mm / baseline.static_mm));
+    case EffectKind::kGainChange: return std::abs(std::log(changed.speed_right_mm_s_per_v / baseline.speed_right_mm_s_per_v));
+    case EffectKind::kDeadzoneShift:
+      return std::max(std::abs(changed.break_right_v - baseline.break_right_v), std::abs(changed.break_left_v - baseline.break_left_v));
+    case EffectKind::kValveLag: return std::abs(changed.spool_lag_s - baseline.spool_lag_s);
+    case EffectKind::kInputDelay: return std::abs(changed.delay_samples - baseline.delay_samples);
+    default: return 0.0;
+  }
+}
+
+// The smallest change of `kind` ever named, in size_of's units.
+double floor_of(const HealthConfig& c, EffectKind kind) {
+  switch (kind) {
+    case EffectKind::kStaticFriction: return std::log1p(c.friction_ratio_tolerance);
+    case EffectKind::kGainChange: return std::log1p(c.gain_ratio_tolerance);
+    case EffectKind::kDeadzoneShift: return c.break_tolerance_v;
+    case EffectKind::kValveLag: return c.lag_tolerance_s;
+    case EffectKind::kInputDelay: return 1.0;
+    default: return 0.0;
+  }
+}
+
+std::size_t index_of(EffectKind kind) {
+  return static_cast<std::size_t>(std::find(std::begin(kAxisChanges), std::end(kAxisChanges), kind) - std::begin(kAxisChanges));
+}
+
+std::string percent(double ratio) {
+  const double pct = std::round(std::abs(ratio - 1.0) * 100.0);
+  return std::string(ratio >= 1.0 ? "up " : "down ") + core::format_number(pct) + " %";
+}
+
+// The change in words, against the commissioned model.
+std::string describe(EffectKind kind, const core::StickSlipParams& changed, const core::StickSlipParams& commissioned) {
+  const auto v = [](double x, double scale) { return core::format_number(std::round(x * scale) / scale); };
+  switch (kind) {
+    case EffectKind::kStaticFriction: return "friction " + percent(changed.static_mm / commissioned.static_mm);
+    case EffectKind::kGainChange: return "flow gain " + percent(changed.speed_right_mm_s_per_v / commissioned.speed_right_mm_s_per_v) + " (supply or valve)";
+    case EffectKind::kDeadzoneShift:
+      return "dead band moved: right break point " + v(changed.break_right_v - commissioned.break_right_v, 100) + " V, left " +
+             v(changed.break_left_v - commissioned.break_left_v, 100) + " V";
+    case EffectKind::kValveLag:
+      return "spool lag " + v(changed.spool_lag_s * 1000.0, 10) + " ms (commissioned " + v(commissioned.spool_lag_s * 1000.0, 10) + " ms)";
+    case EffectKind::kInputDelay:
+      return "dead time " + std::to_string(changed.delay_samples) + " samples (commissioned " + std::to_string(commissioned.delay_samples) + ")";
+    default: return "";
+  }
+}
+
+}  // namespace
+
+const char* to_string(HealthState state) {
+  switch (state) {
+    case HealthState::kOff: return "off";
+    case HealthState::kLearning: return "learning";
+    case HealthState::kOk: return "ok";
+    case HealthState::kDrifting: return "drifting";
+    case HealthState::kUnexplained: return "unexplained";
+    case HealthState::kHunting: return "hunting";
+  }
+  return "?";
+}
+
+std::string HealthConfig::problem() const {
+  if (baseline_moves < 2 || baseline_moves > 100) return "baseline_moves must lie in 2..100";
+  if (window_moves < 2 || window_moves > 100) return "window_moves must lie in 2..100";
+  if (baseline_moves < window_moves) return "baseline_moves must be at least window_moves";
+  if (!(spread_margin >= 1.0 && spread_margin <= 10.0)) return "spread_margin must lie in [1, 10]";
+  if (confirm_windows < 1 || confirm_windows > 20) return "confirm_windows must lie in 1..20";
+  if (!(min_reduction > 0.0 && min_reduction < 1.0)) return "min_reduction must lie in (0, 1)";
+  if (!(unexplained_gap_ratio > 1.0 && unexplained_gap_ratio <= 100.0)) return "unexplained_gap_ratio must lie in (1, 100]";
+  if (!(friction_ratio_tolerance > 0.0 && friction_ratio_tolerance <= 10.0)) return "friction_ratio_tolerance must lie in (0, 10]";
+  if (!(gain_ratio_tolerance > 0.0 && gain_ratio_tolerance <= 10.0)) return "gain_ratio_tolerance must lie in (0, 10]";
+  if (!(break_tolerance_v > 0.0 && break_tolerance_v <= 5.0)) return "break_tolerance_v must lie in (0, 5]";
+  if (!(lag_tolerance_s > 0.0 && lag_tolerance_s <= 1.0)) return "lag_tolerance_s must lie in (0, 1]";
+  return "";
+}
+
+core::Result<ModelHealth> ModelHealth::make(const core::StickSlipParams& commissioned, double Ts, double stroke_mm, HealthConfig config,
+                                            std::optional<std::array<double, 2>> drive_range_v) {
+  if (auto s = commissioned.validate(); !s) return core::invalid_argument("model health: the commissioned model: " + s.error().message);
+  if (!(Ts > 0.0) || !std::isfinite(Ts)) return core::invalid_argument("model health: Ts must be > 0");
+  if (!(stroke_mm > 0.0) || !std::isfinite(stroke_mm)) return core::invalid_argument("model health: the stroke must be > 0 mm");
+  if (const auto p = config.problem(); !p.empty()) return core::invalid_argument("model health: " + p);
+  return ModelHealth(commissioned, Ts, stroke_mm, config, drive_range_v);
+}
+
+ModelHealth::ModelHealth(const core::StickSlipParams& commissioned, double Ts, double stroke_mm, HealthConfig config,
+                         std::optional<std::array<double, 2>> drive_range_v)
+    : commissioned_(commissioned), baseline_(commissioned), Ts_(Ts), config_(config) {
+  scope_.stroke_mm = stroke_mm;
+  scope_.span_s = config.span_s;
+  if (drive_range_v) scope_.drive_lo_v = (*drive_range_v)[0], scope_.drive_hi_v = (*drive_range_v)[1];
+  verdict_.state = HealthState::kLearning;
+}
+
+void ModelHealth::retake_baseline() {
+  moves_.clear();
+  have_baseline_ = false;
+  baseline_ = commissioned_;
+  candidate_.reset();
+  agreeing_ = 0;
+  verdict_ = HealthVerdict{};
+  verdict_.state = HealthState::kLearning;
+}
+
+bool ModelHealth::add_move(core::Run run, bool hunted) {
+  const HealthState state_before = verdict_.state;
+  const auto effect_before = verdict_.effect;
+  ++verdict_.moves_seen;
+  moves_.push_back(std::move(run));
+  if (!have_baseline_) {
+    if (moves_.size() >= config_.baseline_moves) {
+      fit_baseline();
+      moves_.clear();
+      verdict_.state = HealthState::kOk;
+    }
+  } else {
+    while (moves_.size() > config_.window_moves) moves_.pop_front();
+    if (moves_.size() == config_.window_moves) judge();
+  }
+  if (hunted) verdict_.state = HealthState::kHunting;  // until a judgement without it
+  return verdict_.state != state_before || verdict_.effect != effect_before;
+}
+
+void ModelHealth::fit_baseline() {
+  const core::Run run = joined(moves_);
+  const auto runs = anchored(run, moves_.front().size());
+  const ChangeFitData data{commissioned_, Ts_, runs, runs, scope_};
+  const ChangeFit joint = fit_change(data, kBaselineTerms);
+  fits_ += joint.evaluations;
+  baseline_ = apply_change(commissioned_, joint.change);
+  verdict_.baseline_gap_mm = from_rest_gap_mm(baseline_, Ts_, runs, scope_);
+  have_baseline_ = true;
+  // How far windows of the unchanged axis scatter about the baseline: each effect fitted on the
+  // baseline's own windows, half a window apart. A later change is named only beyond
+  // spread_margin times the widest of them (and beyond the floor).
+  for (const EffectKind kind : kAxisChanges) tolerance_[index_of(kind)] = floor_of(config_, kind);
+  const std::deque<core::Run> all = moves_;
+  for (std::size_t first = 0; first + config_.window_moves <= all.size(); first += std::max<std::size_t>(1, config_.window_moves / 2)) {
+    moves_.assign(all.begin() + static_cast<std::ptrdiff_t>(first), all.begin() + static_cast<std::ptrdiff_t>(first + config_.window_moves));
+    const core::Run window = joined(moves_);
+    const auto window_runs = anchored(window, moves_.front().size());
+    const ChangeFitData window_data{baseline_, Ts_, window_runs, window_runs, scope_};
+    for (const EffectKind kind : kAxisChanges) {
+      const ChangeFit fit = fit_change(window_data, {kind});
+      fits_ += fit.evaluations;
+      double& t = tolerance_[index_of(kind)];
+      t = std::max(t, config_.spread_margin * size_of(kind, apply_change(baseline_, fit.change), baseline_));
+    }
+  }
+  moves_ = all;
+}
+
+std::size_t ModelHealth::first_move_explained(const core::StickSlipParams& changed, const core::Run& run) const {
+  const auto runs = anchored(run, moves_.front().size());
+  const FreeRunTrace before = from_rest_trace(baseline_, Ts_, runs.front(), scope_);
+  const FreeRunTrace after = from_rest_trace(changed, Ts_, runs.front(), scope_);
+  std::vector<double> sse_before(moves_.size()), sse_after(moves_.size());
+  std::vector<std::size_t> move_end;  // the first sample of the next move
+  for (std::size_t i = 0, end = 0; i < moves_.size(); ++i) move_end.push_back(end += moves_[i].size());
+  const auto add = [&](const FreeRunTrace& t, std::vector<double>& sse) {
+    for (std::size_t i = 0; i < t.k.size(); ++i) {
+      const std::size_t m = std::upper_bound(move_end.begin(), move_end.end(), t.k[i]) - move_end.begin();
+      const double e = t.predicted_mm[i] - run.y_mm[t.k[i]];
+      if (m < sse.size()) sse[m] += e * e;
+    }
+  };
+  add(before, sse_before);
+  add(after, sse_after);
+  for (std::size_t m = 0; m < moves_.size(); ++m)
+    if (sse_after[m] < sse_before[m]) return m;
+  return moves_.size() - 1;
+}
+
+void ModelHealth::judge() {
+  const core::Run run = joined(moves_);
+  const auto runs = anchored(run, moves_.front().size());
+  if (judged_segments(baseline_, Ts_, runs, scope_) < config_.min_judged_segments) return;  // nothing to judge on
+  const double gap_mm = from_rest_gap_mm(baseline_, Ts_, runs, scope_);
+  verdict_.window_gap_mm = gap_mm;
+  const ChangeFitData data{baseline_, Ts_, runs, runs, scope_};
+
+  verdict_.estimates.clear();
+  std::optional<EffectEstimate> best;
+  core::StickSlipParams best_model = baseline_;
+  AxisChange best_change;
+  for (const EffectKind kind : kAxisChanges) {
+    const ChangeFit fit = fit_change(data, {kind});
+    fits_ += fit.evaluations;
+    const core::StickSlipParams changed = apply_change(baseline_, fit.change);
+    EffectEstimate e;
+    e.effect = kind;
+    e.value = term_of(kind, changed).value;
+    e.commissioned = term_of(kind, commissioned_).value;
+    e.ratio = e.commissioned != 0.0 ? e.value / e.commissioned : 1.0;
+    e.reduction = gap_mm > 0.0 ? std::max(0.0, (gap_mm - fit.train_gap_mm) / gap_mm) : 0.0;
+    e.beyond_tolerance = size_of(kind, changed, baseline_) > tolerance_[index_of(kind)];
+    verdict_.estimates.push_back(e);
+    if (e.beyond_tolerance && (!best || e.reduction > best->reduction)) best = e, best_model = changed, best_change = fit.change;
+  }
+
+  // This judgement's reading, then whether enough judgements in a row agree on it.
+  HealthState reading = HealthState::kOk;
+  std::optional<EffectKind> effect;
+  if (best && best->reduction >= config_.min_reduction) {
+    reading = HealthState::kDrifting;
+    effect = best->effect;
+  } else if (gap_mm > config_.unexplained_gap_ratio * verdict_.baseline_gap_mm) {
+    reading = HealthState::kUnexplained;
+  }
+  if (reading == candidate_state_ && effect == candidate_) {
+    ++agreeing_;
+  } else {
+    candidate_state_ = reading;
+    candidate_ = effect;
+    agreeing_ = 1;
+    // The onset: the oldest move of this window that the reading explains better than the baseline.
+    std::size_t first = 0;
+    if (reading == HealthState::kDrifting) first = first_move_explained(best_model, run);
+    onset_move_ = verdict_.moves_seen - moves_.size() + first + 1;
+  }
+  if (agreeing_ < config_.confirm_windows && verdict_.state != HealthState::kHunting) return;
+
+  verdict_.state = reading;
+  verdict_.effect = effect;
+  verdict_.moves_since_onset = reading == HealthState::kOk ? 0 : verdict_.moves_seen - onset_move_ + 1;
+  if (effect) {
+    const Term t = term_of(*effect, best_model);
+    verdict_.value = t.value;
+    verdict_.unit = t.unit;
+    verdict_.commissioned = term_of(*effect, commissioned_).value;
+    verdict_.ratio = verdict_.commissioned != 0.0 ? verdict_.value / verdict_.commissioned : 1.0;
+    verdict_.size = describe(*effect, best_model, commissioned_);
+  } else {
+    verdict_.value = verdict_.commissioned = 0.0;
+    verdict_.ratio = 1.0;
+    verdict_.unit.clear();
+    verdict_.size.clear();
+  }
+}
+
+}  // namespace epa::diag
