@@ -91,7 +91,7 @@
     const rows = d.records.map((r) => `<tr data-record="${r.record}"${r.record === d.record_select ? ' class="selected"' : ""}>` +
       `<td>${r.record}</td><td>${text(r.target_mm, 1, "mm")}</td>` +
       `<td>${r.speed_mm_s ? text(r.speed_mm_s, 1, "mm/s") : "no limit"}</td>` +
-      `<td>${r.window_mm ? text(r.window_mm, 2, "mm") : "default"}</td><td>${esc(r.controller)}</td>` +
+      `<td>${r.window_mm ? text(r.window_mm, 2, "mm") : "default"}</td><td>${esc(r.controller)}</td><td>${esc(r.approach)}</td>` +
       `<td>${enabled ? `<button type="button" class="rec-edit" data-record="${r.record}">edit</button>` : ""}</td></tr>`);
     const body = $("record-table").tBodies[0];
     const html = rows.join("");
@@ -119,15 +119,16 @@
     $("rec-speed").value = String(r.speed_mm_s);
     $("rec-window").value = String(r.window_mm);
     $("rec-controller").value = r.controller;
+    $("rec-approach").value = r.approach;
   }
 
-  // The four fields of the record in the editor, in one POST (one gate group: all or nothing).
+  // The five fields of the record in the editor, in one POST (one gate group: all or nothing).
   function saveRecord() {
     const n = Number($("rec-number").value);
     const field = (id) => ($(id).value.trim() === "" ? NaN : Number($(id).value));
     send("/api/records", {
       record: n, target_mm: field("rec-target"), speed_mm_s: field("rec-speed"), window_mm: field("rec-window"),
-      controller: $("rec-controller").value,
+      controller: $("rec-controller").value, approach: $("rec-approach").value,
     }, `record ${n}`, "rec-answer").then(pollOnce);
   }
   async function pollOnce() {

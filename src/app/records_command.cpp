@@ -24,6 +24,8 @@ CLI::App* add_records_command(CLI::App& app, RecordsOptions& o) {
   set->add_option("--speed-mm-s", o.speed_mm_s, "Speed limit, mm/s (0: none, the law's own step response)");
   set->add_option("--window-mm", o.window_mm, "In-position window, mm (0: [motion] in_position_window_mm)");
   set->add_option("--controller", o.controller, "The law: pp, pp-ngidz, pp-ffidz, pp-traj, or running (the one running then)");
+  set->add_option("--approach", o.approach,
+                  "The side pp-traj's sliding arrival comes from: near (never past the target), from-below or from-above");
   set->add_option("--token", o.token, "The appliance's [web] token; shows in ps: prefer EPA_TOKEN or --token-file")->envname("EPA_TOKEN");
   set->add_option("--token-file", o.token_file, "A file whose first line is the appliance's [web] token");
   set->callback([&o] { o.set = true; });
@@ -44,12 +46,12 @@ std::string number(const nlohmann::json& v, const char* format, const char* zero
 void print_row(const nlohmann::json& r, std::ostream& out) {
   char line[160];
   using K = web::RecordKeys;
-  std::snprintf(line, sizeof line, "%6d  %10s  %16s  %9s  %s\n", r.value(K::kRecord, 0), number(r[K::kTarget], "%.3f", nullptr).c_str(),
+  std::snprintf(line, sizeof line, "%6d  %10s  %16s  %9s  %-8s  %s\n", r.value(K::kRecord, 0), number(r[K::kTarget], "%.3f", nullptr).c_str(),
                 number(r[K::kSpeed], "%.3f", "no limit").c_str(), number(r[K::kWindow], "%.3f", "default").c_str(),
-                r.value(K::kController, std::string("-")).c_str());
+                r.value(K::kController, std::string("-")).c_str(), r.value(K::kApproach, std::string("-")).c_str());
   out << line;
 }
-constexpr const char* kHead = "record   target mm  speed limit mm/s  window mm  law\n";
+constexpr const char* kHead = "record   target mm  speed limit mm/s  window mm  law       approach\n";
 
 }  // namespace
 
@@ -66,7 +68,9 @@ int run_records(const RecordsOptions& o, std::ostream& out, std::ostream& err) {
     if (o.speed_mm_s) body[K::kSpeed] = *o.speed_mm_s;
     if (o.window_mm) body[K::kWindow] = *o.window_mm;
     if (o.controller) body[K::kController] = *o.controller;
-    if (body.size() == 1) return fail("record " + std::to_string(o.record) + ": nothing to set: give --target-mm, --speed-mm-s, --window-mm or --controller");
+    if (o.approach) body[K::kApproach] = *o.approach;
+    if (body.size() == 1)
+      return fail("record " + std::to_string(o.record) + ": nothing to set: give --target-mm, --speed-mm-s, --window-mm, --controller or --approach");
     const auto token = appliance_token(o.token, o.token_file);
     if (!token) return fail("record " + std::to_string(o.record) + ": " + token.error().message);
     for (const char* f : {K::kTarget, K::kSpeed, K::kWindow})

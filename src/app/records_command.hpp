@@ -19,6 +19,7 @@ struct RecordsOptions {
   int record = 0;
   std::optional<double> target_mm, speed_mm_s, window_mm;
   std::optional<std::string> controller;  // a law's name, or "running"
+  std::optional<std::string> approach;    // near, from-below, from-above
   std::string token;       // --token or EPA_TOKEN
   std::string token_file;  // --token-file: its first line
 };

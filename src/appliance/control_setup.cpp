@@ -20,7 +20,7 @@ std::set<points::PointId> persisted_points(const std::optional<modbus::RegisterM
   if (!map) out.insert(points::PointId::kSetpoint);
   for (const auto& e : map ? map->entries() : std::vector<modbus::RegisterEntry>{})
     if (e.persisted) out.insert(e.point->id);
-  for (std::size_t k = 0; k < 4 * points::kPositionRecords; ++k) out.insert(points::indexed_id(points::PointId::kRecordTarget0, k));
+  for (std::size_t k = 0; k < points::kRecordPoints; ++k) out.insert(points::indexed_id(points::PointId::kRecordTarget0, k));
   return out;
 }
 

@@ -49,7 +49,7 @@ core::Result<StoreStartup> open_tuning_store(const std::string& path, const stor
   auto retained = store::RetainedPoints(opened->db).all();
   if (!retained) return core::Error{retained.error().code, "store: " + retained.error().message};
   if (auto it = retained->find(std::string(points::name(points::PointId::kSetpoint))); it != retained->end()) out.retained_setpoint_mm = it->second;
-  for (std::size_t k = 0; k < 4 * points::kPositionRecords; ++k) {
+  for (std::size_t k = 0; k < points::kRecordPoints; ++k) {
     const points::PointId id = points::indexed_id(points::PointId::kRecordTarget0, k);
     points::RecordField f;
     points::record_field(id, f);

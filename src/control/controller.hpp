@@ -83,8 +83,13 @@ struct ControllerOutput {
 void controller_start(const ControllerParams& params, ControllerState& state, double y_v, double speed_v_s) noexcept;
 
 // A move starts, to a new target or the same one again: the hunting watch forgets the last move
-// and releases its hold (the next target releases it too, by itself).
-inline void controller_new_move(ControllerState& state) noexcept { state.hunting = {}; }
+// and releases its hold (the next target releases it too, by itself). approach_direction: the side
+// pp-traj's sliding arrival comes from (+1 below, -1 above; a position record's), 0: the near side.
+inline void controller_new_move(ControllerState& state, double approach_direction = 0.0) noexcept {
+  state.hunting = {};
+  state.trajectory.approach.next_direction = approach_direction;
+  if (approach_direction != 0.0) state.trajectory.approach.phase = ApproachPhase::kIdle;  // planned afresh, even to the same target
+}
 
 // One sample: reads r(k), y(k) (sensor volts), returns the valve command to hold until k+1.
 // No anti-windup: the paper's law runs on the unsaturated u (its F has no pole at 1). Every law

@@ -118,6 +118,7 @@ void approach_after_moving_reference(const ApproachLimits& l, ApproachState& s, 
   }
   s.planned_r_v = r_v;
   s.final_direction = direction;
+  s.next_direction = 0.0;  // a moving reference's arrival is where it stands, from where the piston is
   s.final_leg = true;
   s.retries = l.max_retries;  // judged after the coast: held wherever it stopped
   s.cut_speed_v_s = 0.0;      // and nothing learned from it

@@ -84,7 +84,7 @@ void write_records(std::ostream& out, const RegisterMap& map) {
       << first->address;
   if (stride > 0) out << " + " << stride << "·(N-1)";
   out << ". Each holds, in order:\n\n| field | point | type | meaning |\n| --- | --- | --- | --- |\n";
-  const P fields[] = {P::kRecordTarget0, P::kRecordSpeed0, P::kRecordWindow0, P::kRecordController0};
+  const P fields[] = {P::kRecordTarget0, P::kRecordSpeed0, P::kRecordWindow0, P::kRecordController0, P::kRecordApproach0};
   for (const P f : fields) {
     const RegisterEntry* e = entry_of(map, f);
     out << "| +" << (e ? std::to_string(e->address - first->address) : std::string("?")) << " | " << points::name(f) << " | "

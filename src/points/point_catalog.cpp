@@ -27,7 +27,7 @@ double coefficient(const std::array<double, kCoefficients>& c, std::uint8_t degr
 const std::vector<std::string>& record_names() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> n;
-    for (const char* field : {"target_mm", "speed_mm_s", "window_mm", "controller"})
+    for (const char* field : {"target_mm", "speed_mm_s", "window_mm", "controller", "approach"})
       for (std::size_t i = 1; i <= kPositionRecords; ++i) n.push_back("record" + std::to_string(i) + "_" + field);
     return n;
   }();
@@ -299,14 +299,16 @@ std::vector<PointDef> build() {
   static constexpr std::string_view kRecordText[] = {
       "position record: target", "position record: speed limit (0: none, the law's own step response)",
       "position record: in-position window (0: [motion] in_position_window_mm)",
-      "position record: law (0 pp, 1 pp-ngidz, 2 pp-ffidz, 3 pp-traj; 255 the running one)"};
-  static constexpr double kRecordMax[] = {10000.0, 10000.0, 100.0, double(kKeepController)};
-  static constexpr std::string_view kRecordUnit[] = {"mm", "mm/s", "mm", ""};
+      "position record: law (0 pp, 1 pp-ngidz, 2 pp-ffidz, 3 pp-traj; 255 the running one)",
+      "position record: side pp-traj's sliding arrival comes from (0 the near side: never past the target; 1 from below, "
+      "2 from above: from that side even when the piston stands on the other, passing the target by up to one approach length)"};
+  static constexpr double kRecordMax[] = {10000.0, 10000.0, 100.0, double(kKeepController), 2.0};
+  static constexpr std::string_view kRecordUnit[] = {"mm", "mm/s", "mm", "", ""};
   const auto& records = record_names();
   for (std::size_t k = 0; k < records.size(); ++k) {
     const std::size_t field = k / kPositionRecords;
     PointDef d{indexed_id(P::kRecordTarget0, k), records[k], kRecordUnit[field], kRecordText[field], A::kTuning,
-               field == 0 ? -10000.0 : 0.0, kRecordMax[field], field == 3, true, nullptr, static_cast<int>(k)};
+               field == 0 ? -10000.0 : 0.0, kRecordMax[field], field >= 3, true, nullptr, static_cast<int>(k)};
     d.read = [](const Ctx& c, int j) {
       RecordField f;
       record_field(indexed_id(P::kRecordTarget0, static_cast<std::size_t>(j)), f);

@@ -54,8 +54,9 @@ enum class PointId : std::uint16_t {
   kRecordSpeed0 = kRecordTarget0 + kPositionRecords,
   kRecordWindow0 = kRecordSpeed0 + kPositionRecords,
   kRecordController0 = kRecordWindow0 + kPositionRecords,
+  kRecordApproach0 = kRecordController0 + kPositionRecords,
   // controller coefficients: kF0 + i, kG0 + i, kH0 + i for i < kCoefficients
-  kF0 = kRecordController0 + kPositionRecords,
+  kF0 = kRecordApproach0 + kPositionRecords,
   kG0 = kF0 + kCoefficients,
   kH0 = kG0 + kCoefficients,
   kCount = kH0 + kCoefficients,

@@ -20,4 +20,20 @@ core::Result<int> parse_record_controller(std::string_view name) {
   return static_cast<int>(*kind);
 }
 
+namespace {
+constexpr std::string_view kApproachNames[] = {"near", "from-below", "from-above"};  // RecordApproach's order
+}
+
+std::string record_approach_name(int approach) {
+  if (approach >= 0 && approach < static_cast<int>(std::size(kApproachNames))) return std::string(kApproachNames[approach]);
+  return std::to_string(approach);
+}
+
+core::Result<int> parse_record_approach(std::string_view name) {
+  for (std::size_t i = 0; i < std::size(kApproachNames); ++i)
+    if (name == kApproachNames[i]) return static_cast<int>(i);
+  return core::invalid_argument("unknown approach '" + std::string(name) +
+                                "': expected near (never past the target), from-below or from-above");
+}
+
 }  // namespace epa::points

@@ -249,6 +249,7 @@ runtime::Command WriteGate::control_command(std::uint16_t word, std::span<const 
   c.value = r.target_mm;
   c.speed_limit_mm_s = r.speed_mm_s;
   c.window_mm = r.window_mm;
+  c.approach_direction = approach_direction(r.approach);
   if (r.controller != kKeepController) {
     c.start_controller = true;
     c.controller = static_cast<control::ControllerKind>(r.controller);

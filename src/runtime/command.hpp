@@ -34,6 +34,7 @@ struct Command {
   std::uint32_t heartbeat = 0;
   std::uint16_t control_word = 0;
   double speed_limit_mm_s = 0.0, window_mm = 0.0;  // a start's: 0 none / the configured window
+  double approach_direction = 0.0;  // a start's: +1 from below, -1 from above, 0 the near side (control/sliding_approach.hpp)
   bool start_controller = false;                    // a start runs its move with `controller` (that move only)
   std::uint64_t sequence = 0;  // the producer's number for it: a refusal is reported with it
   Tuning tuning;

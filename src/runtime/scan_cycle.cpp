@@ -232,7 +232,8 @@ void ScanCycle::apply_control(const Command& c, std::int64_t now_ns) noexcept {
   }
   if (rising & kControlStart) {  // checked: RUN, a target within the setpoint range
     setpoint_mm_ = c.value;
-    start_move(c.value, c.speed_limit_mm_s, c.window_mm, c.start_controller ? std::optional(c.controller) : std::nullopt);
+    start_move(c.value, c.speed_limit_mm_s, c.window_mm, c.start_controller ? std::optional(c.controller) : std::nullopt,
+               c.approach_direction);
   }
   if (mode_ == Mode::kManual) {
     const bool plus = word & kControlJogPlus, minus = word & kControlJogMinus;
@@ -269,7 +270,7 @@ void ScanCycle::end_excitation(ExcitationEnd how) noexcept {
 }
 
 void ScanCycle::start_move(double target_mm, double speed_limit_mm_s, double window_mm,
-                           std::optional<control::ControllerKind> record_law) noexcept {
+                           std::optional<control::ControllerKind> record_law, double approach_direction) noexcept {
   if (moves_.active()) finish_move(MoveEnd::kCutShort);
   hold_on_enable_ = false;  // RUN entered with a move: the move, not a hold
   const control::ControllerKind before = law();
@@ -279,7 +280,7 @@ void ScanCycle::start_move(double target_mm, double speed_limit_mm_s, double win
   const bool usable = record_law && (*record_law != control::ControllerKind::kPpTraj || tuning_.traj_available);
   move_law_ = usable && *record_law != controller_ ? record_law : std::nullopt;
   take_over_from(before);
-  control::controller_new_move(state_);  // a start to the same target is a new try, watched afresh
+  control::controller_new_move(state_, approach_direction);  // a start to the same target is a new try, watched afresh
   moves_.start(position_mm_, target_mm, law(), ch_.samples.written());
   motion_.move(target_mm, speed_limit_mm_s, window_mm, position_mm_, speed_mm_s_);
   if (speed_limit_mm_s > 0.0) {

@@ -72,9 +72,10 @@ class ScanCycle {
   void start_law_at_the_piston(const control::ControllerParams& law) noexcept;
   void end_excitation(ExcitationEnd how) noexcept;
   // A started move (a setpoint written in RUN, or a start): the one before it ends cut short. A
-  // record's own law runs this move only (the selected law, holding `controller`, stays).
+  // record's own law runs this move only (the selected law, holding `controller`, stays), and
+  // its side of approach (+1 below, -1 above, 0 near) this move's sliding arrival.
   void start_move(double target_mm, double speed_limit_mm_s, double window_mm,
-                  std::optional<control::ControllerKind> record_law = std::nullopt) noexcept;
+                  std::optional<control::ControllerKind> record_law = std::nullopt, double approach_direction = 0.0) noexcept;
   // Adds this cycle's reading to the move and ends it when it has ended (in position, braked
   // after a halt, standing off target, or judged after move_window_s).
   void track_move() noexcept;

@@ -53,6 +53,12 @@ std::optional<double> value_of(P id, const json& v, std::string& error) {
     error = point + ": " + c.error().message;
     return std::nullopt;
   }
+  if (v.is_string() && record_field(id, field) && field.kind == RecordField::kApproach) {
+    auto a = points::parse_record_approach(v.get<std::string>());
+    if (a) return static_cast<double>(*a);
+    error = point + ": " + a.error().message;
+    return std::nullopt;
+  }
   error = point + " must be a number";
   return std::nullopt;
 }
@@ -61,7 +67,8 @@ std::optional<double> value_of(P id, const json& v, std::string& error) {
 CommandBody record_body(const json& j) {
   using K = RecordKeys;
   constexpr std::pair<const char*, P> kFields[] = {{K::kTarget, P::kRecordTarget0}, {K::kSpeed, P::kRecordSpeed0},
-                                                   {K::kWindow, P::kRecordWindow0}, {K::kController, P::kRecordController0}};
+                                                   {K::kWindow, P::kRecordWindow0}, {K::kController, P::kRecordController0},
+                                                   {K::kApproach, P::kRecordApproach0}};
   const std::string range = "1.." + std::to_string(points::kPositionRecords);
   const auto number = j.find(K::kRecord);
   if (number == j.end()) return malformed("name the record: {\"record\": " + range + ", \"target_mm\": ...}");
@@ -75,14 +82,14 @@ CommandBody record_body(const json& j) {
     const std::pair<const char*, P>* f = nullptr;
     for (const auto& field : kFields)
       if (k == field.first) f = &field;
-    if (!f) return malformed("unknown field '" + k + "' (a record has target_mm, speed_mm_s, window_mm, controller)");
+    if (!f) return malformed("unknown field '" + k + "' (a record has target_mm, speed_mm_s, window_mm, controller, approach)");
     const P id = points::indexed_id(f->second, i);
     std::string error;
     auto value = value_of(id, v, error);
     if (!value) return malformed(error);
     out.writes.push_back({id, *value});
   }
-  if (out.writes.empty()) return malformed("give at least one of target_mm, speed_mm_s, window_mm, controller for record " + std::to_string(i + 1));
+  if (out.writes.empty()) return malformed("give at least one of target_mm, speed_mm_s, window_mm, controller, approach for record " + std::to_string(i + 1));
   return out;
 }
 

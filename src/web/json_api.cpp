@@ -185,7 +185,8 @@ std::string records_json(const points::PositionRecords& records, int record_sele
     const auto& r = records[i];
     using K = RecordKeys;
     a.push_back({{K::kRecord, i + 1}, {K::kTarget, num(r.target_mm)}, {K::kSpeed, num(r.speed_mm_s)},
-                 {K::kWindow, num(r.window_mm)}, {K::kController, points::record_controller_name(r.controller)}});
+                 {K::kWindow, num(r.window_mm)}, {K::kController, points::record_controller_name(r.controller)},
+                 {K::kApproach, points::record_approach_name(r.approach)}});
   }
   return json{{"records", std::move(a)}, {k(P::kRecordSelect), record_select}}.dump();
 }

@@ -58,6 +58,7 @@ struct RecordKeys {
   static constexpr const char* kSpeed = "speed_mm_s";
   static constexpr const char* kWindow = "window_mm";
   static constexpr const char* kController = "controller";
+  static constexpr const char* kApproach = "approach";
 };
 
 // The position-record table: {"records": [{"record": 1..32, "target_mm", "speed_mm_s" (0: no limit),

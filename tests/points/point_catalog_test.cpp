@@ -45,6 +45,7 @@ const std::map<std::string, std::string> kFormatFiles = {
     {"core/run_file.cpp", "epa-run/1 metadata"},
     {"core/move_metrics.cpp", "epa-run/1 metadata: a move's move_end values, which name how it ended, not the status bits"},
     {"runtime/recorder.cpp", "epa-run/1 metadata"},
+    {"diag/model_health.cpp", "the health states' names (hunting: the law hunted), not the status bit"},
     {"appliance/run_history.cpp", "epa-run/1 metadata"},
     {"app/identify_command.cpp", "epa-run/1 metadata"},
     {"app/simulate_command.cpp", "epa-run/1 metadata"},

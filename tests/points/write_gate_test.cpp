@@ -226,6 +226,31 @@ TEST(WriteGate, AControlWordWrittenAgainAsItIsIsAKeepAliveNotAnAuditedChange) {
   EXPECT_EQ(queued, 5);  // every write still reaches the loop: it is the keep-alive
 }
 
+// A record's start carries its side of approach to the loop: from above as -1, the near side as 0.
+TEST(WriteGate, ARecordsStartCarriesItsSideOfApproach) {
+  const runtime::RuntimeConfig config;
+  runtime::LoopChannels channels(16);
+  WriteGate gate(limits_of(config), config, paper(), channels, nullptr);
+  const PointWrite run[] = {{PointId::kMode, 1.0}};
+  ASSERT_TRUE(gate.submit(run, kOperator).accepted());
+  const PointWrite record[] = {{points::indexed_id(PointId::kRecordTarget0, 0), 200.0},
+                               {points::indexed_id(PointId::kRecordApproach0, 0), 2.0},
+                               {points::indexed_id(PointId::kRecordTarget0, 1), 100.0},
+                               {PointId::kRecordSelect, 1.0}};
+  ASSERT_TRUE(gate.submit(record, kOperator).accepted());
+  const PointWrite start[] = {{PointId::kControlWord, 1.0}};
+  const PointWrite release[] = {{PointId::kControlWord, 0.0}};
+  const PointWrite select2[] = {{PointId::kRecordSelect, 2.0}};
+  const PointWrite bad_side[] = {{points::indexed_id(PointId::kRecordApproach0, 0), 3.0}};
+  EXPECT_FALSE(gate.submit(bad_side, kOperator).accepted());
+  for (const auto* group : {start, release, select2, start}) ASSERT_TRUE(gate.submit({group, 1}, kOperator).accepted());
+  std::vector<std::pair<double, double>> starts;  // target, side
+  runtime::Command c;
+  while (channels.commands.try_pop(c))
+    if (c.kind == runtime::CommandKind::kControl && (c.control_word & runtime::kControlStart)) starts.emplace_back(c.value, c.approach_direction);
+  EXPECT_EQ(starts, (std::vector<std::pair<double, double>>{{200.0, -1.0}, {100.0, 0.0}}));
+}
+
 // A read right after a mode change shows the motion bits as the new mode will have them, not the
 // old mode's: RUN's in_position and a halt's halted must not read beside manual_mode.
 TEST(WriteGate, AModeChangeNotYetAppliedReadsWithTheNewModesMotionBits) {

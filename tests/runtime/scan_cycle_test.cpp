@@ -14,7 +14,10 @@
 #include "plant/plant_adapter.hpp"
 #include "runtime/recorder.hpp"
 #include "sim/closed_loop.hpp"
+#include "../support/physics_identified_model.hpp"
 #include "../support/temp_path.hpp"
+#include "core/model_file.hpp"
+#include "plant/stick_slip_model.hpp"
 #include "paper_loop.hpp"
 
 namespace epa::runtime {
@@ -339,6 +342,48 @@ TEST(ScanCycle, AHuntingPpTrajArrivesWhileSlidingInsteadAndEndsInPosition) {
   EXPECT_NEAR(end.position_mm, 100.0, config.in_position_window_mm);
   EXPECT_EQ(end.valve_v, 0.0);
   EXPECT_TRUE(end.axis.in_position);
+}
+
+// A position record's side of approach, on an axis whose model says stick-slip (pp-traj arrives
+// while sliding): from the near side the move never passes its target; asked from above, the
+// piston below the target goes past it and comes down to it.
+struct SlidingAxisRun {
+  double highest_mm = 0.0, end_mm = 0.0;
+};
+SlidingAxisRun record_move_on_a_sliding_axis(double approach_direction) {
+  auto file = *core::parse_model_toml(epa::testing::kPhysicsIdentifiedModelToml, "identified");
+  auto c = control::paper_controller_config(ControllerKind::kPpTraj);
+  c.A = file.model.A, c.B = file.model.B, c.dead_zone = file.model.dead_zone;
+  c.trajectory.coast_s = *plant::sliding_arrival_coast_s(file, 50.0 * c.trajectory.approach_speed_v_s);
+  auto plant = plant::make_pneumatic_simulator({}, {.initial_position_mm = 100.0});
+  auto daq = *hal::SimDaq::make(std::move(*plant));
+  VirtualClock clock;
+  RuntimeConfig config;
+  config.controller = ControllerKind::kPpTraj;
+  config.start_mode = Mode::kRun;
+  LoopChannels ch(8000);
+  ScanCycle loop(config, *make_tuning(c), daq, clock, ch);
+  run_cycles(loop, clock, 20);
+  Command start = control_command(kControlStart);
+  start.value = 150.0;
+  start.approach_direction = approach_direction;
+  EXPECT_TRUE(ch.commands.try_push(start));
+  SlidingAxisRun out;
+  for (int k = 0; k < 1600; ++k) {  // 8 s
+    run_cycles(loop, clock, 1);
+    out.highest_mm = std::max(out.highest_mm, loop.last_snapshot().position_mm);
+  }
+  out.end_mm = loop.last_snapshot().position_mm;
+  return out;
+}
+
+TEST(ScanCycle, ARecordsSideOfApproachIsTheSideItsSlidingArrivalComesFrom) {
+  const SlidingAxisRun near = record_move_on_a_sliding_axis(0.0);
+  EXPECT_LE(near.highest_mm, 151.0) << "from the near side the move passed its target";
+  EXPECT_NEAR(near.end_mm, 150.0, 1.0);
+  const SlidingAxisRun above = record_move_on_a_sliding_axis(-1.0);
+  EXPECT_GT(above.highest_mm, 160.0) << "asked from above, the piston never went above the target";
+  EXPECT_NEAR(above.end_mm, 150.0, 1.0);
 }
 
 TEST(ScanCycle, ShutDownPutsTheValveSafe) {

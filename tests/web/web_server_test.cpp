@@ -507,10 +507,11 @@ TEST_F(WebServerTest, RecordsListTheTableAsTheGateHoldsIt) {
     EXPECT_EQ(r["speed_mm_s"], 0.0);
     EXPECT_EQ(r["window_mm"], 0.0);
     EXPECT_EQ(r["controller"], "running");
+    EXPECT_EQ(r["approach"], "near");
   }
   auto res = post("/api/points",
                   R"({"record3_target_mm": 120.5, "record3_speed_mm_s": 50, "record3_window_mm": 0.5,
-                      "record3_controller": "pp-traj", "record_select": 3, "record4_controller": 1})", "t");
+                      "record3_controller": "pp-traj", "record_select": 3, "record4_controller": 1, "record3_approach": 2})", "t");
   ASSERT_TRUE(res);
   ASSERT_EQ(res->status, 200) << res->body;
   const json after = get_json("/api/records");
@@ -521,6 +522,7 @@ TEST_F(WebServerTest, RecordsListTheTableAsTheGateHoldsIt) {
   EXPECT_DOUBLE_EQ(r3["speed_mm_s"].get<double>(), 50.0);
   EXPECT_DOUBLE_EQ(r3["window_mm"].get<double>(), 0.5);
   EXPECT_EQ(r3["controller"], "pp-traj");
+  EXPECT_EQ(r3["approach"], "from-above");
   EXPECT_EQ(after["records"][3]["controller"], "pp-ngidz");
   EXPECT_EQ(after["records"][1]["target_mm"], 0.0);  // its neighbours untouched
   EXPECT_EQ(after["records"][3]["target_mm"], 0.0);
@@ -530,7 +532,7 @@ TEST_F(WebServerTest, RecordsListTheTableAsTheGateHoldsIt) {
 // nothing; a malformed body is 400 naming what was wrong, before the gate sees it.
 TEST_F(WebServerTest, ARecordIsWrittenAsOneGroupAllOrNothing) {
   start("t");
-  auto ok = post("/api/records", R"({"record": 5, "target_mm": 200, "speed_mm_s": 10, "window_mm": 2, "controller": "pp"})", "t");
+  auto ok = post("/api/records", R"({"record": 5, "target_mm": 200, "speed_mm_s": 10, "window_mm": 2, "controller": "pp", "approach": "from-below"})", "t");
   ASSERT_TRUE(ok);
   ASSERT_EQ(ok->status, 200) << ok->body;
   auto record5 = [this] { return get_json("/api/records")["records"][4]; };
@@ -538,9 +540,11 @@ TEST_F(WebServerTest, ARecordIsWrittenAsOneGroupAllOrNothing) {
   EXPECT_DOUBLE_EQ(record5()["speed_mm_s"].get<double>(), 10.0);
   EXPECT_DOUBLE_EQ(record5()["window_mm"].get<double>(), 2.0);
   EXPECT_EQ(record5()["controller"], "pp");
+  EXPECT_EQ(record5()["approach"], "from-below");
   std::set<std::string> audited;
   for (const auto& e : audit_.entries()) audited.insert(e.point);
-  EXPECT_EQ(audited, (std::set<std::string>{"record5_target_mm", "record5_speed_mm_s", "record5_window_mm", "record5_controller"}));
+  EXPECT_EQ(audited, (std::set<std::string>{"record5_target_mm", "record5_speed_mm_s", "record5_window_mm", "record5_controller",
+                                            "record5_approach"}));
   auto some = post("/api/records", R"({"record": 5, "controller": "running"})", "t");  // the others kept
   ASSERT_TRUE(some);
   ASSERT_EQ(some->status, 200) << some->body;
@@ -552,6 +556,7 @@ TEST_F(WebServerTest, ARecordIsWrittenAsOneGroupAllOrNothing) {
       {R"({"record": 5, "target_mm": 300, "window_mm": 1000})", "record5_window_mm"},
       {R"({"record": 5, "target_mm": 600, "window_mm": 1})", "setpoint range [0, 500]"},
       {R"({"record": 5, "target_mm": 300, "controller": 7})", "record5_controller"},
+      {R"({"record": 5, "target_mm": 300, "approach": 3})", "record5_approach"},
   };
   for (const auto& [body, named] : refused) {
     auto res = post("/api/records", body, "t");
@@ -572,6 +577,7 @@ TEST_F(WebServerTest, ARecordIsWrittenAsOneGroupAllOrNothing) {
       {R"({"record": 5})", "give at least one of"},
       {R"({"record": 5, "target_mm": "far"})", "record5_target_mm must be a number"},
       {R"({"record": 5, "controller": "pp-fast"})", "unknown controller 'pp-fast'"},
+      {R"({"record": 5, "approach": "sideways"})", "unknown approach 'sideways'"},
       {R"([5])", "JSON object"},
   };
   const auto entries_before = audit_.entries().size();
