@@ -45,8 +45,8 @@ def main():
         # The table as text and as JSON.
         r = records()
         lines = r.stdout.splitlines()
-        check(r.returncode == 0 and lines[0].split() == ["record", "target", "mm", "speed", "limit", "mm/s", "window", "mm", "law"]
-              and len(lines) == 34 and lines[1].split() == ["1", "0.000", "no", "limit", "default", "running"]
+        check(r.returncode == 0 and lines[0].split() == ["record", "target", "mm", "speed", "limit", "mm/s", "window", "mm", "law", "approach"]
+              and len(lines) == 34 and lines[1].split() == ["1", "0.000", "no", "limit", "default", "running", "near"]
               and lines[-1].startswith("record_select: 0"),
               f"`epa records` lists 32 records under a header, then record_select (exit {r.returncode}): {r.stdout[:300]!r} {r.stderr!r}")
         r = records("--json")
@@ -55,16 +55,18 @@ def main():
               "`epa records --json` is GET /api/records: 32 records, record_select 0")
 
         # One record set in one request, read back through the API.
-        r = records("set", "3", "--target-mm", "123.5", "--speed-mm-s", "40", "--window-mm", "0.8", "--controller", "pp-traj", "--token", TOKEN)
+        r = records("set", "3", "--target-mm", "123.5", "--speed-mm-s", "40", "--window-mm", "0.8", "--controller", "pp-traj",
+                    "--approach", "from-below", "--token", TOKEN)
         rec3 = table()["records"][2]
-        check(r.returncode == 0 and rec3 == {"record": 3, "target_mm": 123.5, "speed_mm_s": 40.0, "window_mm": 0.8, "controller": "pp-traj"},
+        check(r.returncode == 0 and rec3 == {"record": 3, "target_mm": 123.5, "speed_mm_s": 40.0, "window_mm": 0.8, "controller": "pp-traj",
+                                             "approach": "from-below"},
               f"`epa records set 3 ...` (exit {r.returncode}, {r.stderr.strip()!r}): /api/records has {rec3}")
-        check(any(l.split() == ["3", "123.500", "40.000", "0.800", "pp-traj"] for l in r.stdout.splitlines()),
+        check(any(l.split() == ["3", "123.500", "40.000", "0.800", "pp-traj", "from-below"] for l in r.stdout.splitlines()),
               f"`epa records set` shows the record as the appliance holds it: {r.stdout!r}")
         with urllib.request.urlopen(url + "/api/audit", timeout=5) as a:
             audited = {e["point"] for e in json.load(a)["entries"] if e["source"].startswith("web ")}
-        check({"record3_target_mm", "record3_speed_mm_s", "record3_window_mm", "record3_controller"} <= audited,
-              f"the four writes are in the audit trail from the web: {sorted(audited)}")
+        check({"record3_target_mm", "record3_speed_mm_s", "record3_window_mm", "record3_controller", "record3_approach"} <= audited,
+              f"the five writes are in the audit trail from the web: {sorted(audited)}")
 
         # A refused value: the appliance's words, and nothing of the request applied.
         r = records("set", "3", "--target-mm", "900", "--speed-mm-s", "10", "--token", TOKEN)
