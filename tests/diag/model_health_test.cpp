@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "../support/physics_identified_model.hpp"
+#include "../support/pp_traj_on_model.hpp"
 #include "control/controller.hpp"
 #include "control/paper_controller.hpp"
 #include "core/model_file.hpp"
@@ -25,14 +26,7 @@ core::ModelFile health_model_file() {
   return *f;
 }
 
-control::ControllerParams health_law(const core::ModelFile& f) {
-  auto c = control::paper_controller_config(control::ControllerKind::kPpTraj);
-  c.A = f.model.A;
-  c.B = f.model.B;
-  c.dead_zone = f.model.dead_zone;
-  c.trajectory.coast_s = *plant::sliding_arrival_coast_s(f, 50.0 * c.trajectory.approach_speed_v_s);
-  return *control::ControllerParams::make(c);
-}
+control::ControllerParams health_law(const core::ModelFile& f) { return *control::ControllerParams::make(testing::pp_traj_config_on(f)); }
 
 // Moves between seeded random targets on the stick-slip model `plant_params`, changed to `changed`
 // after change_at moves; each move's run handed to `health`. Returns the move (counted from the

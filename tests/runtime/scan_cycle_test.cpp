@@ -15,9 +15,9 @@
 #include "runtime/recorder.hpp"
 #include "sim/closed_loop.hpp"
 #include "../support/physics_identified_model.hpp"
+#include "../support/pp_traj_on_model.hpp"
 #include "../support/temp_path.hpp"
 #include "core/model_file.hpp"
-#include "plant/stick_slip_model.hpp"
 #include "paper_loop.hpp"
 
 namespace epa::runtime {
@@ -352,9 +352,7 @@ struct SlidingAxisRun {
 };
 SlidingAxisRun record_move_on_a_sliding_axis(double approach_direction) {
   auto file = *core::parse_model_toml(epa::testing::kPhysicsIdentifiedModelToml, "identified");
-  auto c = control::paper_controller_config(ControllerKind::kPpTraj);
-  c.A = file.model.A, c.B = file.model.B, c.dead_zone = file.model.dead_zone;
-  c.trajectory.coast_s = *plant::sliding_arrival_coast_s(file, 50.0 * c.trajectory.approach_speed_v_s);
+  const auto c = epa::testing::pp_traj_config_on(file);
   auto plant = plant::make_pneumatic_simulator({}, {.initial_position_mm = 100.0});
   auto daq = *hal::SimDaq::make(std::move(*plant));
   VirtualClock clock;

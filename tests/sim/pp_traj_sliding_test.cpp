@@ -13,6 +13,7 @@
 
 #include "../support/physics_coast.hpp"
 #include "../support/physics_identified_model.hpp"
+#include "../support/pp_traj_on_model.hpp"
 #include "control/paper_controller.hpp"
 #include "control/sliding_approach.hpp"
 #include "core/model_file.hpp"
@@ -33,14 +34,7 @@ core::ModelFile identified() {
 }
 
 control::ControllerParams pp_traj_for(const core::ModelFile& f) {
-  auto c = control::paper_controller_config(control::ControllerKind::kPpTraj);
-  c.A = f.model.A;
-  c.B = f.model.B;
-  c.dead_zone = f.model.dead_zone;
-  const auto coast = plant::sliding_arrival_coast_s(f, 50.0 * c.trajectory.approach_speed_v_s);
-  EXPECT_TRUE(coast.has_value());
-  c.trajectory.coast_s = coast ? *coast : 0.0;
-  auto p = control::ControllerParams::make(c);
+  auto p = control::ControllerParams::make(epa::testing::pp_traj_config_on(f));
   EXPECT_TRUE(p.has_value()) << (p ? "" : p.error().message);
   return *p;
 }
