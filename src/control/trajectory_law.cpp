@@ -125,23 +125,22 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   p.creep_margin_v = c.creep_margin_v;
   p.creep_margin_step_v = c.creep_margin_v / std::max(1.0, std::round(c.creep_blend_s / Ts));
   p.integrator_limit = std::max(dz.m_r * (valve_limit_v - dz.b_r), dz.m_l * (valve_limit_v + dz.b_l));
+  // The sliding arrival: the law's own when coast_s > 0, else (coast_s 0) only its fallback's.
   p.sliding_approach = c.coast_s > 0.0;
-  {
-    p.approach.coast_s = p.sliding_approach ? c.coast_s : kFallbackCoastS;
-    p.approach.dead_length_v = c.coast_dead_length_v;
-    p.approach.speed_v_s = c.approach_speed_v_s;
-    p.approach.length_v = c.approach_length_v;
-    p.approach.decel_v_s2 = c.approach_decel_v_s2;
-    p.approach.top_speed_pos_v_s = p.limits.speed_pos_v_s;
-    p.approach.top_speed_neg_v_s = p.limits.speed_neg_v_s;
-    p.approach.accel_v_s2 = p.limits.accel_v_s2;
-    p.approach.retry_band_v = c.retry_band_v;
-    p.approach.max_retries = static_cast<int>(c.max_retries);
-    p.approach.settle_samples = static_cast<std::size_t>(std::max(1.0, std::round(c.approach_settle_s / Ts)));
-    p.approach.Ts = Ts;
-    p.approach.travel_min_v = c.travel_min_v;
-    p.approach.travel_max_v = c.travel_max_v;
-  }
+  p.approach.coast_s = c.coast_s;
+  p.approach.dead_length_v = c.coast_dead_length_v;
+  p.approach.speed_v_s = c.approach_speed_v_s;
+  p.approach.length_v = c.approach_length_v;
+  p.approach.decel_v_s2 = c.approach_decel_v_s2;
+  p.approach.top_speed_pos_v_s = p.limits.speed_pos_v_s;
+  p.approach.top_speed_neg_v_s = p.limits.speed_neg_v_s;
+  p.approach.accel_v_s2 = p.limits.accel_v_s2;
+  p.approach.retry_band_v = c.retry_band_v;
+  p.approach.max_retries = static_cast<int>(c.max_retries);
+  p.approach.settle_samples = static_cast<std::size_t>(std::max(1.0, std::round(c.approach_settle_s / Ts)));
+  p.approach.Ts = Ts;
+  p.approach.travel_min_v = c.travel_min_v;
+  p.approach.travel_max_v = c.travel_max_v;
   p.fallback_approach = p.approach;
   p.fallback_approach.coast_s = kFallbackCoastS;
   return p;

@@ -148,7 +148,7 @@ struct TrajectoryOutput {
 };
 
 // A law that arrives through its integrator hunted about a standing target: from here on it
-// arrives while sliding instead (sliding_approach.hpp), planning afresh from y_v, with the coast
+// arrives while sliding instead (sliding_approach.hpp), planning afresh at its next step, with the coast
 // first guessed (kFallbackCoastS) and then learned from its stops. Without a stick-slip model the
 // integrator cannot place a sticking piston; a steady slide cut at its predicted stop can, and its
 // retries are bounded, so it cannot hunt.
