@@ -1,7 +1,7 @@
 // The model-health monitor (diag/model_health.hpp) against the physics plant, faster than real
 // time: an axis commissioned by `epa identify` (the model file given) makes moves between random
 // targets with pp-traj designed on that model, as the appliance would, each move recorded from its
-// start for move_s seconds; after `change_at` moves (24) one physical parameter changes
+// start for move_s seconds; after `change_at` moves (32) one physical parameter changes
 // (plant/pneumatic_params.hpp keys, as `epa plant-server`'s `physics` lines), and every move is
 // handed to the monitor. Prints each state change, then one line per case:
 //
@@ -67,7 +67,7 @@ control::ControllerParams law_for(const core::ModelFile& f, control::ControllerK
 int main(int argc, char** argv) {
   CLI::App app{"The model-health monitor on the physics plant, one change at a time"};
   std::string model_path, only, law = "pp-traj";
-  int seeds = 1, moves = 60, change_at = 24;
+  int seeds = 1, moves = 70, change_at = 32;
   double move_s = 2.5, noise_mm = 0.1;
   app.add_option("model", model_path, "epa-model/1 file with [stick_slip] (epa identify)")->required();
   app.add_option("--case", only, "one case by name");
@@ -86,6 +86,7 @@ int main(int argc, char** argv) {
   app.add_option("--confirm", hc.confirm_windows, "the monitor's confirm_windows");
   app.add_option("--min-reduction", hc.min_reduction, "the monitor's min_reduction");
   app.add_option("--span", hc.span_s, "the monitor's span_s");
+  app.add_option("--spread-margin", hc.spread_margin, "the monitor's spread_margin");
   CLI11_PARSE(app, argc, argv);
   auto file = core::read_model_file(model_path);
   if (!file || !file->stick_slip) {

@@ -35,7 +35,7 @@ enum class HealthState { kOff, kLearning, kOk, kDrifting, kUnexplained, kHunting
 const char* to_string(HealthState state);  // "off", "learning", "ok", "drifting", "unexplained", "hunting"
 
 struct HealthConfig {
-  std::size_t baseline_moves = 16;  // moves the baseline is fitted on (at least window_moves)
+  std::size_t baseline_moves = 24;  // moves the baseline is fitted on (at least window_moves): its 5 windows give the scatter
   std::size_t window_moves = 8;    // moves each later judgement is fitted on
   int confirm_windows = 2;         // judgements in a row that must agree before the state changes
   double min_reduction = 0.25;     // a change must shrink the window's gap by this share of it

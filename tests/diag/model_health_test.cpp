@@ -85,10 +85,10 @@ TEST(ModelHealth, ItLearnsABaselineFirstThenJudgesAnUnchangedAxisOk) {
   auto health = ModelHealth::make(p, kHealthTs, 500.0, {});
   ASSERT_TRUE(health.has_value()) << health.error().message;
   EXPECT_EQ(health->verdict().state, HealthState::kLearning);
-  const HealthRun r = run_moves(*health, p, p, 1000, 30, std::nullopt, 1);
+  const HealthRun r = run_moves(*health, p, p, 1000, 40, std::nullopt, 1);
   EXPECT_EQ(r.alarms_before_change, 0);
   EXPECT_EQ(health->verdict().state, HealthState::kOk);
-  EXPECT_EQ(health->verdict().moves_seen, 30u);
+  EXPECT_EQ(health->verdict().moves_seen, 40u);
   EXPECT_EQ(health->verdict().estimates.size(), std::size(kAxisChanges));
   health->retake_baseline();
   EXPECT_EQ(health->verdict().state, HealthState::kLearning);
@@ -101,7 +101,7 @@ TEST(ModelHealth, FrictionDoubledOnTheModelsOwnFormIsNamedWithItsSize) {
   changed.static_mm *= 2.0, changed.coulomb_mm *= 2.0;
   auto health = ModelHealth::make(p, kHealthTs, 500.0, {});
   ASSERT_TRUE(health.has_value());
-  const HealthRun r = run_moves(*health, p, changed, 20, 50, plant::EffectKind::kStaticFriction, 2);
+  const HealthRun r = run_moves(*health, p, changed, 28, 60, plant::EffectKind::kStaticFriction, 2);
   EXPECT_EQ(r.alarms_before_change, 0);
   ASSERT_GE(r.named_after, 0) << "friction x2 was never named";
   EXPECT_LE(r.named_after, 20);
@@ -114,7 +114,7 @@ TEST(ModelHealth, AFlowGainDownOnTheModelsOwnFormIsNamedDown) {
   changed.speed_right_mm_s_per_v *= 0.7, changed.speed_left_mm_s_per_v *= 0.7;
   auto health = ModelHealth::make(p, kHealthTs, 500.0, {});
   ASSERT_TRUE(health.has_value());
-  const HealthRun r = run_moves(*health, p, changed, 20, 50, plant::EffectKind::kGainChange, 3);
+  const HealthRun r = run_moves(*health, p, changed, 28, 60, plant::EffectKind::kGainChange, 3);
   ASSERT_GE(r.named_after, 0) << "a flow gain x0.7 was never named";
   EXPECT_LT(r.ratio_named, 0.9);
 }
