@@ -256,7 +256,6 @@ void ModelHealth::judge() {
   verdict_.estimates.clear();
   std::optional<EffectEstimate> best;
   core::StickSlipParams best_model = baseline_;
-  AxisChange best_change;
   for (const EffectKind kind : kAxisChanges) {
     const ChangeFit fit = fit_change(data, {kind});
     fits_ += fit.evaluations;
@@ -269,7 +268,7 @@ void ModelHealth::judge() {
     e.reduction = gap_mm > 0.0 ? std::max(0.0, (gap_mm - fit.train_gap_mm) / gap_mm) : 0.0;
     e.beyond_tolerance = size_of(kind, changed, baseline_) > tolerance_[index_of(kind)];
     verdict_.estimates.push_back(e);
-    if (e.beyond_tolerance && (!best || e.reduction > best->reduction)) best = e, best_model = changed, best_change = fit.change;
+    if (e.beyond_tolerance && (!best || e.reduction > best->reduction)) best = e, best_model = changed;
   }
 
   // This judgement's reading, then whether enough judgements in a row agree on it.
