@@ -45,6 +45,20 @@ core::StickSlipParams apply_change(const core::StickSlipParams& commissioned, co
   return p;
 }
 
+AxisChange change_between(EffectKind kind, const core::StickSlipParams& from, const core::StickSlipParams& to) {
+  AxisChange change;
+  change.kinds = {kind};
+  change.delay_samples = to.delay_samples;
+  switch (kind) {
+    case EffectKind::kStaticFriction: change.values = {{to.static_mm / from.static_mm}}; break;
+    case EffectKind::kGainChange: change.values = {{to.speed_right_mm_s_per_v / from.speed_right_mm_s_per_v}}; break;
+    case EffectKind::kDeadzoneShift: change.values = {{to.break_right_v - from.break_right_v, to.break_left_v - from.break_left_v}}; break;
+    case EffectKind::kValveLag: change.values = {{to.spool_lag_s}}; break;
+    default: change.values = {{}}; break;
+  }
+  return change;
+}
+
 double change_size(EffectKind kind, const AxisChange& change, const core::StickSlipParams& c) {
   if (kind == EffectKind::kInputDelay) return std::abs(change.delay_samples - c.delay_samples);
   const auto* v = change.values_of(kind);

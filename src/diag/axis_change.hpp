@@ -41,6 +41,9 @@ struct AxisChange {
 
 // The commissioned model with the changes applied.
 core::StickSlipParams apply_change(const core::StickSlipParams& commissioned, const AxisChange& change);
+// The change of `kind` that takes `from` to `to` in that kind's terms (its inverse of apply_change):
+// a model fitted from another one, described against the first.
+AxisChange change_between(plant::EffectKind kind, const core::StickSlipParams& from, const core::StickSlipParams& to);
 
 // Whether the change of `kind` lies beyond what the commissioned model's own uncertainty allows:
 // beyond kSpreadMargin times the spread of its terms over parts of its identification runs, and

@@ -67,21 +67,7 @@ Term term_of(EffectKind kind, const core::StickSlipParams& p) {
   }
 }
 
-// How far `changed` lies from `baseline` in the term of `kind`: a log ratio (friction, flow gain),
-// volts (the break point that moved most), seconds (the spool's lag), samples (the dead time).
-double size_of(EffectKind kind, const core::StickSlipParams& changed, const core::StickSlipParams& baseline) {
-  switch (kind) {
-    case EffectKind::kStaticFriction: return std::abs(std::log(changed.static_mm / baseline.static_mm));
-    case EffectKind::kGainChange: return std::abs(std::log(changed.speed_right_mm_s_per_v / baseline.speed_right_mm_s_per_v));
-    case EffectKind::kDeadzoneShift:
-      return std::max(std::abs(changed.break_right_v - baseline.break_right_v), std::abs(changed.break_left_v - baseline.break_left_v));
-    case EffectKind::kValveLag: return std::abs(changed.spool_lag_s - baseline.spool_lag_s);
-    case EffectKind::kInputDelay: return std::abs(changed.delay_samples - baseline.delay_samples);
-    default: return 0.0;
-  }
-}
-
-// The smallest change of `kind` ever named, in size_of's units.
+// The smallest change of `kind` ever named, in change_size's units (axis_change.hpp).
 double floor_of(const HealthConfig& c, EffectKind kind) {
   switch (kind) {
     case EffectKind::kStaticFriction: return std::log1p(c.friction_ratio_tolerance);
@@ -95,28 +81,6 @@ double floor_of(const HealthConfig& c, EffectKind kind) {
 
 std::size_t index_of(EffectKind kind) {
   return static_cast<std::size_t>(std::find(std::begin(kAxisChanges), std::end(kAxisChanges), kind) - std::begin(kAxisChanges));
-}
-
-std::string percent(double ratio) {
-  const double pct = std::round(std::abs(ratio - 1.0) * 100.0);
-  return std::string(ratio >= 1.0 ? "up " : "down ") + core::format_number(pct) + " %";
-}
-
-// The change in words, against the commissioned model.
-std::string describe(EffectKind kind, const core::StickSlipParams& changed, const core::StickSlipParams& commissioned) {
-  const auto v = [](double x, double scale) { return core::format_number(std::round(x * scale) / scale); };
-  switch (kind) {
-    case EffectKind::kStaticFriction: return "friction " + percent(changed.static_mm / commissioned.static_mm);
-    case EffectKind::kGainChange: return "flow gain " + percent(changed.speed_right_mm_s_per_v / commissioned.speed_right_mm_s_per_v) + " (supply or valve)";
-    case EffectKind::kDeadzoneShift:
-      return "dead band moved: right break point " + v(changed.break_right_v - commissioned.break_right_v, 100) + " V, left " +
-             v(changed.break_left_v - commissioned.break_left_v, 100) + " V";
-    case EffectKind::kValveLag:
-      return "spool lag " + v(changed.spool_lag_s * 1000.0, 10) + " ms (commissioned " + v(commissioned.spool_lag_s * 1000.0, 10) + " ms)";
-    case EffectKind::kInputDelay:
-      return "dead time " + std::to_string(changed.delay_samples) + " samples (commissioned " + std::to_string(commissioned.delay_samples) + ")";
-    default: return "";
-  }
 }
 
 }  // namespace
@@ -218,7 +182,7 @@ void ModelHealth::fit_baseline() {
       const ChangeFit fit = fit_change(window_data, {kind});
       fits_ += fit.evaluations;
       double& t = tolerance_[index_of(kind)];
-      t = std::max(t, config_.spread_margin * size_of(kind, apply_change(baseline_, fit.change), baseline_));
+      t = std::max(t, config_.spread_margin * change_size(kind, fit.change, baseline_));
     }
   }
   moves_ = all;
@@ -266,7 +230,7 @@ void ModelHealth::judge() {
     e.commissioned = term_of(kind, commissioned_).value;
     e.ratio = e.commissioned != 0.0 ? e.value / e.commissioned : 1.0;
     e.reduction = gap_mm > 0.0 ? std::max(0.0, (gap_mm - fit.train_gap_mm) / gap_mm) : 0.0;
-    e.beyond_tolerance = size_of(kind, changed, baseline_) > tolerance_[index_of(kind)];
+    e.beyond_tolerance = change_size(kind, fit.change, baseline_) > tolerance_[index_of(kind)];
     verdict_.estimates.push_back(e);
     if (e.beyond_tolerance && (!best || e.reduction > best->reduction)) best = e, best_model = changed;
   }
@@ -302,7 +266,7 @@ void ModelHealth::judge() {
     verdict_.unit = t.unit;
     verdict_.commissioned = term_of(*effect, commissioned_).value;
     verdict_.ratio = verdict_.commissioned != 0.0 ? verdict_.value / verdict_.commissioned : 1.0;
-    verdict_.size = describe(*effect, best_model, commissioned_);
+    verdict_.size = describe_change(*effect, change_between(*effect, commissioned_, best_model), commissioned_);  // as the diagnosis words it
   } else {
     verdict_.value = verdict_.commissioned = 0.0;
     verdict_.ratio = 1.0;
