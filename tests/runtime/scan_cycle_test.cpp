@@ -276,21 +276,32 @@ TEST(ScanCycle, SwitchingLawsOnThePhysicsPlantDoesNotStepTheValve) {
   }
 }
 
+// The physics plant (stiction) at 0 mm with 0.1 mm of noise, `law` on the paper's tuning, in RUN
+// with a move to 100 mm: a law whose model knows no friction.
+struct PhysicsRunTo100 {
+  explicit PhysicsRunTo100(ControllerKind law)
+      : daq(*hal::SimDaq::make(plant::make_pneumatic_simulator({}, {.initial_position_mm = 0.0, .noise_std_mm = 0.1, .seed = 3}).value())),
+        ch(8000) {
+    config.controller = law;
+    config.start_mode = Mode::kRun;
+    config.start_moves_to_setpoint = true;
+    config.start_setpoint_mm = 100.0;
+    loop = std::make_unique<ScanCycle>(config, paper_tuning(), daq, clock, ch);
+  }
+  hal::SimDaq daq;
+  VirtualClock clock;
+  RuntimeConfig config;
+  LoopChannels ch;
+  std::unique_ptr<ScanCycle> loop;
+};
+
 // pp-ngidz with the paper's model hunts on the physics plant's stiction; the loop shows the law's
 // hold against it (the axis view's hunting, status bit 13), with the valve centred, until the next
 // start or target.
 TEST(ScanCycle, AHuntingLawIsHeldAndTheStatusSaysSoUntilTheNextTarget) {
-  auto plant = plant::make_pneumatic_simulator({}, {.initial_position_mm = 0.0, .noise_std_mm = 0.1, .seed = 3});
-  ASSERT_TRUE(plant);
-  auto daq = *hal::SimDaq::make(std::move(*plant));
-  VirtualClock clock;
-  RuntimeConfig config;
-  config.controller = ControllerKind::kPpNgidz;
-  config.start_mode = Mode::kRun;
-  config.start_moves_to_setpoint = true;
-  config.start_setpoint_mm = 100.0;
-  LoopChannels ch(8000);
-  ScanCycle loop(config, paper_tuning(), daq, clock, ch);
+  PhysicsRunTo100 rig(ControllerKind::kPpNgidz);
+  auto& [daq, clock, config, ch, loop_ptr] = rig;
+  ScanCycle& loop = *loop_ptr;
   int held_at = -1;
   for (int k = 0; k < 4000 && held_at < 0; ++k) {  // 20 s
     run_cycles(loop, clock, 1);
@@ -321,17 +332,9 @@ TEST(ScanCycle, AHuntingLawIsHeldAndTheStatusSaysSoUntilTheNextTarget) {
 // pp-traj with the paper's model hunts there too, and then arrives while sliding instead of
 // being held: it ends within the in-position window, the status saying neither hunting nor off target.
 TEST(ScanCycle, AHuntingPpTrajArrivesWhileSlidingInsteadAndEndsInPosition) {
-  auto plant = plant::make_pneumatic_simulator({}, {.initial_position_mm = 0.0, .noise_std_mm = 0.1, .seed = 3});
-  ASSERT_TRUE(plant);
-  auto daq = *hal::SimDaq::make(std::move(*plant));
-  VirtualClock clock;
-  RuntimeConfig config;
-  config.controller = ControllerKind::kPpTraj;
-  config.start_mode = Mode::kRun;
-  config.start_moves_to_setpoint = true;
-  config.start_setpoint_mm = 100.0;
-  LoopChannels ch(8000);
-  ScanCycle loop(config, paper_tuning(), daq, clock, ch);
+  PhysicsRunTo100 rig(ControllerKind::kPpTraj);
+  auto& [daq, clock, config, ch, loop_ptr] = rig;
+  ScanCycle& loop = *loop_ptr;
   bool ever_held = false;
   for (int k = 0; k < 3000; ++k) {  // 15 s
     run_cycles(loop, clock, 1);
