@@ -20,7 +20,6 @@ bench="$build/bench/health_drift"
 [ -x "$epa" ] && [ -x "$bench" ] || { echo "health_drift: build $epa and $bench first" >&2; exit 1; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-for seed in 1 2 3; do "$epa" excite --plant physics --seed "$seed" --duration 30 --out "$work/ex$seed.csv" >/dev/null; done
-"$epa" identify "$work/ex1.csv" "$work/ex2.csv" --validate "$work/ex3.csv" --out "$work/model.toml" >"$work/identify.log" 2>&1 ||
-  { echo "health_drift: epa identify failed:" >&2; cat "$work/identify.log" >&2; exit 1; }
-"$bench" "$work/model.toml" --seeds "$seeds" --moves "$moves" "$@"
+source bench/physics_axis.sh
+commission_physics_axis "$epa" "$work" health_drift
+"$bench" "$work/physics-model.toml" --seeds "$seeds" --moves "$moves" "$@"

@@ -18,16 +18,15 @@ epa="$build/src/app/epa"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-for seed in 1 2 3; do "$epa" excite --plant physics --seed "$seed" --duration 30 --out "$work/ex$seed.csv" >/dev/null; done
-"$epa" identify "$work/ex1.csv" "$work/ex2.csv" --validate "$work/ex3.csv" --out "$work/model.toml" >"$work/identify.log" 2>&1 ||
-  { echo "pp_traj_no_pass: epa identify failed:" >&2; cat "$work/identify.log" >&2; exit 1; }
+source bench/physics_axis.sh
+commission_physics_axis "$epa" "$work" pp_traj_no_pass
 
 if [ "$mode" = fast ]; then sizes="10 20 100"; else sizes=$(seq 10 5 200); fi
 up=$(for s in $sizes; do printf '%s,' "$s"; done)
 down=$(for s in $sizes; do printf '%s,' "-$s"; done)
 moves() {  # moves START STEPS: one epa simulate run per step, run files into $work/START
   mkdir -p "$work/from$1"
-  "$epa" simulate --plant physics --model "$work/model.toml" --controller pp-traj --start "$1" --steps "${2%,}" --duration 8 \
+  "$epa" simulate --plant physics --model "$work/physics-model.toml" --controller pp-traj --start "$1" --steps "${2%,}" --duration 8 \
     --out-dir "$work/from$1" >"$work/from$1.log" 2>&1 || { echo "pp_traj_no_pass: epa simulate failed:" >&2; cat "$work/from$1.log" >&2; exit 1; }
 }
 moves 0 "$up"

@@ -19,6 +19,7 @@ epa="$build/src/app/epa"
 [ -x "$epa" ] || { echo "pp_traj_tables: $epa is not built" >&2; exit 1; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+source bench/physics_axis.sh
 
 sim() {  # sim NAME ARGS...: one epa simulate run, its JSON kept as NAME.json
   local name=$1
@@ -36,10 +37,7 @@ if [ "$mode" != fast ]; then
   sim narrower --controller pp-traj --break-point-error -0.1
   sim lag --controller pp-traj --valve-lag 0.02
   sim delay --controller pp-traj --delay 1
-  # A model of the physics plant as commissioning would identify it: two experiments, a third to validate.
-  for seed in 1 2 3; do "$epa" excite --plant physics --seed "$seed" --duration 30 --out "$work/ex$seed.csv" >/dev/null; done
-  "$epa" identify "$work/ex1.csv" "$work/ex2.csv" --validate "$work/ex3.csv" --out "$work/physics-model.toml" >"$work/identify.log" 2>&1 ||
-    { echo "pp_traj_tables: epa identify failed:" >&2; cat "$work/identify.log" >&2; exit 1; }
+  commission_physics_axis "$epa" "$work" pp_traj_tables  # bench/physics_axis.sh: $work/physics-model.toml
   for start in 100 250 400; do
     for delay in 0 2; do
       sim "phys_ff_${start}_$delay" --plant physics --controller pp-ffidz --start "$start" --steps 25,50,100,-25,-50,-100 --duration 5 --delay "$delay"
