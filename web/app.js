@@ -1,5 +1,5 @@
 // The status page: polls /api/status and /api/trend every 250 ms, the slower-changing
-// /api/moves, /api/tuning, /api/audit and /api/faults every 2 s, and draws with Chart.js (Debian's
+// /api/moves, /api/tuning, /api/audit, /api/health and /api/faults every 2 s, and draws with Chart.js (Debian's
 // libjs-chart.js, served at /vendor/chart.js). No build step.
 "use strict";
 
@@ -11,7 +11,7 @@ const fmt = (v, digits = 2) => (v === null || v === undefined || !Number.isFinit
 const num = (v, digits = 2) => (v === null || v === undefined || !Number.isFinite(v)) ? "–" : v.toFixed(digits);
 const setText = (id, text) => { const e = $(id); if (e && e.textContent !== text) e.textContent = text; };
 
-let positionChart = null, valveChart = null;
+let positionChart = null, valveChart = null, healthChart = null;
 
 function makeCharts() {
   if (typeof Chart === "undefined") return;  // Chart.js missing: numbers only
@@ -42,6 +42,37 @@ function makeCharts() {
                plugins: { legend: { labels: { boxWidth: 12, filter: (item) => item.text !== "dead zone b_l" } } } },
   });
   valveChart.data.datasets[1].label = "dead zone [b_l, b_r]";
+  healthChart = new Chart($("health-chart"), {
+    type: "line",
+    data: { datasets: HEALTH_EFFECTS.map(([, label, color]) => ({ label, data: [], borderColor: color })) },
+    options: { ...common, scales: { x: { type: "linear", title: { display: true, text: "move" }, ticks: { maxTicksLimit: 8 } },
+                                    y: { title: { display: true, text: "ratio to commissioned" } } } },
+  });
+}
+
+// The effects the monitor estimates, as /api/health names them, with the chart's label and colour.
+const HEALTH_EFFECTS = [["static_friction", "friction", "#c62828"], ["gain_change", "flow gain", "#1f5fbf"],
+  ["deadzone_shift", "dead band", "#b7791f"], ["valve_lag", "spool lag", "#2e7d32"], ["input_delay", "dead time", "#6a1b9a"]];
+
+// Model health (GET /api/health): the verdict, and each effect's estimate over the judged moves.
+function showHealth(h) {
+  const card = $("health");
+  card.dataset.state = h.state;
+  const badge = $("h-state");
+  setText("h-state", h.state);
+  badge.className = "badge health-" + h.state;
+  setText("h-size", h.size || (h.state === "ok" ? "nothing beyond its tolerance" : "–"));
+  setText("h-ratio", h.ratio === null ? "–" : `${num(h.ratio, 2)} (${num(h.value, 3)} ${h.unit}, commissioned ${num(h.commissioned, 3)})`);
+  setText("h-moves", `${h.moves_since_onset} / ${h.moves_seen}` + (h.moves_dropped ? ` (${h.moves_dropped} not judged: busy)` : ""));
+  setText("h-reason", h.reason);
+  if (!healthChart) return;
+  HEALTH_EFFECTS.forEach(([effect], i) => {
+    healthChart.data.datasets[i].data = h.trend.map((j) => {
+      const e = j.estimates.find((x) => x.effect === effect);
+      return { x: j.move, y: e ? e.ratio : null };
+    });
+  });
+  healthChart.update("none");
 }
 
 async function getJson(path) {
@@ -255,10 +286,11 @@ async function fast() {
 
 async function slow() {
   try {
-    const [m, t, a] = await Promise.all([getJson("/api/moves"), getJson("/api/tuning"), getJson("/api/audit")]);
+    const [m, t, a, h] = await Promise.all([getJson("/api/moves"), getJson("/api/tuning"), getJson("/api/audit"), getJson("/api/health")]);
     showMoves(m);
     showTuning(t);
     showAudit(a);
+    showHealth(h);
   } catch (e) {
     // the fast poll shows the connection state
   } finally {

@@ -11,6 +11,8 @@
 #include "appliance/run_history.hpp"
 #include "appliance/throttled_log.hpp"
 #include "hal/realtime.hpp"
+#include "store/set_activation.hpp"
+#include "store/store_file.hpp"
 
 namespace epa::appliance {
 
@@ -36,6 +38,16 @@ runtime::RecorderConfig recorder_config(const config::ApplianceConfig& c) {
           .min_free_bytes = mib_to_bytes(c.store_min_free_mb)};
 }
 
+// The running set's model, as the health monitor follows it (read from the store's file: the
+// monitor's thread has no other way in).
+core::Result<MonitoredModel> monitored_model(const std::string& store_path, std::int64_t set_id) {
+  auto db = store::open_existing_store(store_path);
+  if (!db) return db.error();
+  auto loaded = store::find_set_with_model(*db, std::to_string(set_id));
+  if (!loaded) return loaded.error();
+  return MonitoredModel{loaded->set.name, loaded->model.stick_slip, loaded->model.model.Ts};
+}
+
 }  // namespace
 
 Axis::Axis(const config::ApplianceConfig& config, const ControlSetup& control, points::WriteLimits limits,
@@ -59,6 +71,11 @@ Axis::Axis(const config::ApplianceConfig& config, const ControlSetup& control, p
       make_axis, services_.identify, services_.render_report, commissioning_bounds(gate_.limits()),
       [](const std::string& line) { spdlog::info("{}", line); }, &services_.audit);
   gate_.attach_commission(commissioning_.get());
+  health_ = std::make_unique<HealthMonitor>(
+      config_.health, [this] { return services_.store.running_set().id; },
+      [this](std::int64_t set_id) { return monitored_model(config_.store_path, set_id); }, &services_.audit,
+      [](bool warning, const std::string& line) { warning ? spdlog::warn("{}", line) : spdlog::info("{}", line); });
+  gate_.attach_health(health_.get());
 }
 
 Axis::~Axis() {
@@ -81,6 +98,7 @@ void Axis::start_recorder() {
       [this](const std::string& path, const core::Run& run) {
         services_.store.record_run(to_run_record(path, run));
         recorded_.put(path, run);
+        health_->add_run(run, channels_.snapshot.read().axis.hunting);
       });
   recorder_->start();
 }
@@ -96,6 +114,8 @@ void Axis::stop() {
   stop_loop();
   take_fault_events();                 // latched since the supervisor's last look
   if (recorder_) recorder_->stop();    // writes what is pending
+  gate_.attach_health(nullptr);
+  health_.reset();                     // moves still queued are not judged
 }
 
 // From the loop's events, never from the snapshot (a reset in the next cycle has cleared the

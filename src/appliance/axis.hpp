@@ -1,8 +1,8 @@
 #pragma once
 // One axis of the appliance: its scan cycle on its own (real-time if allowed) thread, the channels
 // every other thread meets it through, the write gate every interface writes through, the run
-// recorder, the commissioning service, and the intake that moves the faults it latches into the
-// history and the store. Built from the parsed configuration and the store's tuning; a second
+// recorder, the commissioning service, the model-health monitor that judges the recorded moves,
+// and the intake that moves the faults it latches into the history and the store. Built from the parsed configuration and the store's tuning; a second
 // axis is a second instance with its own DAQ.
 #include <atomic>
 #include <memory>
@@ -12,6 +12,7 @@
 
 #include "appliance/commissioning_service.hpp"
 #include "appliance/control_setup.hpp"
+#include "appliance/health_monitor.hpp"
 #include "appliance/recorded_runs.hpp"
 #include "config/appliance_config.hpp"
 #include "core/audit.hpp"
@@ -77,6 +78,7 @@ class Axis {
   points::WriteGate gate_;
   RecordedRuns recorded_;
   std::unique_ptr<CommissioningService> commissioning_;
+  std::unique_ptr<HealthMonitor> health_;
   std::optional<runtime::Recorder> recorder_;
 };
 

@@ -336,6 +336,21 @@ void read_excite(TableReader& top, ApplianceConfig& c) {
   ex.refuse_unknown_keys();
 }
 
+void read_health(TableReader& top, ApplianceConfig& c) {
+  auto& h = c.health;
+  auto& e = h.estimator;
+  TableReader he = top.section("health");
+  he.boolean("enabled", h.enabled);
+  he.number("stroke_mm", h.stroke_mm, closed(1, 100000, "mm"));
+  he.integer("baseline_moves", e.baseline_moves, 2, 100);
+  he.integer("window_moves", e.window_moves, 2, 100);
+  he.integer("confirm_windows", e.confirm_windows, 1, 20);
+  he.number("min_reduction", e.min_reduction, closed(0.01, 0.99, ""));
+  he.number("spread_margin", e.spread_margin, closed(1, 10, ""));
+  he.number("unexplained_gap_ratio", e.unexplained_gap_ratio, closed(1.01, 100, ""));
+  he.refuse_unknown_keys();
+}
+
 void read_store(TableReader& top, ApplianceConfig& c) {
   TableReader st = top.section("store");
   st.text("path", c.store_path);
@@ -438,6 +453,7 @@ core::Status check_across_sections(ApplianceConfig& c, const std::string& file) 
     client = core::ip_text(ip->storage);  // ::0:1 is ::1
   }
   if (auto s = runtime::validate(c.runtime); !s) return core::invalid_argument(file + ": " + s.error().message);
+  if (const auto p = c.health.estimator.problem(); !p.empty()) return core::invalid_argument(file + ": [health] " + p);
   if (c.backend == HalBackend::kModbusIo)
     if (auto s = hal::validate(c.modbus_io); !s) return core::invalid_argument(file + ": [hal.modbus_io] " + s.error().message);
   if (c.backend == HalBackend::kComedi)
@@ -481,6 +497,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   read_recorder(top, c);
   read_motion(top, c);
   read_excite(top, c);
+  read_health(top, c);
   read_store(top, c);
   read_log(top, c);
   read_modbus(top, c);

@@ -8,6 +8,7 @@
 // (/var/lib/epa under systemd).
 #include <string>
 
+#include "diag/model_health.hpp"
 #include "hal/comedi_daq.hpp"
 #include "hal/modbus_io_daq.hpp"
 #include "modbus/modbus_server.hpp"
@@ -20,6 +21,13 @@
 namespace epa::config {
 
 enum class HalBackend { kSim, kModbusIo, kComedi };
+
+// [health]: the model-health monitor (appliance/health_monitor.hpp).
+struct HealthSettings {
+  bool enabled = true;
+  double stroke_mm = 500.0;     // the end stops (0 and this): segments of a move that reach them are not judged
+  diag::HealthConfig estimator;  // its baseline, window and thresholds
+};
 
 struct ApplianceConfig {
   runtime::RuntimeConfig runtime;
@@ -38,6 +46,8 @@ struct ApplianceConfig {
   double store_min_free_mb = 256;          // [store] min_free_mb: below it, no run files and a warning
   std::int64_t audit_max_rows = 1'000'000;  // [store] audit_max_rows: the audit log's newest rows kept
   double status_interval_s = 10.0;
+
+  HealthSettings health;
 
   bool modbus_enabled = true;
   modbus::ServerConfig modbus;

@@ -38,7 +38,7 @@ RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, std::
 points::InterfaceStatus RequestHandler::status(const Session& session, std::int64_t now_ns) const {
   const core::ChangeCounters changes = gate_.counters();
   points::InterfaceStatus s{static_cast<std::uint32_t>(changes.accepted), static_cast<std::uint32_t>(changes.saved), changes.saving,
-                            requests_, clients_, now_ns >= session.unlocked_until_ns, unlock_.failures(), gate_.commission_view()};
+                            requests_, clients_, now_ns >= session.unlocked_until_ns, unlock_.failures(), gate_.commission_view(), gate_.health_view()};
   s.disk_low = changes.disk_low;
   s.records = gate_.records();
   s.record_select = gate_.record_select();

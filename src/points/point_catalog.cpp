@@ -43,7 +43,7 @@ constexpr std::string_view kControlBitText[runtime::kControlBits] = {
     "control word bit 4: rising edge clears a latched fault"};
 constexpr std::string_view kStatusBitNames[runtime::kStatusBits] = {"ready", "run_enabled", "moving", "in_position", "target_reached",
                                                                     "following_error", "warning", "fault_latched", "ack", "halted",
-                                                                    "jogging", "manual_mode", "off_target", "hunting"};
+                                                                    "jogging", "manual_mode", "off_target", "hunting", "health_warning"};
 constexpr std::string_view kStatusBitText[runtime::kStatusBits] = {
     "status bit 0: no fault latched and the I/O works",
     "status bit 1: mode RUN (the law holds or moves the axis)",
@@ -53,7 +53,7 @@ constexpr std::string_view kStatusBitText[runtime::kStatusBits] = {
     "status bit 4: the last started move came into position (RUN; cleared by the next start, from its write on)",
     "status bit 5: the piston beyond following_error_mm from the motion it is asked to follow (a speed-limited move's "
     "profile, or for a step the model's planned motion, up to the target) for 0.2 s; the fault follows after following_error_time_s",
-    "status bit 6: following error, off target, hunting, I/O errors, the store not saving or its disk low",
+    "status bit 6: following error, off target, hunting, a health warning, I/O errors, the store not saving or its disk low",
     "status bit 7: a fault is latched (fault_code)",
     "status bit 8: acknowledge: mirrors the control word's start bit once the loop applied it",
     "status bit 9: the last task was a halt (in_position then says whether it stopped at the move's target)",
@@ -63,7 +63,9 @@ constexpr std::string_view kStatusBitText[runtime::kStatusBits] = {
     "clears if it comes in, or at the next start",
     "status bit 13: the law hunted (a limit cycle about the standing target: the piston came to rest on alternating "
     "sides of it twice within 2 s) under pp, pp-ngidz or pp-ffidz: the valve is held centred where the piston stands (RUN; also a warning); "
-    "clears at the next start or target. pp-traj is not held: it arrives while sliding instead"};
+    "clears at the next start or target. pp-traj is not held: it arrives while sliding instead",
+    "status bit 14: the model-health monitor's verdict is drifting, unexplained or hunting (health_state says which, "
+    "health_effect what drifted): a warning, never a fault"};
 
 // Names of the coefficient points (F0..H6), kept alive for the string_views in the catalog.
 const std::vector<std::string>& coefficient_names() {
@@ -209,6 +211,27 @@ std::vector<PointDef> build() {
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.commission.verdict); }},
       {P::kCommissionProgress, "commission_progress_pct", "%", "commissioning: share of the sequence done", A::kRead, 0, 0, false, true,
        [](const Ctx& c, int) { return c.status.commission.percent; }},
+      // the model-health monitor (appliance/health_monitor.hpp): its verdict on the axis against the running set's model
+      {P::kHealthCommand, "health_command", "", "1 retake the model-health baseline (after unlock): the next moves are learnt as the axis's normal; reads 0",
+       A::kTuning, 1, 1, true, true, [](const Ctx&, int) { return 0.0; }},
+      {P::kHealthState, "health_state", "", "model health: 0 off (no stick-slip model, or [health] enabled = false), 1 learning its baseline, 2 ok, "
+                                            "3 drifting (health_effect names the change), 4 unexplained (the axis left its model, no single effect explains it), "
+                                            "5 hunting (a limit cycle about a standing target); 3-5 warn (status bit 14), never fault",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(static_cast<int>(c.status.health.state)); }},
+      {P::kHealthEffect, "health_effect", "", "model health, drifting: what changed, named as by epa diagnose: 0 none, 1 static_friction, "
+                                              "2 gain_change (supply, valve gain), 3 deadzone_shift (valve overlap), 4 valve_lag (spool), 5 input_delay",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(static_cast<int>(c.status.health.effect)); }},
+      {P::kHealthValue, "health_value", "", "model health, drifting: the effect's model term now (static_friction: breakaway wind-up mm; "
+                                            "gain_change: mm/s per V; deadzone_shift: right break point V; valve_lag: s; input_delay: samples); NaN otherwise",
+       A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.status.health.value; }},
+      {P::kHealthCommissioned, "health_commissioned", "", "model health, drifting: the same term of the commissioned model; NaN otherwise",
+       A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.status.health.commissioned; }},
+      {P::kHealthRatio, "health_ratio", "", "model health, drifting: health_value / health_commissioned (friction doubled: 2); NaN otherwise",
+       A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.status.health.ratio; }},
+      {P::kHealthMovesSinceOnset, "health_moves_since_onset", "", "model health, drifting or unexplained: moves since the first that showed it",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.health.moves_since_onset); }},
+      {P::kHealthMovesSeen, "health_moves_seen", "", "model health: moves judged since the model was set or the baseline retaken",
+       A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.health.moves_seen); }},
       // last move (NaN: does not apply to how it ended, core/move_metrics.hpp)
       {P::kMoveNumber, "move_number", "", "moves measured since start", A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.snapshot.last_move.number); }},
       {P::kMoveFrom, "move_from_mm", "mm", "last move: start", A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.last_move.from_mm; }},
@@ -250,11 +273,11 @@ std::vector<PointDef> build() {
                            0, 1, true, true, [](const Ctx& c, int bit) { return b(c.snapshot.axis.control_word & (1u << bit)); }, i});
   positioning.push_back({P::kStatusWord, "status_word", "", "bits 0 ready, 1 enabled, 2 moving, 3 in_position, 4 target_reached, "
                                                               "5 following_error, 6 warning, 7 fault, 8 ack, 9 halted, 10 jogging, 11 manual, "
-                                                              "12 off_target, 13 hunting",
-                         A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(status_word(c.snapshot, c.status.saving && !c.status.disk_low)); }});
+                                                              "12 off_target, 13 hunting, 14 health_warning",
+                         A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(status_word(c.snapshot, c.status)); }});
   for (int i = 0; i < runtime::kStatusBits; ++i)
     positioning.push_back({indexed_id(P::kStatusBit0, static_cast<std::size_t>(i)), kStatusBitNames[i], "", kStatusBitText[i], A::kRead, 0, 0,
-                           true, true, [](const Ctx& c, int bit) { return b(status_word(c.snapshot, c.status.saving && !c.status.disk_low) & (1u << bit)); }, i});
+                           true, true, [](const Ctx& c, int bit) { return b(status_word(c.snapshot, c.status) & (1u << bit)); }, i});
   positioning.push_back({P::kReference, "reference_mm", "mm", "what the control law follows: the target, or a halt's or jog's braking path",
                          A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.snapshot.axis.reference_mm; }});
   positioning.push_back({P::kSpeed, "speed_mm_s", "mm/s", "measured piston speed (low-pass 20 ms)", A::kRead, 0, 0, false, true,
@@ -347,17 +370,21 @@ const std::vector<PointDef>& catalog() {
 
 }  // namespace
 
-std::uint16_t status_word(const runtime::Snapshot& s, bool store_well) {
+std::uint16_t status_word(const runtime::Snapshot& s, bool store_well, bool health_warning) {
   using namespace runtime;
   const bool fault = s.mode == Mode::kFault;
-  const bool warning = s.axis.following_error || s.axis.off_target || s.axis.hunting || !s.io_ok || !store_well;
+  const bool warning = s.axis.following_error || s.axis.off_target || s.axis.hunting || health_warning || !s.io_ok || !store_well;
   const bool bits[kStatusBits] = {!fault && s.io_ok, s.mode == Mode::kRun, s.axis.moving, s.axis.in_position, s.axis.target_reached,
                                   s.axis.following_error, warning, fault, s.axis.ack, s.axis.halted, s.axis.jogging, s.mode == Mode::kManual,
-                                  s.axis.off_target, s.axis.hunting};
+                                  s.axis.off_target, s.axis.hunting, health_warning};
   std::uint16_t w = 0;
   for (int i = 0; i < kStatusBits; ++i)
     if (bits[i]) w = static_cast<std::uint16_t>(w | (1u << i));
   return w;
+}
+
+std::uint16_t status_word(const runtime::Snapshot& s, const InterfaceStatus& status) {
+  return status_word(s, status.saving && !status.disk_low, health_warns(status.health.state));
 }
 
 std::span<const PointDef> point_catalog() { return catalog(); }

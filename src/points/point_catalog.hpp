@@ -12,6 +12,7 @@
 #include <string_view>
 
 #include "points/commission_control.hpp"
+#include "points/health_control.hpp"
 #include "points/point_id.hpp"
 #include "points/position_records.hpp"
 #include "runtime/fault_history.hpp"
@@ -38,6 +39,7 @@ struct InterfaceStatus {
   bool locked = true;                // tuning points refuse this client's writes
   std::uint64_t unlock_failures = 0; // refused unlock attempts since start (wrong key, back-off)
   CommissionView commission;         // the commissioning service's state (WriteGate::commission_view)
+  HealthView health;                 // the model-health monitor's verdict (WriteGate::health_view)
   PositionRecords records{};         // the position-record table (WriteGate::records)
   int record_select = 0;             // the record a start takes (0: the setpoint)
   std::uint64_t fault_history_count = 0;  // faults recorded (LoopChannels::fault_history)
@@ -47,8 +49,11 @@ struct InterfaceStatus {
 };
 
 // The status word (runtime/axis_words.hpp) of the loop's state and the interfaces' (warning
-// includes a store that does not save or whose disk is low: `store_well` false).
-std::uint16_t status_word(const runtime::Snapshot& s, bool store_well);
+// includes a store that does not save or whose disk is low: `store_well` false; and the
+// model-health monitor's warning, health_warns()).
+std::uint16_t status_word(const runtime::Snapshot& s, bool store_well, bool health_warning);
+// ... with the interfaces' part read from what they know.
+std::uint16_t status_word(const runtime::Snapshot& s, const InterfaceStatus& status);
 
 struct PointContext {
   const runtime::Snapshot& snapshot;

@@ -36,6 +36,8 @@ enum class PointId : std::uint16_t {
   kExciteSeed, kExciteAmplitudeMin, kExciteAmplitudeMax, kExciteDuration, kExciteLeft,
   // the commissioning service: its command (start, abort) and state
   kCommissionCommand, kCommissionStage, kCommissionVerdict, kCommissionProgress,
+  // the model-health monitor: its command (retake the baseline) and verdict
+  kHealthCommand, kHealthState, kHealthEffect, kHealthValue, kHealthCommissioned, kHealthRatio, kHealthMovesSinceOnset, kHealthMovesSeen,
   // the last move
   kMoveNumber, kMoveFrom, kMoveTo, kMoveRise, kMoveSettling, kMoveEss, kMoveOvershoot, kMoveEnd,
   // loop statistics and counters

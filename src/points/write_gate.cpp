@@ -169,9 +169,9 @@ GateResult WriteGate::build(std::span<const PointWrite> writes, const Requester&
   if (writes.empty()) return refuse(Refusal::kInvalidValue, "nothing to write");
   if (GateResult r = check_values(writes); !r.accepted()) return r;
   if (GateResult r = check_rights(writes, who); !r.accepted()) return r;
-  // A commissioning command goes to the service, not the loop: nothing more to decide here.
-  if (std::ranges::any_of(writes, [](const PointWrite& w) { return w.id == PointId::kCommissionCommand; }))
-    return check_commission_command(writes);
+  // A commissioning or health command goes to its service, not the loop: nothing more to decide here.
+  if (std::ranges::any_of(writes, [](const PointWrite& w) { return w.id == PointId::kCommissionCommand || w.id == PointId::kHealthCommand; }))
+    return check_service_command(writes);
   // The commands, all of them or none, from the gate's state as it stands.
   out.tuning = tuning;
   out.excitation = excitation;
@@ -205,11 +205,16 @@ GateResult WriteGate::check_rights(std::span<const PointWrite> writes, const Req
   return {};
 }
 
-// A commissioning command is written alone, and only to a gate with a service behind it.
-GateResult WriteGate::check_commission_command(std::span<const PointWrite> writes) const {
-  const std::string point = quoted(PointId::kCommissionCommand);
+// A service's command (commissioning, model health) is written alone, and only to a gate with the
+// service behind it.
+GateResult WriteGate::check_service_command(std::span<const PointWrite> writes) const {
+  const auto service = std::ranges::find_if(writes, [](const PointWrite& w) { return w.id == PointId::kCommissionCommand || w.id == PointId::kHealthCommand; });
+  const std::string point = quoted(service->id);
   if (writes.size() > 1) return refuse(Refusal::kInvalidValue, fmt::format("{} is written alone", point));
-  if (!commission_) return refuse(Refusal::kNotWritable, fmt::format("{}: this appliance runs no commissioning service", point));
+  if (service->id == PointId::kCommissionCommand && !commission_)
+    return refuse(Refusal::kNotWritable, fmt::format("{}: this appliance runs no commissioning service", point));
+  if (service->id == PointId::kHealthCommand && !health_)
+    return refuse(Refusal::kNotWritable, fmt::format("{}: this appliance runs no model-health monitor", point));
   return {};
 }
 
@@ -387,6 +392,7 @@ GateResult WriteGate::decide(std::span<const PointWrite> writes, const Requester
 
 GateResult WriteGate::submit(std::span<const PointWrite> writes, const Requester& who) {
   if (!writes.empty() && writes.front().id == PointId::kCommissionCommand) return commission(writes, who);
+  if (!writes.empty() && writes.front().id == PointId::kHealthCommand) return health(writes, who);
   std::lock_guard lock(mutex_);
   const runtime::Snapshot snap = with_unapplied(channels_.snapshot.read());  // decided on what reads show
   Decision d;
@@ -458,6 +464,23 @@ GateResult WriteGate::commission(std::span<const PointWrite> writes, const Reque
     return refuse(Refusal::kConflict, "commission_command: no commissioning run is under way");
   }
   return {};  // audited by the service, under who.source, as a start or abort from any interface
+}
+
+GateResult WriteGate::health(std::span<const PointWrite> writes, const Requester& who) {
+  {
+    std::lock_guard lock(mutex_);
+    Decision d;
+    if (GateResult r = build(writes, who, channels_.snapshot.read(), tuning_, excitation_, d); !r.accepted()) return r;
+  }
+  health_->retake_baseline(who.source);  // audited by the monitor, under who.source
+  return {};
+}
+
+HealthReport WriteGate::health_report() const {
+  if (health_) return health_->report();
+  HealthReport r;
+  r.reason = "this appliance runs no model-health monitor";
+  return r;
 }
 
 GateResult WriteGate::replace_tuning(const control::ControllerConfig& replacement, const Requester& who, const core::AuditEntry& entry) {

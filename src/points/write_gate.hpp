@@ -33,6 +33,7 @@
 #include "core/audit.hpp"
 #include "core/sensor_calibration.hpp"
 #include "points/commission_control.hpp"
+#include "points/health_control.hpp"
 #include "points/gate_result.hpp"
 #include "points/point_catalog.hpp"
 #include "points/point_id.hpp"
@@ -91,6 +92,11 @@ class WriteGate {
   // before the interfaces start; it must outlive them.
   void attach_commission(CommissionControl* commission) { commission_ = commission; }
   CommissionView commission_view() const { return commission_ ? commission_->view() : CommissionView{}; }
+  // The model-health monitor behind health_command and the health points (none: state off, the
+  // command refused). Attach it before the interfaces start; it must outlive them.
+  void attach_health(HealthControl* health) { health_ = health; }
+  HealthView health_view() const { return health_ ? health_->view() : HealthView{}; }
+  HealthReport health_report() const;
 
   // Logs and audits the commands the loop refused after the gate accepted them. Off the loop.
   void take_refusals(const std::function<void(const std::string&)>& log);
@@ -104,12 +110,13 @@ class WriteGate {
  private:
   struct Decision;
   GateResult commission(std::span<const PointWrite> writes, const Requester& who);
+  GateResult health(std::span<const PointWrite> writes, const Requester& who);
   GateResult build(std::span<const PointWrite> writes, const Requester& who, const runtime::Snapshot& snap,
                    const control::ControllerConfig& tuning, const runtime::ExcitationSettings& excitation, Decision& out) const;
   // build's steps, in its order.
   GateResult check_values(std::span<const PointWrite> writes) const;
   static GateResult check_rights(std::span<const PointWrite> writes, const Requester& who);
-  GateResult check_commission_command(std::span<const PointWrite> writes) const;
+  GateResult check_service_command(std::span<const PointWrite> writes) const;
   GateResult edit_records(std::span<const PointWrite> writes, Decision& out) const;
   GateResult add_commands(std::span<const PointWrite> writes, const runtime::Snapshot& snap, const control::ControllerConfig& tuning,
                           Decision& out) const;
@@ -131,6 +138,7 @@ class WriteGate {
   runtime::LoopChannels& channels_;
   core::AuditSink* audit_;
   CommissionControl* commission_ = nullptr;
+  HealthControl* health_ = nullptr;
 
   mutable std::mutex mutex_;  // one writer at a time: Modbus and web threads
   control::ControllerConfig tuning_;

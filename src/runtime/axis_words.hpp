@@ -33,7 +33,8 @@ enum StatusBit : int {
   kStatusManual = 11,         // mode MANUAL
   kStatusOffTarget = 12,      // the move stopped outside its window: the piston stands there (also a warning)
   kStatusHunting = 13,        // a limit cycle about the standing target: the valve is held centred until the next target (also a warning)
+  kStatusHealthWarning = 14,  // the model-health monitor finds the axis drifted from its model, or hunting (also a warning; never a fault)
 };
-inline constexpr int kStatusBits = 14;
+inline constexpr int kStatusBits = 15;
 
 }  // namespace epa::runtime

@@ -47,11 +47,43 @@ json status_bits(std::uint16_t word) {
   return bits;
 }
 
+json health_object(const points::HealthReport& h) {
+  const auto& v = h.view;
+  const bool drifting = v.effect != points::HealthEffectCode::kNone;
+  return {{"state", std::string(points::to_string(v.state))},
+          {"effect", std::string(points::to_string(v.effect))},
+          {"size", h.size},
+          {"ratio", drifting ? num(v.ratio) : json(nullptr)},
+          {"value", drifting ? num(v.value) : json(nullptr)},
+          {"commissioned", drifting ? num(v.commissioned) : json(nullptr)},
+          {"unit", h.unit},
+          {"moves_since_onset", v.moves_since_onset},
+          {"moves_seen", v.moves_seen},
+          {"reason", h.reason}};
+}
+
 }  // namespace
 
-std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled, const StoreStats& store) {
+std::string health_json(const points::HealthReport& health) {
+  json j = health_object(health);
+  j["window_gap_mm"] = num(health.window_gap_mm);
+  j["baseline_gap_mm"] = num(health.baseline_gap_mm);
+  j["moves_dropped"] = health.moves_dropped;
+  json trend = json::array();
+  for (const auto& judgement : health.trend) {
+    json estimates = json::array();
+    for (const auto& e : judgement.estimates)
+      estimates.push_back({{"effect", std::string(points::to_string(e.effect))}, {"ratio", num(e.ratio)}, {"reduction", num(e.reduction)}});
+    trend.push_back({{"move", judgement.move}, {"estimates", std::move(estimates)}});
+  }
+  j["trend"] = std::move(trend);
+  return j.dump();
+}
+
+std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled, const StoreStats& store,
+                        const points::HealthReport& health) {
   const bool faulted = s.mode == runtime::Mode::kFault;
-  const std::uint16_t word = points::status_word(s, store.ok && !store.disk_low);
+  const std::uint16_t word = points::status_word(s, store.ok && !store.disk_low, points::health_warns(health.view.state));
   json j = {
       {"version", std::string(core::kVersion)},
       {"cycle", s.cycle},
@@ -100,6 +132,7 @@ std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, b
       {k(P::kControlWord), s.axis.control_word},
       {"commands_enabled", commands_enabled},
       {"any_address_may_command", modbus.any_address_may_command},
+      {"health", health_object(health)},
   };
   return j.dump();
 }

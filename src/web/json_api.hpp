@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/audit.hpp"
+#include "points/health_control.hpp"
 #include "points/position_records.hpp"
 #include "points/write_limits.hpp"
 #include "runtime/fault_history.hpp"
@@ -35,9 +36,14 @@ struct StoreStats {
 };
 
 // With the status word as "status_word" and bit by bit in "status_bits" (ready, run_enabled, ...:
-// the bits' point names), and the control word as the loop applied it.
+// the bits' point names), the control word as the loop applied it, and the model-health verdict
+// as "health": {"state", "effect", "size", "ratio", "moves_since_onset", "moves_seen", "value",
+// "commissioned", "unit", "reason"} (effect, size, unit "" and the numbers null when they do not apply).
 std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled,
-                        const StoreStats& store = {});
+                        const StoreStats& store = {}, const points::HealthReport& health = {});
+// The model-health verdict as in /api/status, with its gaps, the moves not judged and "trend":
+// the newest judgements, oldest first, each {"move", "estimates": [{"effect", "ratio", "reduction"}]}.
+std::string health_json(const points::HealthReport& health);
 std::string trend_json(const std::vector<TrendPoint>& points, const runtime::Snapshot& s);
 std::string moves_json(const std::vector<MoveRecord>& moves);
 std::string tuning_json(const runtime::Snapshot& s);

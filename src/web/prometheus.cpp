@@ -79,10 +79,12 @@ class Writer {
 
 }  // namespace
 
-std::string prometheus_text(const runtime::Snapshot& s, const ModbusStats& modbus, std::uint64_t web_requests) {
+std::string prometheus_text(const runtime::Snapshot& s, const ModbusStats& modbus, std::uint64_t web_requests,
+                            const points::HealthView& health) {
   points::InterfaceStatus server;  // what the points of the Modbus interface read
   server.requests = modbus.requests;
   server.clients = modbus.clients;
+  server.health = health;
   const points::PointContext ctx{s, server};
   Writer w(ctx);
   using Id = points::PointId;  // not P: json_api.cpp has that at file scope, and a unity batch holds both
@@ -99,6 +101,7 @@ std::string prometheus_text(const runtime::Snapshot& s, const ModbusStats& modbu
            static_cast<double>(modbus.exceptions));
   w.point(Id::kModbusClients);
   w.metric("epa_web_requests_total", "counter", "HTTP requests served since start.", static_cast<double>(web_requests));
+  for (const Id id : {Id::kHealthState, Id::kHealthEffect, Id::kHealthRatio, Id::kHealthMovesSinceOnset, Id::kHealthMovesSeen}) w.point(id);
   return w.take();
 }
 

@@ -6,11 +6,14 @@
 // /metrics, Modbus and /api/status say the same thing; epa_build_info{version="..."} names the version.
 #include <string>
 
+#include "points/health_control.hpp"
 #include "runtime/snapshot.hpp"
 #include "web/json_api.hpp"
 
 namespace epa::web {
 
-std::string prometheus_text(const runtime::Snapshot& s, const ModbusStats& modbus, std::uint64_t web_requests);
+// `health`: the model-health monitor's verdict (its points: state, effect, ratio, moves).
+std::string prometheus_text(const runtime::Snapshot& s, const ModbusStats& modbus, std::uint64_t web_requests,
+                            const points::HealthView& health = {});
 
 }  // namespace epa::web

@@ -81,6 +81,12 @@ struct WebServer::Impl {
   runtime::LoopChannels& channels;
   // The loop's snapshot with the accepted writes it has not taken yet (read after write).
   runtime::Snapshot snapshot() const { return gate ? gate->snapshot() : channels.snapshot.read(); }
+  points::HealthReport health_report() const {
+    if (gate) return gate->health_report();
+    points::HealthReport r;
+    r.reason = "this server has no write gate, so no model-health monitor";
+    return r;
+  }
   points::WriteGate* gate;
   RecentAudit* audit;
   ModbusStatsFn modbus_stats;
@@ -288,8 +294,9 @@ struct WebServer::Impl {
       return httplib::Server::HandlerResponse::Unhandled;
     });
     s.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
-      res.set_content(status_json(snapshot(), modbus(), commands_enabled(), store()), kJson);
+      res.set_content(status_json(snapshot(), modbus(), commands_enabled(), store(), health_report()), kJson);
     });
+    s.Get("/api/health", [this](const httplib::Request&, httplib::Response& res) { res.set_content(health_json(health_report()), kJson); });
     s.Get("/api/trend", [this](const httplib::Request&, httplib::Response& res) { res.set_content(*trend_body(), kJson); });
     s.Get("/api/moves", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(moves_json(trend.moves()), kJson);
@@ -314,7 +321,7 @@ struct WebServer::Impl {
       res.set_content(faults_json(count, faults, channels.snapshot.read().fault_events_dropped), kJson);
     });
     s.Get("/metrics", [this](const httplib::Request&, httplib::Response& res) {
-      res.set_content(prometheus_text(channels.snapshot.read(), modbus(), requests.load()),
+      res.set_content(prometheus_text(channels.snapshot.read(), modbus(), requests.load(), gate ? gate->health_view() : points::HealthView{}),
                       "text/plain; version=0.0.4; charset=utf-8");
     });
     s.Get("/vendor/chart.js", [this](const httplib::Request&, httplib::Response& res) {

@@ -44,6 +44,22 @@ TEST(ApplianceConfig, ShippedFileParsesToTheDocumentedDefaults) {
   EXPECT_EQ(c->store_path, "epa.db");          // the appliance's data: relative to the working directory
   EXPECT_EQ(c->sim_plant, "hammerstein");
   EXPECT_EQ(c->physics_config, "");
+  // [health] as shipped is the estimator's own default, the one its benchmark measured.
+  const diag::HealthConfig health;
+  EXPECT_TRUE(c->health.enabled);
+  EXPECT_EQ(c->health.stroke_mm, 500.0);
+  EXPECT_EQ(c->health.estimator.baseline_moves, health.baseline_moves);
+  EXPECT_EQ(c->health.estimator.window_moves, health.window_moves);
+  EXPECT_EQ(c->health.estimator.confirm_windows, health.confirm_windows);
+  EXPECT_EQ(c->health.estimator.min_reduction, health.min_reduction);
+  EXPECT_EQ(c->health.estimator.spread_margin, health.spread_margin);
+  EXPECT_EQ(c->health.estimator.unexplained_gap_ratio, health.unexplained_gap_ratio);
+}
+
+TEST(ApplianceConfig, AHealthWindowLongerThanItsBaselineIsRefusedNamingBoth) {
+  const auto e = error_of("[health]\nbaseline_moves = 8\nwindow_moves = 12\n");
+  EXPECT_NE(e.find("[health] baseline_moves must be at least window_moves"), std::string::npos) << e;
+  EXPECT_NE(error_of("[health]\nmin_reduction = 1.5\n").find("health.min_reduction"), std::string::npos);
 }
 
 TEST(ApplianceConfig, ThePhysicsPlantIsChosenWithItsParameterFileNextToTheConfiguration) {

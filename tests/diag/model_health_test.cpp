@@ -8,25 +8,19 @@
 #include <cmath>
 
 #include "../support/physics_identified_model.hpp"
-#include "../support/pp_traj_on_model.hpp"
-#include "control/controller.hpp"
-#include "control/paper_controller.hpp"
+#include "../support/stick_slip_axis.hpp"
 #include "core/model_file.hpp"
-#include "core/random.hpp"
-#include "plant/stick_slip_model.hpp"
 
 namespace epa::diag {
 namespace {
 
-constexpr double kHealthTs = 0.005;
+constexpr double kHealthTs = testing::StickSlipAxis::kTs;
 
 core::ModelFile health_model_file() {
   auto f = core::parse_model_toml(testing::kPhysicsIdentifiedModelToml, "identified");
   EXPECT_TRUE(f.has_value());
   return *f;
 }
-
-control::ControllerParams health_law(const core::ModelFile& f) { return *control::ControllerParams::make(testing::pp_traj_config_on(f)); }
 
 // Moves between seeded random targets on the stick-slip model `plant_params`, changed to `changed`
 // after change_at moves; each move's run handed to `health`. Returns the move (counted from the
@@ -38,37 +32,11 @@ struct HealthRun {
 };
 HealthRun run_moves(ModelHealth& health, const core::StickSlipParams& plant_params, const core::StickSlipParams& changed, int change_at,
                     int moves, std::optional<plant::EffectKind> expected, std::uint64_t seed) {
-  const auto file = health_model_file();
-  const auto law = health_law(file);
-  auto plant = *plant::StickSlipModel::make(plant_params, kHealthTs);
-  plant.reset(250.0);
-  core::Random noise(seed);
-  core::Random targets(seed * 31 + 7);
-  control::ControllerState state;
-  double target_mm = 250.0;
+  testing::StickSlipAxis axis(health_model_file(), plant_params, seed);
   HealthRun out;
   for (int m = 0; m < moves; ++m) {
-    if (m == change_at) {
-      const double y = plant.position_mm();
-      plant = *plant::StickSlipModel::make(changed, kHealthTs);
-      plant.reset(y);
-    }
-    const double size = 20.0 + 150.0 * targets.uniform();
-    target_mm = std::clamp(target_mm + (target_mm > 250.0 ? -size : size), 30.0, 470.0);
-    control::controller_new_move(state);
-    core::Run run;
-    run.Ts = kHealthTs;
-    double y_mm = plant.position_mm();
-    for (int k = 0; k < 500; ++k) {  // 2.5 s
-      const double reading_mm = y_mm + 0.05 * noise.normal();
-      const auto u = control::controller_step(law, state, target_mm / 50.0, reading_mm / 50.0);
-      run.t_s.push_back(k * kHealthTs);
-      run.r_mm.push_back(target_mm);
-      run.y_mm.push_back(reading_mm);
-      run.u_V.push_back(u.valve_v);
-      y_mm = std::clamp(plant.step(u.valve_v), 0.0, 500.0);
-    }
-    health.add_move(std::move(run));
+    if (m == change_at) axis.change(changed);
+    health.add_move(axis.next_move());
     const auto& v = health.verdict();
     const bool alarm = v.state == HealthState::kDrifting || v.state == HealthState::kUnexplained;
     if (m < change_at && alarm) ++out.alarms_before_change;

@@ -32,6 +32,8 @@ TOKEN = "r1f5_De3kRiAVQhRiD5mSRW4"
 SANITIZER_RUN = os.environ.get("EPA_SANITIZER_RUN") == "1"
 MODE_ADDRESS = 2  # holding `mode` of registers/epa.csv
 RUN, STOP = 1, 0
+HEALTH_STATE_ADDRESS = 162  # input `health_state` of registers/epa.csv
+HEALTH_OFF, HEALTH_LEARNING = 0, 1
 
 
 def commission(epa, app, folder, spec=None, env_token=True, token_file=None, timeout_s=240):
@@ -74,6 +76,10 @@ def commission_instrumented(check, epa, app, folder):
           f"verdict {verdict!r}: {outcome.get('reason', r.stderr.strip()[-300:])})")
 
 
+def health_state(app):
+    return app.client.read_input_registers(HEALTH_STATE_ADDRESS, 1, slave=1).registers[0]
+
+
 def mode(app):
     return app.client.read_holding_registers(MODE_ADDRESS, 1, slave=1).registers[0]
 
@@ -106,6 +112,9 @@ def main():
         check(r.returncode == 1 and "excitation_s" in r.stderr,
               f"--token-file: the appliance answered the spec (not the token): {r.stderr.strip()}")
 
+        # The seeded paper set has no stick-slip model: the model-health monitor is off.
+        check(health_state(app) == HEALTH_OFF, f"model health before commissioning: off (reads {health_state(app)})")
+
         # The defaults, as a new user runs them.
         app.client.write_register(MODE_ADDRESS, STOP, slave=1)
         if SANITIZER_RUN:
@@ -116,6 +125,9 @@ def main():
         check(r.returncode == 0 and outcome.get("verdict") == "deployed" and took <= 180.0,
               f"no spec: deployed in {took:.0f} s (at most 180 s; exit {r.returncode}, verdict {outcome.get('verdict')!r}: "
               f"{outcome.get('reason', r.stderr.strip()[-300:])})")
+        # The deployed set's model has one: the monitor learns the axis's normal on it.
+        check(wait_until(lambda: health_state(app) == HEALTH_LEARNING, 5.0),
+              f"model health after the deployment: learning (reads {health_state(app)})")
         moves = outcome.get("verification", [])
         check(len(moves) >= 3, f"{len(moves)} verification moves on the axis")
         for m in moves:

@@ -46,6 +46,8 @@ const std::map<std::string, std::string> kFormatFiles = {
     {"core/move_metrics.cpp", "epa-run/1 metadata: a move's move_end values, which name how it ended, not the status bits"},
     {"runtime/recorder.cpp", "epa-run/1 metadata"},
     {"diag/model_health.cpp", "the health states' names (hunting: the law hunted), not the status bit"},
+    {"points/health_control.hpp", "the health states' names as the interfaces give them, not the status bit"},
+    {"appliance/health_monitor.cpp", "epa-run/1 metadata: which recorded runs are moves the monitor judges"},
     {"appliance/run_history.cpp", "epa-run/1 metadata"},
     {"app/identify_command.cpp", "epa-run/1 metadata"},
     {"app/simulate_command.cpp", "epa-run/1 metadata"},

@@ -13,7 +13,7 @@ namespace {
 bool excitation_or_record_or_command(PointId id) {
   RecordField f;
   return id == PointId::kExciteSeed || id == PointId::kExciteAmplitudeMin || id == PointId::kExciteAmplitudeMax ||
-         id == PointId::kExciteDuration || id == PointId::kCommissionCommand || record_field(id, f);
+         id == PointId::kExciteDuration || id == PointId::kCommissionCommand || id == PointId::kHealthCommand || record_field(id, f);
 }
 
 TEST(TuningValues, EveryTuningPointOfTheLawHasAValueAndNoOtherPointHasOne) {

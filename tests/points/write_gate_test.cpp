@@ -183,6 +183,42 @@ TEST(WriteGate, CommissionCommandIsUnlockProtectedWrittenAloneAndGoesToTheServic
   EXPECT_TRUE(sink.entries.empty());
 }
 
+// A model-health monitor that records the retakes the gate asked for.
+struct FakeHealth final : HealthControl {
+  HealthView view() const override { return {HealthStateCode::kDrifting, HealthEffectCode::kStaticFriction, 14.0, 7.0, 2.0, 40, 6}; }
+  HealthReport report() const override { return {view(), "friction up 100 %", "mm", "", 0.5, 0.2, 0, {}}; }
+  void retake_baseline(const std::string& source) override { retakes.push_back(source); }
+  std::vector<std::string> retakes;
+};
+
+TEST(WriteGate, HealthCommandIsUnlockProtectedWrittenAloneAndRetakesTheMonitorsBaseline) {
+  const runtime::RuntimeConfig config;
+  runtime::LoopChannels channels(16);
+  RecordingSink sink;
+  WriteGate gate(limits_of(config), config, paper(), channels, &sink);
+  const PointWrite retake{PointId::kHealthCommand, 1.0};
+  EXPECT_EQ(gate.health_view().state, HealthStateCode::kOff);  // no monitor attached
+  const auto none = gate.submit({&retake, 1}, kOperator);
+  EXPECT_EQ(none.refusal, Refusal::kNotWritable);
+  EXPECT_NE(none.reason.find("health_command"), std::string::npos) << none.reason;
+  FakeHealth health;
+  gate.attach_health(&health);
+  EXPECT_EQ(gate.submit({&retake, 1}, Requester{"modbus 127.0.0.1:5000", true, "", false}).refusal, Refusal::kForbidden);
+  const PointWrite two{PointId::kHealthCommand, 2.0};
+  EXPECT_EQ(gate.submit({&two, 1}, kOperator).refusal, Refusal::kInvalidValue);
+  const std::vector<PointWrite> group = {{PointId::kSetpoint, 100.0}, {PointId::kHealthCommand, 1.0}};
+  EXPECT_EQ(gate.submit(group, kOperator).refusal, Refusal::kInvalidValue);
+  EXPECT_TRUE(health.retakes.empty());
+
+  ASSERT_TRUE(gate.submit({&retake, 1}, kOperator).accepted());
+  EXPECT_EQ(health.retakes, std::vector<std::string>{"test"});
+  runtime::Command c;
+  EXPECT_FALSE(channels.commands.try_pop(c));  // nothing for the loop
+  EXPECT_TRUE(sink.entries.empty());           // the monitor audits the retake under its source
+  EXPECT_EQ(gate.health_view().effect, HealthEffectCode::kStaticFriction);
+  EXPECT_EQ(gate.health_report().size, "friction up 100 %");
+}
+
 TEST(WriteGate, AGroupIsTakenWholeOrNotAtAll) {
   const runtime::RuntimeConfig config;
   runtime::LoopChannels channels(16);

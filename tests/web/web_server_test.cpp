@@ -183,12 +183,12 @@ TEST_F(WebServerTest, StatusCarriesTheStatusWordPackedAndBitByBit) {
   const json s = get_json("/api/status");
   // ready (bit 0), run_enabled (1), in_position (3), target_reached (4)
   EXPECT_EQ(s["status_word"], 0x1B);
-  EXPECT_EQ(s["status_word"], epa::points::status_word(snap_, true));
+  EXPECT_EQ(s["status_word"], epa::points::status_word(snap_, true, false));
   EXPECT_EQ(s["control_word"], 1);
   const std::map<std::string, bool> expected = {
       {"ready", true}, {"run_enabled", true}, {"moving", false}, {"in_position", true}, {"target_reached", true},
       {"following_error", false}, {"warning", false}, {"fault_latched", false}, {"ack", false}, {"halted", false},
-      {"jogging", false}, {"manual_mode", false}, {"off_target", false}, {"hunting", false}};
+      {"jogging", false}, {"manual_mode", false}, {"off_target", false}, {"hunting", false}, {"health_warning", false}};
   ASSERT_EQ(s["status_bits"].size(), expected.size()) << s["status_bits"];
   for (const auto& [bit, on] : expected) EXPECT_EQ(s["status_bits"][bit], on) << bit;
 
@@ -209,6 +209,12 @@ TEST_F(WebServerTest, StatusCarriesTheStatusWordPackedAndBitByBit) {
   const json h = get_json("/api/status");
   EXPECT_EQ(h["status_word"], (1 << 0) | (1 << 1) | (1 << 6) | (1 << 13));
   EXPECT_TRUE(h["status_bits"]["hunting"].get<bool>());
+  // No model-health monitor behind this server: off, and why, with every key of the object.
+  EXPECT_EQ(h["health"]["state"], "off");
+  EXPECT_FALSE(h["health"]["reason"].get<std::string>().empty());
+  for (const char* key : {"effect", "size", "ratio", "value", "commissioned", "unit", "moves_since_onset", "moves_seen"})
+    EXPECT_TRUE(h["health"].contains(key)) << key;
+  EXPECT_TRUE(h["health"]["ratio"].is_null());
 }
 
 TEST_F(WebServerTest, StatusNamesALatchedFaultInWords) {

@@ -1,0 +1,249 @@
+#include "appliance/health_monitor.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "core/move_metrics.hpp"
+#include "core/utc_stamp.hpp"
+#include "points/point_catalog.hpp"
+
+namespace epa::appliance {
+
+namespace {
+
+using points::HealthStateCode;
+
+// A move ended as a move (not cut short, halted, stopped or faulted), closed-loop, recorded whole
+// and from rest: what the estimator compares with its model (diag/model_health.hpp).
+bool judged_move(const core::Run& run) {
+  if (run.meta("move").empty() || run.meta("controller") == "open-loop" || !run.meta("samples_lost").empty()) return false;
+  const auto end = core::parse_move_end(run.meta("move_end"));
+  if (!end || (*end != core::MoveEnd::kInPosition && *end != core::MoveEnd::kOffTarget && *end != core::MoveEnd::kTimeout)) return false;
+  // From rest: a move that follows a cut one starts at speed.
+  constexpr std::size_t kRestSamples = 4;
+  constexpr double kRestMm = 0.5;
+  if (run.size() < 2 * kRestSamples) return false;
+  for (std::size_t k = 1; k < kRestSamples; ++k)
+    if (std::abs(run.y_mm[k] - run.y_mm[0]) > kRestMm) return false;
+  return true;
+}
+
+// The lowest priority Linux has: the monitor takes only what the loop, the interfaces and the
+// store leave. An unprivileged process may always lower its own.
+void lower_priority() {
+  sched_param p{};
+  p.sched_priority = 0;
+  (void)pthread_setschedparam(pthread_self(), SCHED_IDLE, &p);
+}
+
+std::string state_reason(HealthStateCode s, const diag::HealthConfig& c) {
+  switch (s) {
+    case HealthStateCode::kLearning:
+      return "learning the axis's normal: the first " + std::to_string(c.baseline_moves) + " moves after the model was set are the baseline";
+    case HealthStateCode::kOk: return "the axis follows its baseline model";
+    case HealthStateCode::kDrifting: return "one effect of the model has changed beyond its tolerance and explains the axis's recent moves";
+    case HealthStateCode::kUnexplained: return "the axis has left its model and no single effect explains it: run epa diagnose on its run files";
+    case HealthStateCode::kHunting: return "the law hunted about a standing target (a limit cycle): see the hunting status bit";
+    case HealthStateCode::kOff: break;
+  }
+  return "";
+}
+
+}  // namespace
+
+points::HealthStateCode health_state_code(diag::HealthState state) {
+  switch (state) {
+    case diag::HealthState::kOff: return HealthStateCode::kOff;
+    case diag::HealthState::kLearning: return HealthStateCode::kLearning;
+    case diag::HealthState::kOk: return HealthStateCode::kOk;
+    case diag::HealthState::kDrifting: return HealthStateCode::kDrifting;
+    case diag::HealthState::kUnexplained: return HealthStateCode::kUnexplained;
+    case diag::HealthState::kHunting: return HealthStateCode::kHunting;
+  }
+  return HealthStateCode::kOff;
+}
+
+points::HealthEffectCode health_effect_code(plant::EffectKind effect) {
+  using E = points::HealthEffectCode;
+  switch (effect) {
+    case plant::EffectKind::kStaticFriction: return E::kStaticFriction;
+    case plant::EffectKind::kGainChange: return E::kGainChange;
+    case plant::EffectKind::kDeadzoneShift: return E::kDeadzoneShift;
+    case plant::EffectKind::kValveLag: return E::kValveLag;
+    case plant::EffectKind::kInputDelay: return E::kInputDelay;
+    default: return E::kNone;
+  }
+}
+
+HealthMonitor::HealthMonitor(config::HealthSettings config, RunningSetId running_set, ModelOf model_of, core::AuditSink* audit, Log log)
+    : config_(std::move(config)), running_set_(std::move(running_set)), model_of_(std::move(model_of)), audit_(audit), log_(std::move(log)) {
+  if (!config_.enabled) {
+    report_.reason = "the model-health monitor is switched off ([health] enabled = false)";
+    return;
+  }
+  busy_ = true;  // until the thread has looked at the running set
+  thread_ = std::thread([this] { run_thread(); });
+}
+
+HealthMonitor::~HealthMonitor() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  changed_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void HealthMonitor::add_run(const core::Run& run, bool hunting) {
+  if (!config_.enabled || !judged_move(run)) return;
+  {
+    std::lock_guard lock(mutex_);
+    if (queue_.size() >= kQueued) {
+      ++report_.moves_dropped;
+      return;
+    }
+    queue_.push_back({run, hunting});
+  }
+  changed_.notify_all();
+}
+
+points::HealthView HealthMonitor::view() const {
+  std::lock_guard lock(mutex_);
+  return report_.view;
+}
+
+points::HealthReport HealthMonitor::report() const {
+  std::lock_guard lock(mutex_);
+  return report_;
+}
+
+void HealthMonitor::retake_baseline(const std::string& source) {
+  {
+    std::lock_guard lock(mutex_);
+    retake_source_ = source;
+  }
+  changed_.notify_all();
+}
+
+bool HealthMonitor::wait_idle(int timeout_ms) const {
+  std::unique_lock lock(mutex_);
+  return changed_.wait_for(lock, std::chrono::milliseconds(timeout_ms), [&] { return queue_.empty() && !busy_ && !retake_source_; });
+}
+
+void HealthMonitor::run_thread() {
+  lower_priority();
+  follow_running_set();  // learning (or off, and why) from the start, not from the first move
+  std::unique_lock lock(mutex_);
+  busy_ = false;
+  changed_.notify_all();
+  while (true) {
+    changed_.wait(lock, [&] { return stop_ || !queue_.empty() || retake_source_; });
+    if (stop_) return;
+    busy_ = true;
+    std::optional<std::string> retake = std::exchange(retake_source_, std::nullopt);
+    std::optional<Queued> item;
+    if (!retake && !queue_.empty()) item = std::move(queue_.front()), queue_.pop_front();
+    lock.unlock();
+    follow_running_set();
+    if (retake && health_) {
+      health_->retake_baseline();
+      publish(*retake + ": retake the baseline", /*always_audit=*/true);
+    }
+    if (item) judge(std::move(*item));
+    lock.lock();
+    busy_ = false;
+    changed_.notify_all();
+  }
+}
+
+void HealthMonitor::follow_running_set() {
+  const std::int64_t id = running_set_();
+  if (set_id_ == id) return;
+  set_id_ = id;
+  health_.reset();
+  auto model = model_of_(id);
+  if (!model) return set_off("the running tuning set's model could not be read: " + model.error().message, "health monitor");
+  if (!model->stick_slip)
+    return set_off("the running tuning set '" + model->set_name +
+                       "' has no stick-slip model: commission the axis (epa commission) to give it one",
+                   "health monitor");
+  auto health = diag::ModelHealth::make(*model->stick_slip, model->Ts, config_.stroke_mm, config_.estimator);
+  if (!health) return set_off(health.error().message, "health monitor");
+  health_.emplace(std::move(*health));
+  publish("health monitor: tuning set '" + model->set_name + "' runs");
+}
+
+void HealthMonitor::judge(Queued item) {
+  if (!health_) return;
+  health_->add_move(std::move(item.run), item.hunting);
+  publish("health monitor");
+}
+
+void HealthMonitor::set_off(const std::string& reason, const std::string& source) {
+  points::HealthReport r;
+  r.reason = reason;
+  HealthStateCode before;
+  {
+    std::lock_guard lock(mutex_);
+    before = report_.view.state;
+    r.moves_dropped = report_.moves_dropped;
+    report_ = std::move(r);
+  }
+  log_(false, "model health: off: " + reason);
+  if (audit_ && before != HealthStateCode::kOff)
+    audit_->record({{core::unix_time_ms(), source, std::string(points::name(points::PointId::kHealthState)), double(static_cast<int>(before)),
+                     double(static_cast<int>(HealthStateCode::kOff))}});
+}
+
+void HealthMonitor::publish(const std::string& source, bool always_audit) {
+  const diag::HealthVerdict& v = health_->verdict();
+  points::HealthReport r;
+  r.view.state = health_state_code(v.state);
+  r.view.moves_seen = static_cast<std::uint32_t>(v.moves_seen);
+  r.view.moves_since_onset = static_cast<std::uint32_t>(v.moves_since_onset);
+  if (v.effect) {
+    r.view.effect = health_effect_code(*v.effect);
+    r.view.value = v.value;
+    r.view.commissioned = v.commissioned;
+    r.view.ratio = v.ratio;
+    r.unit = v.unit;
+    r.size = v.size;
+  }
+  r.reason = state_reason(r.view.state, config_.estimator);
+  r.window_gap_mm = v.estimates.empty() ? std::nan("") : v.window_gap_mm;
+  r.baseline_gap_mm = v.state == diag::HealthState::kLearning ? std::nan("") : v.baseline_gap_mm;
+
+  HealthStateCode before;
+  points::HealthEffectCode effect_before;
+  {
+    std::lock_guard lock(mutex_);
+    before = report_.view.state;
+    effect_before = report_.view.effect;
+    r.moves_dropped = report_.moves_dropped;
+    r.trend = std::move(report_.trend);
+    const bool new_judgement = !v.estimates.empty() && (r.trend.empty() || r.trend.back().move != r.view.moves_seen);
+    if (r.view.state == HealthStateCode::kLearning) r.trend.clear();
+    else if (new_judgement) {
+      points::HealthJudgement j{r.view.moves_seen, {}};
+      for (const auto& e : v.estimates) j.estimates.push_back({health_effect_code(e.effect), e.ratio, e.reduction});
+      r.trend.push_back(std::move(j));
+      if (r.trend.size() > kTrendKept) r.trend.erase(r.trend.begin());
+    }
+    report_ = r;
+  }
+  if (before == r.view.state && effect_before == r.view.effect && !always_audit) return;
+  const bool warns = points::health_warns(r.view.state);
+  log_(warns, "model health: " + std::string(points::to_string(before)) + " -> " + std::string(points::to_string(r.view.state)) +
+                  (r.size.empty() ? "" : " (" + r.size + ", " + std::to_string(r.view.moves_since_onset) + " moves since its onset)") +
+                  " after " + std::to_string(r.view.moves_seen) + " moves");
+  if (audit_)
+    audit_->record({{core::unix_time_ms(), source + (r.size.empty() ? "" : ": " + r.size),
+                     std::string(points::name(points::PointId::kHealthState)), double(static_cast<int>(before)),
+                     double(static_cast<int>(r.view.state))}});
+}
+
+}  // namespace epa::appliance

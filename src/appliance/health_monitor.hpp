@@ -1,0 +1,105 @@
+#pragma once
+// The model-health monitor of one axis: each move the recorder writes is judged, on a thread of
+// its own at the lowest scheduling priority (SCHED_IDLE: it takes only CPU nothing else wants),
+// against the running tuning set's stick-slip model by diag::ModelHealth. Its verdict is what the
+// health points, /api/status, /metrics and the page show; each change of state goes to the audit
+// trail and the log. It never commands the axis: a drift warns, it does not fault.
+//
+// The model follows the running set: when another set runs (commissioning deployed one, or rolled
+// back), the monitor starts learning again on that set's model. A set whose model has no
+// stick-slip table (the paper's, or one identified before stick-slip models existed) is not
+// monitored: the state is off, and the reason says so.
+#include <array>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "config/appliance_config.hpp"
+#include "core/audit.hpp"
+#include "core/result.hpp"
+#include "core/run.hpp"
+#include "core/stick_slip_params.hpp"
+#include "diag/model_health.hpp"
+#include "points/health_control.hpp"
+
+namespace epa::appliance {
+
+// The running set's model as the monitor needs it.
+struct MonitoredModel {
+  std::string set_name;
+  std::optional<core::StickSlipParams> stick_slip;  // none: not monitored
+  double Ts = 0.005;
+};
+
+class HealthMonitor final : public points::HealthControl {
+ public:
+  using Log = std::function<void(bool warning, const std::string& line)>;
+  // The running set's id (cheap: asked for every move) and its model (read when the id changes).
+  // Both are called on the monitor's thread.
+  using RunningSetId = std::function<std::int64_t()>;
+  using ModelOf = std::function<core::Result<MonitoredModel>(std::int64_t set_id)>;
+
+  // `audit` may be null. Starts its thread (unless disabled).
+  HealthMonitor(config::HealthSettings config, RunningSetId running_set, ModelOf model_of, core::AuditSink* audit, Log log);
+  ~HealthMonitor() override;  // stops the thread; moves still queued are not judged
+  HealthMonitor(const HealthMonitor&) = delete;
+  HealthMonitor& operator=(const HealthMonitor&) = delete;
+
+  // A run the recorder wrote: a move's file is queued for judging (at most kQueued wait; more are
+  // dropped and counted), any other run is ignored. `hunting`: the loop's hunting watch holds the
+  // law as it is written. Never blocks on a judgement.
+  void add_run(const core::Run& run, bool hunting);
+
+  points::HealthView view() const override;
+  points::HealthReport report() const override;
+  void retake_baseline(const std::string& source) override;
+
+  // Waits (at most `timeout_ms`) until every run queued so far has been judged; for tests.
+  bool wait_idle(int timeout_ms) const;
+
+  static constexpr std::size_t kQueued = 8;
+  static constexpr std::size_t kTrendKept = 120;  // judgements the page's trend shows
+
+ private:
+  struct Queued {
+    core::Run run;
+    bool hunting = false;
+  };
+  void run_thread();
+  void follow_running_set();                     // the model of the set that runs now
+  void judge(Queued item);
+  // The estimator's verdict into report_, logged and audited when its state or effect changed.
+  void publish(const std::string& source, bool always_audit = false);
+  void set_off(const std::string& reason, const std::string& source);
+
+  const config::HealthSettings config_;
+  RunningSetId running_set_;
+  ModelOf model_of_;
+  core::AuditSink* audit_;
+  Log log_;
+
+  // The thread's own: the estimator and the set it was made for.
+  std::optional<diag::ModelHealth> health_;
+  std::optional<std::int64_t> set_id_;
+
+  mutable std::mutex mutex_;
+  mutable std::condition_variable changed_;
+  std::deque<Queued> queue_;
+  bool busy_ = false;  // a run is being judged
+  std::optional<std::string> retake_source_;  // a baseline retake asked for, by whom
+  bool stop_ = false;
+  points::HealthReport report_;
+  std::thread thread_;
+};
+
+// diag's vocabulary in the interface's codes.
+points::HealthStateCode health_state_code(diag::HealthState state);
+points::HealthEffectCode health_effect_code(plant::EffectKind effect);
+
+}  // namespace epa::appliance
