@@ -116,9 +116,15 @@ points::HealthView HealthMonitor::view() const {
   return report_.view;
 }
 
-points::HealthReport HealthMonitor::report() const {
+points::HealthReport HealthMonitor::report(bool with_trend) const {
   std::lock_guard lock(mutex_);
-  return report_;
+  if (with_trend) return report_;
+  points::HealthReport r;
+  r.view = report_.view;
+  r.size = report_.size, r.unit = report_.unit, r.reason = report_.reason;
+  r.window_gap_mm = report_.window_gap_mm, r.baseline_gap_mm = report_.baseline_gap_mm;
+  r.moves_dropped = report_.moves_dropped;
+  return r;
 }
 
 void HealthMonitor::retake_baseline(const std::string& source) {
@@ -141,7 +147,9 @@ void HealthMonitor::run_thread() {
   busy_ = false;
   changed_.notify_all();
   while (true) {
-    changed_.wait(lock, [&] { return stop_ || !queue_.empty() || retake_source_; });
+    // Woken by a move or a command, and every kSetPollS to see whether another set runs (one is
+    // deployed by commissioning, or rolled back, between moves).
+    changed_.wait_for(lock, std::chrono::duration<double>(kSetPollS), [&] { return stop_ || !queue_.empty() || retake_source_; });
     if (stop_) return;
     busy_ = true;
     std::optional<std::string> retake = std::exchange(retake_source_, std::nullopt);
@@ -166,7 +174,10 @@ void HealthMonitor::follow_running_set() {
   set_id_ = id;
   health_.reset();
   auto model = model_of_(id);
-  if (!model) return set_off("the running tuning set's model could not be read: " + model.error().message, "health monitor");
+  if (!model) {
+    set_id_.reset();  // read it again at the next look: the store may have been busy
+    return set_off("the running tuning set's model could not be read: " + model.error().message, "health monitor");
+  }
   if (!model->stick_slip)
     return set_off("the running tuning set '" + model->set_name +
                        "' has no stick-slip model: commission the axis (epa commission) to give it one",
@@ -187,13 +198,15 @@ void HealthMonitor::set_off(const std::string& reason, const std::string& source
   points::HealthReport r;
   r.reason = reason;
   HealthStateCode before;
+  bool same_reason;
   {
     std::lock_guard lock(mutex_);
     before = report_.view.state;
+    same_reason = report_.reason == reason;
     r.moves_dropped = report_.moves_dropped;
     report_ = std::move(r);
   }
-  log_(false, "model health: off: " + reason);
+  if (!same_reason) log_(false, "model health: off: " + reason);
   if (audit_ && before != HealthStateCode::kOff)
     audit_->record({{core::unix_time_ms(), source, std::string(points::name(points::PointId::kHealthState)), double(static_cast<int>(before)),
                      double(static_cast<int>(HealthStateCode::kOff))}});

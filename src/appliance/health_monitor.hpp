@@ -57,7 +57,7 @@ class HealthMonitor final : public points::HealthControl {
   void add_run(const core::Run& run, bool hunting);
 
   points::HealthView view() const override;
-  points::HealthReport report() const override;
+  points::HealthReport report(bool with_trend) const override;
   void retake_baseline(const std::string& source) override;
 
   // Waits (at most `timeout_ms`) until every run queued so far has been judged; for tests.
@@ -65,6 +65,7 @@ class HealthMonitor final : public points::HealthControl {
 
   static constexpr std::size_t kQueued = 8;
   static constexpr std::size_t kTrendKept = 120;  // judgements the page's trend shows
+  static constexpr double kSetPollS = 0.5;         // how often the running set is looked at between moves
 
  private:
   struct Queued {

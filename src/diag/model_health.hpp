@@ -15,9 +15,9 @@
 // a row. A window whose gap grew beyond unexplained_gap_ratio times the baseline's with no change
 // that explains it is unexplained.
 //
-// Pure: no threads, no clock, so that it can run on a low-priority thread beside the scan cycle.
-// The appliance does not run it yet: its false alarms are still above zero (notes/model-health.md);
-// bench/health_drift.cpp measures it on the physics plant.
+// Pure: no threads, no clock, so that it can run on a low-priority thread beside the scan cycle
+// (appliance/health_monitor.hpp runs it so). bench/health_drift.cpp measures it on the physics
+// plant; its false alarms are still above zero there (notes/model-health.md).
 #include <array>
 #include <cstddef>
 #include <deque>

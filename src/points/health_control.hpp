@@ -67,7 +67,8 @@ class HealthControl {
  public:
   virtual ~HealthControl() = default;
   virtual HealthView view() const = 0;
-  virtual HealthReport report() const = 0;
+  // With `with_trend` false, `trend` is left empty (what /api/status needs, polled 4 times a second).
+  virtual HealthReport report(bool with_trend) const = 0;
   // Forgets the baseline: the next moves are learnt as the new one. `source`: who asked (audit).
   virtual void retake_baseline(const std::string& source) = 0;
 };

@@ -476,8 +476,8 @@ GateResult WriteGate::health(std::span<const PointWrite> writes, const Requester
   return {};
 }
 
-HealthReport WriteGate::health_report() const {
-  if (health_) return health_->report();
+HealthReport WriteGate::health_report(bool with_trend) const {
+  if (health_) return health_->report(with_trend);
   HealthReport r;
   r.reason = "this appliance runs no model-health monitor";
   return r;

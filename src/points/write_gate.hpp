@@ -96,7 +96,7 @@ class WriteGate {
   // command refused). Attach it before the interfaces start; it must outlive them.
   void attach_health(HealthControl* health) { health_ = health; }
   HealthView health_view() const { return health_ ? health_->view() : HealthView{}; }
-  HealthReport health_report() const;
+  HealthReport health_report(bool with_trend) const;
 
   // Logs and audits the commands the loop refused after the gate accepted them. Off the loop.
   void take_refusals(const std::function<void(const std::string&)>& log);

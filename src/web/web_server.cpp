@@ -81,8 +81,8 @@ struct WebServer::Impl {
   runtime::LoopChannels& channels;
   // The loop's snapshot with the accepted writes it has not taken yet (read after write).
   runtime::Snapshot snapshot() const { return gate ? gate->snapshot() : channels.snapshot.read(); }
-  points::HealthReport health_report() const {
-    if (gate) return gate->health_report();
+  points::HealthReport health_report(bool with_trend) const {
+    if (gate) return gate->health_report(with_trend);
     points::HealthReport r;
     r.reason = "this server has no write gate, so no model-health monitor";
     return r;
@@ -294,9 +294,9 @@ struct WebServer::Impl {
       return httplib::Server::HandlerResponse::Unhandled;
     });
     s.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
-      res.set_content(status_json(snapshot(), modbus(), commands_enabled(), store(), health_report()), kJson);
+      res.set_content(status_json(snapshot(), modbus(), commands_enabled(), store(), health_report(false)), kJson);
     });
-    s.Get("/api/health", [this](const httplib::Request&, httplib::Response& res) { res.set_content(health_json(health_report()), kJson); });
+    s.Get("/api/health", [this](const httplib::Request&, httplib::Response& res) { res.set_content(health_json(health_report(true)), kJson); });
     s.Get("/api/trend", [this](const httplib::Request&, httplib::Response& res) { res.set_content(*trend_body(), kJson); });
     s.Get("/api/moves", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(moves_json(trend.moves()), kJson);

@@ -81,7 +81,7 @@ TEST(HealthMonitor, ASetWithoutAStickSlipModelIsNotMonitoredAndSaysWhy) {
   Rig rig(/*with_stick_slip=*/false);
   testing::StickSlipAxis axis(rig.model, *rig.model.stick_slip, 1);
   rig.moves(axis, 3);
-  const auto r = rig.monitor.report();
+  const auto r = rig.monitor.report(true);
   EXPECT_EQ(r.view.state, HealthStateCode::kOff);
   EXPECT_EQ(r.view.moves_seen, 0u);
   EXPECT_NE(r.reason.find("no stick-slip model"), std::string::npos) << r.reason;
@@ -96,7 +96,7 @@ TEST(HealthMonitor, SwitchedOffItJudgesNothing) {
   rig.monitor.add_run(axis.next_move(), false);
   EXPECT_TRUE(rig.monitor.wait_idle(1000));
   EXPECT_EQ(rig.monitor.view().state, HealthStateCode::kOff);
-  EXPECT_NE(rig.monitor.report().reason.find("enabled = false"), std::string::npos);
+  EXPECT_NE(rig.monitor.report(true).reason.find("enabled = false"), std::string::npos);
   EXPECT_EQ(rig.model_reads.load(), 0);
 }
 
@@ -141,7 +141,7 @@ TEST(HealthMonitor, FrictionDoubledIsPublishedAuditedAndWarns) {
     if (rig.monitor.view().state == HealthStateCode::kDrifting) named_after = m;
   }
   ASSERT_GT(named_after, 0) << "friction x2 never named";
-  const auto r = rig.monitor.report();
+  const auto r = rig.monitor.report(true);
   EXPECT_EQ(r.view.effect, HealthEffectCode::kStaticFriction);
   EXPECT_NEAR(r.view.ratio, 2.0, 0.6);
   EXPECT_NEAR(r.view.value / r.view.commissioned, r.view.ratio, 1e-9);

@@ -186,7 +186,7 @@ TEST(WriteGate, CommissionCommandIsUnlockProtectedWrittenAloneAndGoesToTheServic
 // A model-health monitor that records the retakes the gate asked for.
 struct FakeHealth final : HealthControl {
   HealthView view() const override { return {HealthStateCode::kDrifting, HealthEffectCode::kStaticFriction, 14.0, 7.0, 2.0, 40, 6}; }
-  HealthReport report() const override { return {view(), "friction up 100 %", "mm", "", 0.5, 0.2, 0, {}}; }
+  HealthReport report(bool) const override { return {view(), "friction up 100 %", "mm", "", 0.5, 0.2, 0, {}}; }
   void retake_baseline(const std::string& source) override { retakes.push_back(source); }
   std::vector<std::string> retakes;
 };
@@ -216,7 +216,7 @@ TEST(WriteGate, HealthCommandIsUnlockProtectedWrittenAloneAndRetakesTheMonitorsB
   EXPECT_FALSE(channels.commands.try_pop(c));  // nothing for the loop
   EXPECT_TRUE(sink.entries.empty());           // the monitor audits the retake under its source
   EXPECT_EQ(gate.health_view().effect, HealthEffectCode::kStaticFriction);
-  EXPECT_EQ(gate.health_report().size, "friction up 100 %");
+  EXPECT_EQ(gate.health_report(false).size, "friction up 100 %");
 }
 
 TEST(WriteGate, AGroupIsTakenWholeOrNotAtAll) {
