@@ -98,8 +98,9 @@ void Axis::start_recorder() {
       [this](const std::string& path, const core::Run& run) {
         services_.store.record_run(to_run_record(path, run));
         recorded_.put(path, run);
-        health_->add_run(run, channels_.snapshot.read().axis.hunting);
       });
+  // The monitor judges a move from the rest it started at, which its file does not hold.
+  recorder_->on_move_with_rest([this](const core::Run& move) { health_->add_run(move, channels_.snapshot.read().axis.hunting); });
   recorder_->start();
 }
 

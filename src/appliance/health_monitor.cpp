@@ -4,6 +4,7 @@
 #include <sched.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 
@@ -17,19 +18,22 @@ namespace {
 
 using points::HealthStateCode;
 
-// A move ended as a move (not cut short, halted, stopped or faulted), closed-loop, recorded whole
-// and from rest: what the estimator compares with its model (diag/model_health.hpp).
-bool judged_move(const core::Run& run) {
+// A move ended as a move (not cut short, halted, stopped or faulted), closed-loop and recorded
+// whole: what the estimator compares with its model (diag/model_health.hpp).
+bool whole_move(const core::Run& run) {
   if (run.meta("move").empty() || run.meta("controller") == "open-loop" || !run.meta("samples_lost").empty()) return false;
   const auto end = core::parse_move_end(run.meta("move_end"));
-  if (!end || (*end != core::MoveEnd::kInPosition && *end != core::MoveEnd::kOffTarget && *end != core::MoveEnd::kTimeout)) return false;
-  // From rest: a move that follows a cut one starts at speed.
-  constexpr std::size_t kRestSamples = 4;
-  constexpr double kRestMm = 0.5;
-  if (run.size() < 2 * kRestSamples) return false;
-  for (std::size_t k = 1; k < kRestSamples; ++k)
-    if (std::abs(run.y_mm[k] - run.y_mm[0]) > kRestMm) return false;
-  return true;
+  return end && (*end == core::MoveEnd::kInPosition || *end == core::MoveEnd::kOffTarget || *end == core::MoveEnd::kTimeout);
+}
+
+// The move that follows a cut one starts with the piston at speed, not from rest as the estimator
+// assumes. (Its first readings cannot tell: from rest, a wound-up air spring moves the piston in the
+// first sample.)
+bool follows_a_cut_move(const core::Run& run, const std::string& previous_move, const std::string& previous_end) {
+  std::uint64_t previous = 0;
+  const auto [end, error] = std::from_chars(previous_move.data(), previous_move.data() + previous_move.size(), previous);
+  const bool previous_is_the_one_before = error == std::errc() && std::to_string(previous + 1) == run.meta("move");
+  return !previous_is_the_one_before || previous_end == core::to_string(core::MoveEnd::kCutShort);
 }
 
 // The lowest priority Linux has: the monitor takes only what the loop, the interfaces and the
@@ -99,9 +103,13 @@ HealthMonitor::~HealthMonitor() {
 }
 
 void HealthMonitor::add_run(const core::Run& run, bool hunting) {
-  if (!config_.enabled || !judged_move(run)) return;
+  if (!config_.enabled || run.meta("move").empty()) return;
   {
     std::lock_guard lock(mutex_);
+    const bool after_cut = follows_a_cut_move(run, previous_move_, previous_end_);
+    previous_move_ = run.meta("move");
+    previous_end_ = run.meta("move_end");
+    if (after_cut || !whole_move(run)) return;
     if (queue_.size() >= kQueued) {
       ++report_.moves_dropped;
       return;

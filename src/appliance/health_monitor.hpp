@@ -51,8 +51,9 @@ class HealthMonitor final : public points::HealthControl {
   HealthMonitor(const HealthMonitor&) = delete;
   HealthMonitor& operator=(const HealthMonitor&) = delete;
 
-  // A run the recorder wrote: a move's file is queued for judging (at most kQueued wait; more are
-  // dropped and counted), any other run is ignored. `hunting`: the loop's hunting watch holds the
+  // A run the recorder wrote: a whole move's file is queued for judging (at most kQueued wait; more
+  // are dropped and counted), unless the move before it was cut short (or not seen: the piston may
+  // have been sliding); any other run is ignored. `hunting`: the loop's hunting watch holds the
   // law as it is written. Never blocks on a judgement.
   void add_run(const core::Run& run, bool hunting);
 
@@ -92,6 +93,7 @@ class HealthMonitor final : public points::HealthControl {
   mutable std::mutex mutex_;
   mutable std::condition_variable changed_;
   std::deque<Queued> queue_;
+  std::string previous_move_, previous_end_;  // the last move's number and end, as its run file says
   bool busy_ = false;  // a run is being judged
   std::optional<std::string> retake_source_;  // a baseline retake asked for, by whom
   bool stop_ = false;

@@ -1,6 +1,7 @@
 #include "runtime/recorder.hpp"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -43,9 +44,11 @@ std::size_t Recorder::process_pending() {
   RecordRequest r;
   while (ch_.record_requests.try_pop(r)) {
     if (r.reason == RecordRequest::Reason::kMove && !config_.per_move) continue;
-    if (!may_write(r)) continue;
-    write(r);
-    ++n;
+    if (may_write(r)) {
+      write(r);
+      ++n;
+    }
+    if (r.reason == RecordRequest::Reason::kMove) last_move_end_ = std::max(last_move_end_, r.end);
   }
   return n;
 }
@@ -161,6 +164,21 @@ void Recorder::write(const RecordRequest& request) {
   if (log_) log_("recorder: wrote " + path + " (" + std::to_string(run.size()) + " samples)");
   quota_->add(path);
   if (written_) written_(path, run);
+  if (move_with_rest_ && request.reason == RecordRequest::Reason::kMove) hand_over_with_rest(request, run);
+}
+
+void Recorder::hand_over_with_rest(const RecordRequest& request, const core::Run& move) const {
+  const auto rest = static_cast<std::uint64_t>(std::lround(config_.rest_before_s / config_.Ts));
+  const std::uint64_t from = std::max(request.first > rest ? request.first - rest : 0, last_move_end_);
+  core::Run with_rest;
+  with_rest.Ts = config_.Ts;
+  with_rest.metadata = move.metadata;
+  const auto first = ch_.samples.copy_out(std::min(from, request.first), request.end, with_rest);
+  if (with_rest.size() < move.size()) return move_with_rest_(move);  // the ring has lapped the rest meanwhile
+  const double t0 = with_rest.t_s.front();
+  for (double& t : with_rest.t_s) t = std::round((t - t0) / config_.Ts) * config_.Ts;
+  with_rest.set_meta("rest_before_samples", std::to_string(request.first - first));
+  move_with_rest_(with_rest);
 }
 
 }  // namespace epa::runtime

@@ -29,13 +29,20 @@ struct RecorderConfig {
   std::uint64_t quota_bytes = 512ull * 1024 * 1024;
   double move_files_per_minute = 60;
   std::uint64_t min_free_bytes = 256ull * 1024 * 1024;
+  // A move handed to on_move_with_rest() holds up to this much before its first cycle, back to the
+  // end of the move before it: the rest it started from (its file holds the move alone).
+  double rest_before_s = 1.0;
 };
 
 class Recorder {
  public:
   using Log = std::function<void(const std::string&)>;
   using Written = std::function<void(const std::string& path, const core::Run& run)>;  // e.g. into the run history
+  using MoveWithRest = std::function<void(const core::Run& move)>;
   Recorder(RecorderConfig config, LoopChannels& channels, Log log = {}, Written written = {});
+  // Each move whose file was written, again with the rest before it (rest_before_s; metadata as its
+  // file's, and rest_before_samples): what the model-health monitor judges. Before start().
+  void on_move_with_rest(MoveWithRest f) { move_with_rest_ = std::move(f); }
   ~Recorder();
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
@@ -54,12 +61,15 @@ class Recorder {
 
  private:
   void write(const RecordRequest& request);
+  void hand_over_with_rest(const RecordRequest& request, const core::Run& move) const;
   bool may_write(const RecordRequest& request);  // the rate and the disk's free space
 
   RecorderConfig config_;
   LoopChannels& ch_;
   Log log_;
   Written written_;
+  MoveWithRest move_with_rest_;
+  std::uint64_t last_move_end_ = 0;  // the sample after the last move the loop reported: a rest before a move starts there
   std::atomic<bool> stop_{false};
   std::thread thread_;
   std::atomic<std::uint64_t> files_written_{0};

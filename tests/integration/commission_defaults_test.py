@@ -94,7 +94,7 @@ def main():
     epa, src = sys.argv[1], sys.argv[2]
     check = Checks()
     app = Appliance(epa, os.path.join(src, "registers", "epa.csv"), web_static_dir=os.path.join(src, "web"),
-                    web_extra=f'token = "{TOKEN}"\n')
+                    web_extra=f'token = "{TOKEN}"\n', extra_config="[health]\nenabled = true\n")
     folder = tempfile.mkdtemp(prefix="epa-commission-defaults.")
     try:
         # A spec this appliance cannot run: the shipped ring keeps 60 s, an experiment may take 59 s.

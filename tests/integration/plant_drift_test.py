@@ -10,50 +10,15 @@ are refused naming what was wrong, and the Hammerstein plant refuses `physics` l
 Loopback only, bounded waits; the plant-servers are stopped by their PIDs. Exit 0 when every check holds.
 """
 import os
-import queue
-import subprocess
 import sys
-import threading
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
-from epa_appliance import UNIT, Checks, ModbusTcpClient, free_port, stop_process  # noqa: E402
+from epa_appliance import UNIT, Checks, ModbusTcpClient  # noqa: E402
+from plant_server import PlantServer  # noqa: E402
 
 MM_PER_VOLT = 50.0  # the physics plant's sensor: 0-10 V over its 500 mm stroke
 COUNTS_PER_VOLT = 32767 / 10.0
-
-
-class PlantServer:
-    def __init__(self, epa, plant):
-        self.port = free_port()
-        self.proc = subprocess.Popen([epa, "plant-server", "--plant", plant, "--port", str(self.port), "--control-stdin",
-                                      "--initial-position", "100"],
-                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1)
-        self.lines = queue.Queue()
-        threading.Thread(target=self._read, daemon=True).start()
-        first = self.line(5.0)
-        if "listening" not in first:
-            stop_process(self.proc)
-            raise RuntimeError(f"plant-server did not start: {first!r}")
-        self.line(5.0)  # the plant line
-
-    def _read(self):
-        for text in self.proc.stdout:
-            self.lines.put(text.strip())
-
-    def line(self, timeout_s):
-        try:
-            return self.lines.get(timeout=timeout_s)
-        except queue.Empty:
-            return ""
-
-    def command(self, text):
-        self.proc.stdin.write(text + "\n")
-        self.proc.stdin.flush()
-        return self.line(5.0)
-
-    def stop(self):
-        stop_process(self.proc)
 
 
 def position_mm(client):

@@ -472,5 +472,54 @@ TEST(Recorder, WritesEachMoveAsAValidRunFile) {
   EXPECT_EQ(requested->size(), 200u);
 }
 
+// The model-health monitor's copy of a move: the same samples as its file, after the rest it
+// started from, back to rest_before_s but never into the move before it.
+TEST(Recorder, HandsOverEachMoveWithTheRestItStartedFrom) {
+  const test::TempDir dir("recorder-rest");
+  auto daq = *hal::SimDaq::make(core::paper::model(), {});
+  VirtualClock clock;
+  RuntimeConfig config;
+  config.start_mode = Mode::kRun;
+  config.start_moves_to_setpoint = true;
+  config.start_setpoint_mm = 50.0;
+  config.move_window_s = 2.0;
+  config.controller = ControllerKind::kPpNgidz;
+  LoopChannels ch(4000);
+  ScanCycle loop(config, paper_tuning(), daq, clock, ch);
+  Recorder recorder({.directory = dir.path.string(), .per_move = true, .Ts = 0.005, .source = "test", .rest_before_s = 1.0}, ch);
+  std::vector<core::Run> handed;
+  recorder.on_move_with_rest([&](const core::Run& move) { handed.push_back(move); });
+  run_cycles(loop, clock, 450);
+  ASSERT_EQ(recorder.process_pending(), 1u);
+  ASSERT_EQ(handed.size(), 1u);
+  run_cycles(loop, clock, 600);  // 3 s at rest
+  ASSERT_TRUE(ch.commands.try_push(setpoint_command(100.0)));
+  run_cycles(loop, clock, 450);
+  ASSERT_EQ(recorder.process_pending(), 1u);
+  ASSERT_EQ(handed.size(), 2u);
+  auto file = core::read_run_file(recorder.last_file(), 0.005);
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  const core::Run& with_rest = handed.back();
+  EXPECT_EQ(with_rest.meta("rest_before_samples"), "200");  // 1 s: the rest was longer
+  EXPECT_EQ(with_rest.meta("move"), file->meta("move"));
+  EXPECT_EQ(with_rest.meta("move_end"), file->meta("move_end"));
+  ASSERT_EQ(with_rest.size(), file->size() + 200);
+  for (std::size_t k = 0; k < file->size(); ++k) EXPECT_NEAR(with_rest.y_mm[200 + k], file->y_mm[k], 1e-4) << k;
+  for (std::size_t k = 0; k < 200; ++k) EXPECT_NEAR(with_rest.y_mm[k], file->y_mm[0], 0.5) << k;  // standing
+  EXPECT_EQ(with_rest.t_s.front(), 0.0);
+
+  // A move right after another: its rest goes back to that move's end, not into it.
+  ASSERT_TRUE(ch.commands.try_push(setpoint_command(150.0)));
+  const auto moves = loop.last_snapshot().last_move.number;
+  for (int k = 0; k < 450 && loop.last_snapshot().last_move.number == moves; ++k) run_cycles(loop, clock, 1);
+  ASSERT_TRUE(ch.commands.try_push(setpoint_command(200.0)));  // the moment the move to 150 mm ended
+  run_cycles(loop, clock, 450);
+  ASSERT_EQ(recorder.process_pending(), 2u);
+  ASSERT_EQ(handed.size(), 4u);
+  const auto rest_samples = std::stoul(handed.back().meta("rest_before_samples"));
+  EXPECT_LT(rest_samples, 200u);
+  EXPECT_EQ(handed.back().size(), std::stoul(handed.back().meta("rest_before_samples")) + core::read_run_file(recorder.last_file(), 0.005)->size());
+}
+
 }  // namespace
 }  // namespace epa::runtime

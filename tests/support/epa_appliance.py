@@ -73,6 +73,38 @@ def i16_value(word):
     return word - 0x10000 if word & 0x8000 else word
 
 
+# ---- points by name, through a register map file (epa-registers/1) ----
+def read_register_map(path):
+    """{name: (table, address, type, word_order)} of a register map file."""
+    points = {}
+    with open(path) as f:
+        for line in f:
+            fields = line.rstrip("\n").split(",")
+            if line.startswith("#") or len(fields) < 5 or fields[0] == "name":
+                continue
+            points[fields[0]] = (fields[1], int(fields[2]), fields[3], fields[4] or "ABCD")
+    return points
+
+
+def read_point(client, points, name):
+    """A holding or input point's value, decoded by its type (float32, uint32, uint16)."""
+    table, address, kind, order = points[name]
+    count = 2 if kind in ("float32", "uint32") else 1
+    read = client.read_input_registers if table == "input" else client.read_holding_registers
+    words = read(address, count, slave=UNIT).registers
+    if kind == "float32":
+        return f32_value(words, order)
+    return u32_value(words) if kind == "uint32" else words[0]
+
+
+def write_point(client, points, name, value):
+    """Writes a holding point (float32 or uint16) in one request; the pymodbus answer."""
+    table, address, kind, order = points[name]
+    if kind == "float32":
+        return client.write_registers(address, f32_words(value, order), slave=UNIT)
+    return client.write_register(address, int(value), slave=UNIT)
+
+
 # ---- the appliance as a child process ----
 def wait_until(predicate, timeout_s, every_s=0.01):
     """Polls `predicate` until it returns something true (returned) or `timeout_s` has passed (its
