@@ -7,11 +7,12 @@ made by `physics` lines on the plant-server's stdin, as wear would make it while
 After every move the monitor's verdict is read over Modbus (health_state, health_effect,
 health_ratio), as an HMI reads it.
 
-  bench/health_hil.py EPA MODEL [MOVES=70] [CHANGE_AT=32] [CASE ...]
+  bench/health_hil.py EPA MODEL [MOVES=70] [CHANGE_AT=32] [--law LAW] [CASE ...]
 
 Cases: friction-x2, supply-4.5bar, overlap-0.25V, spool-x3, null (no change; all when none are
-given). Prints one line per case and "health hil: N of M changes named, median K moves after the
-change, latest L; false alarms F in U unchanged moves".
+given). LAW moves the axis (pp-traj when not given). Prints one line per case and "health hil: N
+of M changes named, median K moves after the change, latest L; false alarms F in U unchanged
+moves".
 """
 import json
 import os
@@ -42,12 +43,12 @@ CASES = {
 MOVE_END_BOUND_S = 8.0
 
 
-def run_case(epa, model, points, name, moves, change_at, seed):
+def run_case(epa, model, points, name, moves, change_at, law, seed):
     lines, expected, direction = CASES[name]
     plant = PlantServer(epa, "physics", initial_position_mm=250.0, extra_args=["--sync-to-valve-writes"])
     app = None
     try:
-        extra = ('[controller]\nkind = "pp-traj"\n'
+        extra = (f'[controller]\nkind = "{law}"\n'
                  f'model = "{model}"\n'
                  '[hal]\nbackend = "modbus-io"\n'
                  f'[hal.modbus_io]\nport = {plant.port}\n'
@@ -102,8 +103,13 @@ def run_case(epa, model, points, name, moves, change_at, seed):
 
 def main(argv):
     if len(argv) < 3:
-        print(__doc__.strip().splitlines()[-5], file=sys.stderr)
+        print("usage:" + next(line for line in __doc__.splitlines() if "health_hil.py EPA" in line), file=sys.stderr)
         return 2
+    law = "pp-traj"
+    if "--law" in argv:
+        i = argv.index("--law")
+        law = argv[i + 1]
+        argv = argv[:i] + argv[i + 2:]
     epa, model = argv[1], os.path.abspath(argv[2])
     moves = int(argv[3]) if len(argv) > 3 else 70
     change_at = int(argv[4]) if len(argv) > 4 else 32
@@ -112,7 +118,7 @@ def main(argv):
     named, changes, alarms_total, unchanged = [], 0, 0, 0
     for name in names:
         start = time.monotonic()
-        after, ratio, alarms, seen, unchanged_moves, final = run_case(epa, model, points, name, moves, change_at, seed=1)
+        after, ratio, alarms, seen, unchanged_moves, final = run_case(epa, model, points, name, moves, change_at, law, seed=1)
         alarms_total += alarms
         unchanged += unchanged_moves
         if CASES[name][0]:
@@ -122,7 +128,7 @@ def main(argv):
         verdict = ("not named" if after is None else f"named {CASES[name][1]} {after} moves after the change (ratio {ratio:.2f})") \
             if CASES[name][0] else "no change"
         state, effect, final_ratio = final
-        print(f"case {name}: {verdict}; {alarms} false alarm(s) before the change; {seen} moves judged; at the end: "
+        print(f"case {name} ({law}): {verdict}; {alarms} false alarm(s) before the change; {seen} moves judged; at the end: "
               f"health_state {state} {effect} ratio {final_ratio:.2f}; {time.monotonic() - start:.0f} s")
     median = f"{statistics.median(named):.0f}" if named else "-"
     latest = f"{max(named)}" if named else "-"

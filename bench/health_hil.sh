@@ -3,7 +3,7 @@
 # (bench/health_hil.py): the axis identified as a commissioning engineer does it
 # (bench/physics_axis.sh), then per case 70 moves in real time with one physical change after 32.
 #
-#   bench/health_hil.sh [BUILD_DIR=build/release] [MOVES=70] [CHANGE_AT=32] [CASE ...]
+#   bench/health_hil.sh [BUILD_DIR=build/release] [MOVES=70] [CHANGE_AT=32] [--law LAW] [CASE ...]
 #
 # Prints each case and "health hil: N of M changes named, median K moves after the change, latest
 # L; false alarms F in U unchanged moves". About 2 minutes a case. CI's smoke step runs one short

@@ -56,7 +56,7 @@ def one_run(epa, model, points, monitor_on, seconds, move_s, seed):
 
 def main(argv):
     if len(argv) < 3:
-        print(__doc__.strip().splitlines()[-3], file=sys.stderr)
+        print("usage:" + next(line for line in __doc__.splitlines() if "health_jitter.py EPA" in line), file=sys.stderr)
         return 2
     epa, model = argv[1], os.path.abspath(argv[2])
     runs = int(argv[3]) if len(argv) > 3 else 3

@@ -52,6 +52,7 @@ smoke identify_physics '^identify_physics: [0-9]+ of [0-9]+ pairs' bench/identif
 smoke commission_physics '^deployed [0-9]+/[0-9]+$' bench/commission_physics.sh 1 101 0.3 "$build"
 smoke abuse_jitter '^abuse jitter p99 median: [0-9]+ us' bench/abuse_jitter.sh 1 1 "$build"
 smoke health_jitter '^health jitter p99: on [0-9]+ us / off [0-9]+ us' bench/health_jitter.sh "$build" 1 3
+smoke health_hil '^health hil: [0-9]+ of [0-9]+ changes named' bench/health_hil.sh "$build" 4 2 friction-x2
 
 # Not in the "N passed, N failed" form: the suite's count is ctest's, these are not tests.
 if [ "$failed" -eq 0 ]; then echo "bench smoke: all $passed benchmarks ran"; else echo "bench smoke: $failed of $((passed + failed)) benchmarks FAILED"; exit 1; fi

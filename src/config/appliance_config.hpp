@@ -24,9 +24,7 @@ enum class HalBackend { kSim, kModbusIo, kComedi };
 
 // [health]: the model-health monitor (appliance/health_monitor.hpp).
 struct HealthSettings {
-  // Off unless switched on: on the appliance's own move files it does not yet name drifts
-  // (bench/health_hil.sh; docs/operation.md, "Model health").
-  bool enabled = false;
+  bool enabled = true;
   double stroke_mm = 500.0;     // the end stops (0 and this): segments of a move that reach them are not judged
   diag::HealthConfig estimator;  // its baseline, window and thresholds
 };

@@ -46,7 +46,7 @@ TEST(ApplianceConfig, ShippedFileParsesToTheDocumentedDefaults) {
   EXPECT_EQ(c->physics_config, "");
   // [health] as shipped is the estimator's own default, the one its benchmark measured.
   const diag::HealthConfig health;
-  EXPECT_FALSE(c->health.enabled);  // off until it names drifts on the appliance's own move files
+  EXPECT_TRUE(c->health.enabled);
   EXPECT_EQ(c->health.stroke_mm, 500.0);
   EXPECT_EQ(c->health.estimator.baseline_moves, health.baseline_moves);
   EXPECT_EQ(c->health.estimator.window_moves, health.window_moves);

@@ -215,6 +215,11 @@ TEST_F(WebServerTest, StatusCarriesTheStatusWordPackedAndBitByBit) {
   for (const char* key : {"effect", "size", "ratio", "value", "commissioned", "unit", "moves_since_onset", "moves_seen"})
     EXPECT_TRUE(h["health"].contains(key)) << key;
   EXPECT_TRUE(h["health"]["ratio"].is_null());
+  const json detail = get_json("/api/health");
+  EXPECT_EQ(detail["state"], "off");
+  EXPECT_TRUE(detail["trend"].is_array());
+  EXPECT_TRUE(detail["trend"].empty());
+  EXPECT_TRUE(detail["window_gap_mm"].is_null());
 }
 
 TEST_F(WebServerTest, StatusNamesALatchedFaultInWords) {
@@ -786,6 +791,31 @@ TEST_F(WebServerTest, WrongTokensFromAnAddressAreRefusedUnseenForABackOff) {
   EXPECT_FALSE(locked->get_header_value("Retry-After").empty());
   EXPECT_TRUE(queued().empty());
   EXPECT_EQ(get_json("/api/status")["mode"], "run");  // reading goes on
+}
+
+// A drifting verdict in JSON: the effect by the diagnosis's name, its numbers, each judgement's estimates.
+TEST(HealthJson, ADriftCarriesItsEffectSizeAndTrend) {
+  epa::points::HealthReport r;
+  r.view = {epa::points::HealthStateCode::kDrifting, epa::points::HealthEffectCode::kStaticFriction, 14.2, 7.9, 14.2 / 7.9, 61, 6};
+  r.size = "friction up 80 %";
+  r.unit = "mm";
+  r.window_gap_mm = 3.1;
+  r.trend = {{60, {{epa::points::HealthEffectCode::kStaticFriction, 1.7, 0.6}, {epa::points::HealthEffectCode::kGainChange, 0.9, 0.2}}}};
+  const json status = json::parse(epa::web::status_json({}, {}, false, {}, r));
+  EXPECT_EQ(status["health"]["state"], "drifting");
+  EXPECT_EQ(status["health"]["effect"], "static_friction");
+  EXPECT_EQ(status["health"]["size"], "friction up 80 %");
+  EXPECT_NEAR(status["health"]["ratio"].get<double>(), 14.2 / 7.9, 1e-12);
+  EXPECT_EQ(status["health"]["moves_since_onset"], 6);
+  EXPECT_EQ(status["health"]["moves_seen"], 61);
+  EXPECT_TRUE(status["status_bits"]["health_warning"].get<bool>());
+  EXPECT_TRUE(status["status_bits"]["warning"].get<bool>());
+  const json detail = json::parse(epa::web::health_json(r));
+  ASSERT_EQ(detail["trend"].size(), 1u);
+  EXPECT_EQ(detail["trend"][0]["move"], 60);
+  EXPECT_EQ(detail["trend"][0]["estimates"][1]["effect"], "gain_change");
+  EXPECT_NEAR(detail["trend"][0]["estimates"][0]["reduction"].get<double>(), 0.6, 1e-12);
+  EXPECT_NEAR(detail["window_gap_mm"].get<double>(), 3.1, 1e-12);
 }
 
 TEST(WebServerStatic, NothingOutsideStaticDirIsServedAndTheFolderMustHoldThePage) {
