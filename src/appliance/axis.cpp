@@ -72,7 +72,7 @@ Axis::Axis(const config::ApplianceConfig& config, const ControlSetup& control, p
       [](const std::string& line) { spdlog::info("{}", line); }, &services_.audit);
   gate_.attach_commission(commissioning_.get());
   health_ = std::make_unique<HealthMonitor>(
-      config_.health, [this] { return services_.store.running_set().id; },
+      config_.health, [this] { return services_.store.running_set_id(); },
       [this](std::int64_t set_id) { return monitored_model(config_.store_path, set_id); }, &services_.audit,
       [](bool warning, const std::string& line) { warning ? spdlog::warn("{}", line) : spdlog::info("{}", line); });
   gate_.attach_health(health_.get());

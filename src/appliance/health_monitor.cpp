@@ -1,7 +1,7 @@
 #include "appliance/health_monitor.hpp"
 
-#include <pthread.h>
-#include <sched.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <charconv>
@@ -36,13 +36,10 @@ bool follows_a_cut_move(const core::Run& run, const std::string& previous_move, 
   return !previous_is_the_one_before || previous_end == core::to_string(core::MoveEnd::kCutShort);
 }
 
-// The lowest priority Linux has: the monitor takes only what the loop, the interfaces and the
-// store leave. An unprivileged process may always lower its own.
-void lower_priority() {
-  sched_param p{};
-  p.sched_priority = 0;
-  (void)pthread_setschedparam(pthread_self(), SCHED_IDLE, &p);
-}
+// The lowest nice value: the monitor takes what the loop, the interfaces and the store leave. Not
+// SCHED_IDLE: a thread of that class can wait for the CPU for seconds on a busy machine, and it
+// still takes short locks. An unprivileged process may always lower its own threads.
+void lower_priority() { (void)setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19); }
 
 std::string state_reason(HealthStateCode s, const diag::HealthConfig& c) {
   switch (s) {
@@ -86,9 +83,11 @@ points::HealthEffectCode health_effect_code(plant::EffectKind effect) {
 HealthMonitor::HealthMonitor(config::HealthSettings config, RunningSetId running_set, ModelOf model_of, core::AuditSink* audit, Log log)
     : config_(std::move(config)), running_set_(std::move(running_set)), model_of_(std::move(model_of)), audit_(audit), log_(std::move(log)) {
   if (!config_.enabled) {
-    report_.reason = "the model-health monitor is switched off ([health] enabled = false)";
+    current_.reason = "the model-health monitor is switched off ([health] enabled = false)";
+    put(current_);
     return;
   }
+  put(current_);
   busy_ = true;  // until the thread has looked at the running set
   thread_ = std::thread([this] { run_thread(); });
 }
@@ -111,7 +110,7 @@ void HealthMonitor::add_run(const core::Run& run, bool hunting) {
     previous_end_ = run.meta("move_end");
     if (after_cut || !whole_move(run)) return;
     if (queue_.size() >= kQueued) {
-      ++report_.moves_dropped;
+      ++dropped_;
       return;
     }
     queue_.push_back({run, hunting});
@@ -119,20 +118,28 @@ void HealthMonitor::add_run(const core::Run& run, bool hunting) {
   changed_.notify_all();
 }
 
-points::HealthView HealthMonitor::view() const {
-  std::lock_guard lock(mutex_);
-  return report_.view;
-}
+points::HealthView HealthMonitor::view() const { return view_.read(); }
 
 points::HealthReport HealthMonitor::report(bool with_trend) const {
-  std::lock_guard lock(mutex_);
-  if (with_trend) return report_;
+  std::shared_ptr<const points::HealthReport> published;
+  {
+    std::lock_guard lock(report_mutex_);
+    published = report_;
+  }
   points::HealthReport r;
-  r.view = report_.view;
-  r.size = report_.size, r.unit = report_.unit, r.reason = report_.reason;
-  r.window_gap_mm = report_.window_gap_mm, r.baseline_gap_mm = report_.baseline_gap_mm;
-  r.moves_dropped = report_.moves_dropped;
+  r.view = published->view;
+  r.size = published->size, r.unit = published->unit, r.reason = published->reason;
+  r.window_gap_mm = published->window_gap_mm, r.baseline_gap_mm = published->baseline_gap_mm;
+  if (with_trend) r.trend = published->trend;
+  r.moves_dropped = dropped_.load();
   return r;
+}
+
+void HealthMonitor::put(points::HealthReport report) {
+  view_.publish(report.view);
+  auto shared = std::make_shared<const points::HealthReport>(std::move(report));
+  std::lock_guard lock(report_mutex_);
+  report_.swap(shared);  // the old one is freed outside the lock, when `shared` goes
 }
 
 void HealthMonitor::retake_baseline(const std::string& source) {
@@ -203,17 +210,11 @@ void HealthMonitor::judge(Queued item) {
 }
 
 void HealthMonitor::set_off(const std::string& reason, const std::string& source) {
-  points::HealthReport r;
-  r.reason = reason;
-  HealthStateCode before;
-  bool same_reason;
-  {
-    std::lock_guard lock(mutex_);
-    before = report_.view.state;
-    same_reason = report_.reason == reason;
-    r.moves_dropped = report_.moves_dropped;
-    report_ = std::move(r);
-  }
+  const HealthStateCode before = current_.view.state;
+  const bool same_reason = current_.reason == reason;
+  current_ = points::HealthReport{};
+  current_.reason = reason;
+  put(current_);
   if (!same_reason) log_(false, "model health: off: " + reason);
   if (audit_ && before != HealthStateCode::kOff)
     audit_->record({{core::unix_time_ms(), source, std::string(points::name(points::PointId::kHealthState)), double(static_cast<int>(before)),
@@ -238,33 +239,30 @@ void HealthMonitor::publish(const std::string& source, bool always_audit) {
   r.window_gap_mm = v.estimates.empty() ? std::nan("") : v.window_gap_mm;
   r.baseline_gap_mm = v.state == diag::HealthState::kLearning ? std::nan("") : v.baseline_gap_mm;
 
-  HealthStateCode before;
-  points::HealthEffectCode effect_before;
-  {
-    std::lock_guard lock(mutex_);
-    before = report_.view.state;
-    effect_before = report_.view.effect;
-    r.moves_dropped = report_.moves_dropped;
-    r.trend = std::move(report_.trend);
-    const bool new_judgement = !v.estimates.empty() && (r.trend.empty() || r.trend.back().move != r.view.moves_seen);
-    if (r.view.state == HealthStateCode::kLearning) r.trend.clear();
-    else if (new_judgement) {
-      points::HealthJudgement j{r.view.moves_seen, {}};
-      for (const auto& e : v.estimates) j.estimates.push_back({health_effect_code(e.effect), e.ratio, e.reduction});
-      r.trend.push_back(std::move(j));
-      if (r.trend.size() > kTrendKept) r.trend.erase(r.trend.begin());
-    }
-    report_ = r;
+  const HealthStateCode before = current_.view.state;
+  const points::HealthEffectCode effect_before = current_.view.effect;
+  r.trend = std::move(current_.trend);
+  const bool new_judgement = !v.estimates.empty() && (r.trend.empty() || r.trend.back().move != r.view.moves_seen);
+  if (r.view.state == HealthStateCode::kLearning) {
+    r.trend.clear();
+  } else if (new_judgement) {
+    points::HealthJudgement j{r.view.moves_seen, {}};
+    for (const auto& e : v.estimates) j.estimates.push_back({health_effect_code(e.effect), e.ratio, e.reduction});
+    r.trend.push_back(std::move(j));
+    if (r.trend.size() > kTrendKept) r.trend.erase(r.trend.begin());
   }
-  if (before == r.view.state && effect_before == r.view.effect && !always_audit) return;
-  const bool warns = points::health_warns(r.view.state);
-  log_(warns, "model health: " + std::string(points::to_string(before)) + " -> " + std::string(points::to_string(r.view.state)) +
-                  (r.size.empty() ? "" : " (" + r.size + ", " + std::to_string(r.view.moves_since_onset) + " moves since its onset)") +
-                  " after " + std::to_string(r.view.moves_seen) + " moves");
+  current_ = r;
+  put(std::move(r));
+  const points::HealthReport& now = current_;
+  if (before == now.view.state && effect_before == now.view.effect && !always_audit) return;
+  const bool warns = points::health_warns(now.view.state);
+  log_(warns, "model health: " + std::string(points::to_string(before)) + " -> " + std::string(points::to_string(now.view.state)) +
+                  (now.size.empty() ? "" : " (" + now.size + ", " + std::to_string(now.view.moves_since_onset) + " moves since its onset)") +
+                  " after " + std::to_string(now.view.moves_seen) + " moves");
   if (audit_)
-    audit_->record({{core::unix_time_ms(), source + (r.size.empty() ? "" : ": " + r.size),
+    audit_->record({{core::unix_time_ms(), source + (now.size.empty() ? "" : ": " + now.size),
                      std::string(points::name(points::PointId::kHealthState)), double(static_cast<int>(before)),
-                     double(static_cast<int>(r.view.state))}});
+                     double(static_cast<int>(now.view.state))}});
 }
 
 }  // namespace epa::appliance

@@ -1,6 +1,6 @@
 #pragma once
 // The model-health monitor of one axis: each move the recorder writes is judged, on a thread of
-// its own at the lowest scheduling priority (SCHED_IDLE: it takes only CPU nothing else wants),
+// its own at the lowest priority (nice 19: the loop, the interfaces and the store come first),
 // against the running tuning set's stick-slip model by diag::ModelHealth. Its verdict is what the
 // health points, /api/status, /metrics and the page show; each change of state goes to the audit
 // trail and the log. It never commands the axis: a drift warns, it does not fault.
@@ -10,6 +10,7 @@
 // stick-slip table (the paper's, or one identified before stick-slip models existed) is not
 // monitored: the state is off, and the reason says so.
 #include <array>
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -27,6 +28,7 @@
 #include "core/stick_slip_params.hpp"
 #include "diag/model_health.hpp"
 #include "points/health_control.hpp"
+#include "runtime/seqlock.hpp"
 
 namespace epa::appliance {
 
@@ -86,18 +88,29 @@ class HealthMonitor final : public points::HealthControl {
   core::AuditSink* audit_;
   Log log_;
 
-  // The thread's own: the estimator and the set it was made for.
+  // Hands the report over: readers copy a pointer, never wait for a judgement.
+  void put(points::HealthReport report);
+
+  // The thread's own: the estimator, the set it was made for, the verdict it last published.
   std::optional<diag::ModelHealth> health_;
   std::optional<std::int64_t> set_id_;
+  points::HealthReport current_;
 
-  mutable std::mutex mutex_;
+  // What the interfaces read. The thread runs at the lowest priority, so nothing it shares with
+  // them is held while it works: the numbers through a seqlock (a Modbus request reads them), the
+  // report as a pointer swapped under report_mutex_.
+  runtime::SeqlockCell<points::HealthView> view_;
+  mutable std::mutex report_mutex_;
+  std::shared_ptr<const points::HealthReport> report_;
+  std::atomic<std::uint64_t> dropped_{0};
+
+  mutable std::mutex mutex_;  // the queue and the commands
   mutable std::condition_variable changed_;
   std::deque<Queued> queue_;
   std::string previous_move_, previous_end_;  // the last move's number and end, as its run file says
   bool busy_ = false;  // a run is being judged
   std::optional<std::string> retake_source_;  // a baseline retake asked for, by whom
   bool stop_ = false;
-  points::HealthReport report_;
   std::thread thread_;
 };
 

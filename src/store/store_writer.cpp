@@ -23,7 +23,9 @@ constexpr std::uint64_t kItemsBetweenRetention = 1000;
 }  // namespace
 
 StoreWriter::StoreWriter(Database db, TuningSet running, std::set<points::PointId> persisted, Log log)
-    : db_(std::move(db)), running_(std::move(running)), persisted_(std::move(persisted)), log_(std::move(log)) {}
+    : db_(std::move(db)), running_(std::move(running)), persisted_(std::move(persisted)), log_(std::move(log)) {
+  running_set_id_.store(running_.id, std::memory_order_release);
+}
 
 StoreWriter::~StoreWriter() { stop(0.0); }
 
@@ -202,6 +204,7 @@ bool StoreWriter::flush() {
     if (!health_.ok && log_) log_("store: saving again after " + std::to_string(health_.failures) + " failed attempts");
     health_.ok = true;
     running_ = running;
+    running_set_id_.store(running.id, std::memory_order_release);
     std::uint64_t changes = 0;
     for (const Item& item : batch) changes += std::holds_alternative<std::vector<core::AuditEntry>>(item) ? 1 : 0;
     pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(batch.size()));

@@ -71,6 +71,9 @@ class StoreWriter final : public core::AuditSink {
   StoreHealth health() const;
   // The set the loop runs, as of the last write (a switch still pending is not in it yet).
   TuningSet running_set() const;
+  // Its id, without the lock: for a thread of low priority, which must not hold what the
+  // interfaces wait for.
+  std::int64_t running_set_id() const noexcept { return running_set_id_.load(std::memory_order_acquire); }
 
   // One write attempt of everything pending (the thread calls this; tests may call it directly).
   bool flush();
@@ -88,6 +91,7 @@ class StoreWriter final : public core::AuditSink {
 
   Database db_;
   TuningSet running_;  // owned by the writing side (the thread, or flush() in tests)
+  std::atomic<std::int64_t> running_set_id_{0};  // running_.id
   std::set<points::PointId> persisted_;
   Log log_;
 
