@@ -93,6 +93,9 @@ class Serve:
         self.proc = subprocess.Popen([epa, "serve", "--config", self.config, "--mode", "stop"], stdout=self.log,
                                      stderr=subprocess.STDOUT)
 
+    # Until `text` is in the log (or the process ended). The start is waited for by the
+    # supervisor's whole "running" line: the word alone comes earlier, in the model-health
+    # monitor's "the running tuning set ..." line, before the listeners are up.
     def wait_for(self, text, timeout_s=15.0):
         deadline = time.monotonic() + timeout_s
         while time.monotonic() < deadline:
@@ -133,7 +136,7 @@ def ipv6_only(epa, src, folder):
                 f'[modbus]\naddress = "::1"\nport = {mb_port}\nregister_map = "{os.path.join(src, "registers", "epa.csv")}"\n'
                 f'[web]\naddress = "::1"\nport = {web_port}\nstatic_dir = "{os.path.join(src, "web")}"\n')
     try:
-        check(app.wait_for("running"), "address = \"::1\": the appliance starts")
+        check(app.wait_for("[info] running\n"), "address = \"::1\": the appliance starts")
         log = app.log_text()
         check(f"modbus: listening on [::1]:{mb_port}" in log, f"the log names the Modbus socket as bound: [::1]:{mb_port}")
         check(f"web: listening on [::1]:{web_port}" in log, f"the log names the web socket as bound: [::1]:{web_port}")
@@ -165,7 +168,7 @@ def dual_stack(epa, src, folder):
                 f'[modbus]\naddress = "::"\nport = {mb_port}\nregister_map = "{os.path.join(src, "registers", "epa.csv")}"\n'
                 f'write_clients = ["127.0.0.1"]\n[web]\naddress = "::"\nport = {web_port}\nstatic_dir = "{os.path.join(src, "web")}"\n')
     try:
-        check(app.wait_for("running"), "address = \"::\": the appliance starts")
+        check(app.wait_for("[info] running\n"), "address = \"::\": the appliance starts")
         log = app.log_text()
         check(f"modbus: listening on [::]:{mb_port}" in log, f"the log names [::]:{mb_port}")
         check("any address may command motion" not in log, "write_clients set: no WARNING")
