@@ -18,15 +18,15 @@ packages=(
   libeigen3-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libjs-chart.js libpagmo-dev libnlopt-cxx-dev libsqlite3-dev
-  libmodbus-dev libcomedi-dev libspdlog-dev libsystemd-dev libcpp-httplib-dev
+  libmodbus-dev libcomedi-dev libspdlog-dev libsystemd-dev libcpp-httplib-dev libssl-dev
   # sanitizer and fuzz builds (scripts/test-sanitizers.sh, test-tsan.sh, fuzz.sh)
   clang libclang-rt-14-dev
   # programs the tests and scripts call: Modbus clients (mbpoll, Debian's python3 with pymodbus),
-  # the browser, HTTP (curl), taskset/chrt (util-linux), mount (fault injection), promtool
+  # the browser, HTTP (curl), TLS (openssl s_client), taskset/chrt (util-linux), mount (fault injection), promtool
   # (/metrics checked by Prometheus' own linter; Debian ships it only in prometheus, which also
   # installs the Prometheus server as a service: the tests use promtool alone); sqlite3 is the
   # database's own shell, for looking into the tuning store (epa.db)
-  python3 python3-pymodbus python3-serial-asyncio mbpoll chromium curl sqlite3 util-linux mount prometheus
+  python3 python3-pymodbus python3-serial-asyncio mbpoll chromium curl sqlite3 util-linux mount prometheus openssl
   # Node.js and npm: the modbus-serial interop test (tests/interop/node, its modules by `npm ci` below)
   nodejs npm
 )
