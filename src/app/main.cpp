@@ -4,6 +4,7 @@
 #include <iostream>
 #include <string>
 
+#include "app/certs_command.hpp"
 #include "app/commission_command.hpp"
 #include "app/design_command.hpp"
 #include "app/diagnose_command.hpp"
@@ -47,6 +48,8 @@ int main(int argc, char** argv) {
   CLI::App* records_command = epa::app::add_records_command(app, records);
   epa::app::DiagnoseOptions diagnose;
   epa::app::add_diagnose_command(app, diagnose);
+  epa::app::CertsOptions certs;
+  CLI::App* certs_command = epa::app::add_certs_command(app, certs);
   // CLI11 answers a mistyped command with "A subcommand is required"; name it and the commands.
   std::string commands;
   bool known = false;
@@ -74,6 +77,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("registers")) return epa::app::run_registers(registers, std::cout, std::cerr);
     if (app.got_subcommand("tuning")) return epa::app::run_tuning(app, tuning, std::cout, std::cerr);
     if (app.got_subcommand(records_command)) return epa::app::run_records(records, std::cout, std::cerr);
+    if (app.got_subcommand(certs_command)) return epa::app::run_certs(certs, std::cout, std::cerr);
     if (app.got_subcommand(faults_command)) return epa::app::run_faults(faults, std::cout, std::cerr);
     if (app.got_subcommand("plant-server")) return epa::app::run_plant_server(plant_server, std::cout, std::cerr);
   } catch (const std::exception& e) {  // third-party code (CLI11, JSON, filesystem) at the edge

@@ -86,7 +86,7 @@ core::Result<ServeConfig> load_serve_config(const ServeOptions& o) {
   if (!loaded) return loaded.error();
   if (auto s = apply_overrides(o, *loaded); !s) return s.error();
   ServeConfig out{std::move(*loaded), std::nullopt};
-  if (out.appliance.modbus_enabled) {
+  if (config::serves_modbus(out.appliance)) {
     auto map = modbus::RegisterMap::load(out.appliance.register_map_path);
     if (!map) return map.error();
     out.register_map = std::move(*map);

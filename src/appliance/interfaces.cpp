@@ -8,6 +8,14 @@ namespace epa::appliance {
 
 namespace {
 
+// Where Modbus/TCP Security listens, whom it trusts and what each role may do.
+void log_modbus_tls(const modbus::SecureConfig& s, const std::string& bound, bool read_only) {
+  std::string roles;
+  for (const modbus::RoleRights& r : s.roles) roles += (roles.empty() ? "" : ", ") + r.role + " " + std::string(points::to_string(r.rights));
+  spdlog::info("modbus-tls: listening on {} (TLS 1.2/1.3, client certificates of CA {}, {}; roles: {}{})", bound, s.files.ca,
+               s.files.crl.empty() ? "no CRL" : "CRL " + s.files.crl, roles, read_only ? "; read-only: every write refused" : "");
+}
+
 // `status_page_url`: the status page's address (FC43's VendorUrl), "" with none.
 core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const config::ApplianceConfig& c, const modbus::RegisterMap& map,
                                                                  Axis& axis, std::string status_page_url) {
@@ -18,9 +26,11 @@ core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const config::A
   const auto& p = c.modbus.policy;
   std::string aliases;
   for (const int id : c.modbus.alias_unit_ids) aliases += (aliases.empty() ? ", also " : " and ") + std::to_string(id);
-  spdlog::info("modbus: listening on {} (unit {}{}, map {}, {} points, {})", (*server)->bound_address(),
-               c.modbus.unit_id, aliases, c.register_map_path, map.entries().size(),
-               p.read_only ? "read-only" : p.unlock_key ? "tuning locked until unlocked" : "tuning locked (no unlock key)");
+  if (c.modbus.plain_enabled)
+    spdlog::info("modbus: listening on {} (unit {}{}, map {}, {} points, {})", (*server)->bound_address(),
+                 c.modbus.unit_id, aliases, c.register_map_path, map.entries().size(),
+                 p.read_only ? "read-only" : p.unlock_key ? "tuning locked until unlocked" : "tuning locked (no unlock key)");
+  if (c.modbus.secure.enabled) log_modbus_tls(c.modbus.secure, (*server)->secure_bound_address(), p.read_only);
   if (const std::string notice = config::any_address_notice(c); !notice.empty()) spdlog::warn("{}", notice);
   return server;
 }

@@ -3,6 +3,7 @@
 #include "core/audit.hpp"
 #include "core/format.hpp"
 #include "core/ip_address.hpp"
+#include "core/printable_name.hpp"
 #include "core/secret_strength.hpp"
 #include "core/toml_at_line.hpp"
 #include "core/toml_document.hpp"
@@ -111,6 +112,20 @@ class TableReader {
       if (!v || *v < lo || *v > hi)
         return fail(item, key, "must contain whole numbers within " + std::to_string(lo) + ".." + std::to_string(hi) + " only");
       out.push_back(static_cast<int>(*v));
+    }
+  }
+  // A table of free names (its keys) to strings ([modbus_tls.roles]): each pair handed to `take`,
+  // whose error is reported at the pair's line. Absent: `out_present` stays false.
+  void name_table(const char* key, bool& out_present, const std::function<core::Status(const std::string&, const std::string&)>& take) {
+    const toml::node* n = find(key);
+    if (!n) return;
+    const auto* table = n->as_table();
+    if (!table) return fail(*n, key, "must be a table of names to strings");
+    out_present = true;
+    for (const auto& [name, value] : *table) {
+      const std::string item = std::string(key) + "." + std::string(name.str());
+      if (!value.is_string()) return fail(value, item.c_str(), "must be a string");
+      if (auto s = take(std::string(name.str()), *value.value<std::string>()); !s) return fail(value, item.c_str(), s.error().message);
     }
   }
   const toml::table* subtable(const char* key) {
@@ -368,7 +383,7 @@ void read_log(TableReader& top, ApplianceConfig& c) {
 void read_modbus(TableReader& top, ApplianceConfig& c) {
   auto& m = c.modbus;
   TableReader mbs = top.section("modbus");
-  mbs.boolean("enabled", c.modbus_enabled);
+  mbs.boolean("enabled", m.plain_enabled);
   mbs.choice<std::string>("address", m.address, listen_address);
   mbs.integer("port", m.port, 0, 65535);
   mbs.integer("unit_id", m.unit_id, 0, 247);
@@ -383,6 +398,33 @@ void read_modbus(TableReader& top, ApplianceConfig& c) {
   mbs.number("unlock_timeout_s", m.policy.unlock_timeout_s, closed(1, kDay_s, "s"));
   mbs.text_list("write_clients", m.policy.write_clients);
   mbs.refuse_unknown_keys();
+}
+
+// [modbus_tls.roles]: role name = "read" | "operate" | "tune"; when given, it replaces the defaults.
+core::Status take_role(std::vector<modbus::RoleRights>& roles, const std::string& role, const std::string& rights_text) {
+  if (auto ok = core::check_printable_name(role, "a role"); !ok) return ok;
+  const auto rights = points::parse_rights(rights_text);
+  if (!rights) return core::invalid_argument("= \"" + core::visible_text(rights_text) + "\": must be \"read\", \"operate\" or \"tune\"");
+  roles.push_back({role, *rights});
+  return core::ok();
+}
+
+void read_modbus_tls(TableReader& top, ApplianceConfig& c) {
+  auto& s = c.modbus.secure;
+  TableReader tls = top.section("modbus_tls");
+  tls.boolean("enabled", s.enabled);
+  tls.choice<std::string>("address", s.address, listen_address);
+  tls.integer("port", s.port, 0, 65535);
+  tls.text("ca", s.files.ca);
+  tls.text("cert", s.files.cert);
+  tls.text("key", s.files.key);
+  tls.text("crl", s.files.crl);
+  tls.number("handshake_timeout_s", s.handshake_timeout_s, closed(0.1, 60, "s"));
+  std::vector<modbus::RoleRights> roles;
+  bool given = false;
+  tls.name_table("roles", given, [&roles](const std::string& role, const std::string& rights) { return take_role(roles, role, rights); });
+  if (given) s.roles = std::move(roles);
+  tls.refuse_unknown_keys();
 }
 
 void read_web(TableReader& top, ApplianceConfig& c) {
@@ -440,6 +482,18 @@ void read_hal(TableReader& top, ApplianceConfig& c) {
   hal.refuse_unknown_keys();
 }
 
+// Modbus/TCP Security needs its files and at least one role, and a port of its own.
+core::Status check_modbus_tls(const ApplianceConfig& c) {
+  const auto& s = c.modbus.secure;
+  if (!s.enabled) return core::ok();
+  for (const auto& [key, value] : {std::pair{"ca", &s.files.ca}, {"cert", &s.files.cert}, {"key", &s.files.key}})
+    if (value->empty()) return core::invalid_argument(std::string("enabled needs ") + key + ": the PEM file (epa certs init makes them)");
+  if (s.roles.empty()) return core::invalid_argument("roles is empty: no certificate could have any rights");
+  if (c.modbus.plain_enabled && s.port != 0 && s.port == c.modbus.port)
+    return core::invalid_argument("port " + std::to_string(s.port) + " is [modbus] port too: give each its own");
+  return core::ok();
+}
+
 // Rules across keys and sections, in the runtime's and backends' own validators; write_clients
 // are rewritten into the form a peer's address is compared in.
 core::Status check_across_sections(ApplianceConfig& c, const std::string& file) {
@@ -452,6 +506,7 @@ core::Status check_across_sections(ApplianceConfig& c, const std::string& file) 
     if (!ip) return core::invalid_argument(file + ": [modbus] write_clients: " + ip.error().message);
     client = core::ip_text(ip->storage);  // ::0:1 is ::1
   }
+  if (auto s = check_modbus_tls(c); !s) return core::invalid_argument(file + ": [modbus_tls] " + s.error().message);
   if (auto s = runtime::validate(c.runtime); !s) return core::invalid_argument(file + ": " + s.error().message);
   if (const auto p = c.health.estimator.problem(); !p.empty()) return core::invalid_argument(file + ": [health] " + p);
   if (c.backend == HalBackend::kModbusIo)
@@ -473,7 +528,7 @@ const char* to_string(HalBackend b) {
 }
 
 bool any_address_may_command(const ApplianceConfig& c) {
-  return c.modbus_enabled && !c.modbus.policy.read_only && c.modbus.policy.write_clients.empty();
+  return c.modbus.plain_enabled && !c.modbus.policy.read_only && c.modbus.policy.write_clients.empty();
 }
 
 std::string any_address_notice(const ApplianceConfig& c) {
@@ -501,6 +556,7 @@ core::Result<ApplianceConfig> parse_appliance_config(const std::string& text, co
   read_store(top, c);
   read_log(top, c);
   read_modbus(top, c);
+  read_modbus_tls(top, c);
   read_web(top, c);
   read_hal(top, c);
   top.refuse_unknown_keys();
@@ -516,7 +572,9 @@ core::Result<ApplianceConfig> read_appliance_config(const std::string& path) {
   if (!c) return c;
   // Files the configuration names are found next to it, wherever the appliance is started from.
   const auto folder = std::filesystem::path(path).parent_path();
-  for (std::string* p : {&c->model_path, &c->design_path, &c->register_map_path, &c->web.static_dir, &c->physics_config})
+  auto& tls_files = c->modbus.secure.files;
+  for (std::string* p : {&c->model_path, &c->design_path, &c->register_map_path, &c->web.static_dir, &c->physics_config, &tls_files.ca,
+                         &tls_files.cert, &tls_files.key, &tls_files.crl})
     if (!p->empty() && std::filesystem::path(*p).is_relative()) *p = (folder / *p).lexically_normal().string();
   return c;
 }

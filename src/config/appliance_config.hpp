@@ -49,8 +49,7 @@ struct ApplianceConfig {
 
   HealthSettings health;
 
-  bool modbus_enabled = true;
-  modbus::ServerConfig modbus;
+  modbus::ServerConfig modbus;  // [modbus] (plain_enabled: its enabled) and [modbus_tls] (secure)
   std::string register_map_path = "../registers/epa.csv";  // relative to the configuration file
 
   bool web_enabled = true;
@@ -71,6 +70,8 @@ struct ApplianceConfig {
 core::Result<ApplianceConfig> parse_appliance_config(const std::string& toml_text, const std::string& source_name);
 core::Result<ApplianceConfig> read_appliance_config(const std::string& path);
 const char* to_string(HalBackend backend);
+// Whether the appliance serves Modbus at all: plain, or Modbus/TCP Security, or both.
+inline bool serves_modbus(const ApplianceConfig& c) { return c.modbus.plain_enabled || c.modbus.secure.enabled; }
 // True when any address may command motion: the Modbus server runs, writable, with no
 // [modbus] write_clients. (HTTP commands always need the [web] token.) Said at start and in
 // /api/status (any_address_may_command).

@@ -35,10 +35,17 @@ RequestHandler::RequestHandler(const RegisterMap& map, WritePolicy policy, std::
     : map_(map), policy_(std::move(policy)), unit_ids_(std::move(unit_ids)), identity_(appliance_identity(map.source(), status_page_url)), gate_(gate),
       channels_(channels), log_(std::move(log)), unlock_(policy_.unlock_key) {}
 
+namespace {
+// Whether tuning points refuse this client's writes (the locked point): its role's, or its unlock's.
+bool locked(const Session& session, std::int64_t now_ns) {
+  return session.rights ? *session.rights != points::Rights::kTune : now_ns >= session.unlocked_until_ns;
+}
+}  // namespace
+
 points::InterfaceStatus RequestHandler::status(const Session& session, std::int64_t now_ns) const {
   const core::ChangeCounters changes = gate_.counters();
   points::InterfaceStatus s{static_cast<std::uint32_t>(changes.accepted), static_cast<std::uint32_t>(changes.saved), changes.saving,
-                            requests_, clients_, now_ns >= session.unlocked_until_ns, unlock_.failures(), gate_.commission_view(), gate_.health_view()};
+                            requests_, clients_, locked(session, now_ns), unlock_.failures(), gate_.commission_view(), gate_.health_view()};
   s.disk_low = changes.disk_low;
   s.records = gate_.records();
   s.record_select = gate_.record_select();
@@ -208,11 +215,7 @@ std::uint8_t RequestHandler::take_key(const Write& key, const Session& session, 
 
 std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, Session& session, std::int64_t now_ns) {
   // The unlock key is this interface's own; everything else goes through the gate as one group.
-  points::Requester who{"modbus " + session.peer, true, "", now_ns < session.unlocked_until_ns};
-  if (policy_.read_only) who.may_write = false, who.no_write_reason = "the Modbus server is read-only";
-  if (!policy_.write_clients.empty() &&
-      std::find(policy_.write_clients.begin(), policy_.write_clients.end(), session.address) == policy_.write_clients.end())
-    who.may_write = false, who.no_write_reason = "client " + session.address + " is not in [modbus] write_clients";
+  const points::Requester who = requester(session, now_ns);
   std::vector<points::PointWrite> group;
   bool unlock = false;
   for (const auto& w : writes) {
@@ -220,7 +223,7 @@ std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, Sess
       group.push_back({w.entry->point->id, w.value});
       continue;
     }
-    if (!who.may_write) return kCannotApply;
+    if (!who.may_write || session.rights) return kCannotApply;  // on the secure port the role decides, not the key
     if (auto e = take_key(w, session, now_ns)) return e;
     unlock = true;
   }
@@ -236,6 +239,23 @@ std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, Sess
     session.unlocked_until_ns = now_ns + static_cast<std::int64_t>(policy_.unlock_timeout_s * 1e9);
   }
   return 0;
+}
+
+// Who writes: on the secure port, by the role in the client's certificate; on plain Modbus, by
+// write_clients and this connection's unlock. A read-only server refuses every write on both.
+points::Requester RequestHandler::requester(const Session& session, std::int64_t now_ns) const {
+  points::Requester who;
+  if (session.rights) {
+    who = points::requester_with_rights("modbus-tls " + session.peer + " " + session.subject + " (" + session.role + ")", session.role,
+                                        *session.rights);
+  } else {
+    who = {"modbus " + session.peer, true, "", now_ns < session.unlocked_until_ns};
+    if (!policy_.write_clients.empty() &&
+        std::find(policy_.write_clients.begin(), policy_.write_clients.end(), session.address) == policy_.write_clients.end())
+      who.may_write = false, who.no_write_reason = "client " + session.address + " is not in [modbus] write_clients";
+  }
+  if (policy_.read_only) who.may_write = false, who.no_write_reason = "the Modbus server is read-only";
+  return who;
 }
 
 _modbus_mapping_t* new_register_image(const RegisterMap& map) {

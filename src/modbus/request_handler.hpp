@@ -13,7 +13,8 @@
 // validate together, or a bad device identification read code; 04 the write cannot be applied
 // (server read-only, client not allowed to write, tuning locked, wrong mode, fault latched, an
 // unlock refused unseen: from a connection in its back-off, or while its address is in back-off
-// from a connection that sent a wrong key or is not yet open 2 s); 06 the command queue is full (busy); 0B a request
+// from a connection that sent a wrong key or is not yet open 2 s; on the secure port, a write the
+// client's role may not make, and any unlock: the role decides); 06 the command queue is full (busy); 0B a request
 // for a unit id that is not this device's (unit_id, and by default 0 and 0xFF).
 //
 // Bit tables (coils, discrete inputs) read in blocks of 16, as clients poll them: every address
@@ -30,6 +31,7 @@
 #include "modbus/device_identification.hpp"
 #include "modbus/register_map.hpp"
 #include "modbus/unlock_guard.hpp"
+#include "points/client_rights.hpp"
 #include "points/write_gate.hpp"
 #include "runtime/loop_channels.hpp"
 
@@ -51,6 +53,11 @@ struct Session {
   std::int64_t unlocked_until_ns = 0;  // the unlock is this connection's, until then or until it closes
   std::string local_address;           // this appliance's address the client reached (FC43's VendorUrl)
   std::int64_t opened_ns = 0;          // when the connection was accepted (the unlock back-off hears old ones)
+  // Modbus/TCP Security: the rights of the role in the client's certificate (none: plain Modbus,
+  // where write_clients and the unlock key decide), the role, and the certificate's subject.
+  std::optional<points::Rights> rights{};
+  std::string role{};
+  std::string subject{};
 };
 
 // What goes back for one request.
@@ -98,6 +105,7 @@ class RequestHandler {
   std::uint8_t collect_coil_writes(int address, int quantity, const std::uint8_t* bits, std::vector<Write>& out) const;
   std::uint8_t apply_writes(const std::vector<Write>& writes, Session& session, std::int64_t now_ns);
   std::uint8_t take_key(const Write& key, const Session& session, std::int64_t now_ns);
+  points::Requester requester(const Session& session, std::int64_t now_ns) const;
 
   const RegisterMap& map_;
   WritePolicy policy_;

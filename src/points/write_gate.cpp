@@ -201,7 +201,8 @@ GateResult WriteGate::check_rights(std::span<const PointWrite> writes, const Req
   if (!who.may_write) return refuse(Refusal::kForbidden, who.no_write_reason.empty() ? "this client may not write" : who.no_write_reason);
   for (const PointWrite& w : writes)
     if (point(w.id).tuning() && !who.tuning_unlocked)
-      return refuse(Refusal::kForbidden, fmt::format("{} is a tuning point: unlock the tuning first", quoted(w.id)));
+      return refuse(Refusal::kForbidden, fmt::format("{} is a tuning point: {}", quoted(w.id),
+                                                     who.tuning_locked_reason.empty() ? "unlock the tuning first" : who.tuning_locked_reason));
   return {};
 }
 

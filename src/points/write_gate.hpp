@@ -54,6 +54,7 @@ struct Requester {
   bool may_write = true;         // the interface's write policy for this client
   std::string no_write_reason;   // why not, when !may_write ("the Modbus server is read-only")
   bool tuning_unlocked = false;  // Modbus: the key was sent; HTTP: the token
+  std::string tuning_locked_reason{};  // why tuning is refused when locked; "": unlock it first
 };
 
 class WriteGate {

@@ -37,7 +37,8 @@ TEST(ApplianceConfig, ShippedFileParsesToTheDocumentedDefaults) {
   EXPECT_DOUBLE_EQ(c->modbus_io.layout.sensor.volts_per_count, hal::default_remote_io_layout().sensor.volts_per_count);
   EXPECT_EQ(c->comedi.device, "/dev/comedi0");
   EXPECT_EQ(c->register_map_path, std::string(EPA_SOURCE_DIR) + "/registers/epa.csv");  // next to the config
-  EXPECT_TRUE(c->modbus_enabled);
+  EXPECT_TRUE(c->modbus.plain_enabled);
+  EXPECT_FALSE(c->modbus.secure.enabled);
   EXPECT_EQ(c->modbus.port, 502);
   EXPECT_EQ(c->modbus.alias_unit_ids, (std::vector<int>{0, 255}));  // 0 and 0xFF also mean this device
   EXPECT_FALSE(c->modbus.policy.unlock_key.has_value());  // no default key: tuning stays locked until one is set
@@ -71,6 +72,40 @@ TEST(ApplianceConfig, ThePhysicsPlantIsChosenWithItsParameterFileNextToTheConfig
   EXPECT_NE(error_of("[hal.sim]\nplant = \"cfd\"\n").find("hal.sim.plant"), std::string::npos);
   EXPECT_NE(error_of("[hal.sim]\nsensor_bits = 40\n").find("hal.sim.sensor_bits"), std::string::npos);
   EXPECT_NE(error_of("[store]\nfile = \"x.db\"\n").find("unknown key 'file' in [store]"), std::string::npos);
+}
+
+TEST(ApplianceConfig, ModbusTlsTakesItsFilesAndARoleTableThatReplacesTheDefaults) {
+  auto c = parse_appliance_config("[modbus]\nenabled = false\n[modbus_tls]\nenabled = true\nport = 8802\nca = \"ca.pem\"\n"
+                                  "cert = \"device.pem\"\nkey = \"device.key\"\n[modbus_tls.roles]\nhmi = \"operate\"\nscada = \"read\"\n",
+                                  "x.toml");
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  EXPECT_FALSE(c->modbus.plain_enabled);
+  EXPECT_TRUE(serves_modbus(*c));
+  EXPECT_EQ(c->modbus.secure.port, 8802);
+  EXPECT_EQ(c->modbus.secure.files.key, "device.key");
+  ASSERT_EQ(c->modbus.secure.roles.size(), 2u);
+  EXPECT_EQ(c->modbus.secure.roles[0].role, "hmi");
+  EXPECT_EQ(c->modbus.secure.roles[0].rights, points::Rights::kOperate);
+  EXPECT_FALSE(any_address_may_command(*c)) << "the secure port's writers are known by their certificates";
+  auto defaults = parse_appliance_config("", "empty.toml");
+  ASSERT_TRUE(defaults.has_value());
+  EXPECT_FALSE(defaults->modbus.secure.enabled);
+  EXPECT_EQ(defaults->modbus.secure.port, 802);
+  ASSERT_EQ(defaults->modbus.secure.roles.size(), 3u);
+  EXPECT_EQ(defaults->modbus.secure.roles[2].role, "engineer");
+  EXPECT_EQ(defaults->modbus.secure.roles[2].rights, points::Rights::kTune);
+}
+
+TEST(ApplianceConfig, ModbusTlsMistakesAreNamed) {
+  const std::string files = "ca = \"ca.pem\"\ncert = \"d.pem\"\nkey = \"d.key\"\n";
+  EXPECT_NE(error_of("[modbus_tls]\nenabled = true\n").find("[modbus_tls] enabled needs ca"), std::string::npos);
+  EXPECT_NE(error_of("[modbus_tls]\n" + files + "[modbus_tls.roles]\nhmi = \"write\"\n").find("test.toml:6: modbus_tls.roles.hmi = \"write\": must be"),
+            std::string::npos)
+      << error_of("[modbus_tls]\n" + files + "[modbus_tls.roles]\nhmi = \"write\"\n");
+  EXPECT_NE(error_of("[modbus_tls]\nenabled = true\n" + files + "roles = {}\n").find("roles is empty"), std::string::npos);
+  EXPECT_NE(error_of("[modbus]\nport = 802\n[modbus_tls]\nenabled = true\n" + files).find("port 802 is [modbus] port too"), std::string::npos);
+  EXPECT_NE(error_of("[modbus_tls]\nhandshake_timeout_s = 0\n").find("modbus_tls.handshake_timeout_s"), std::string::npos);
+  EXPECT_NE(error_of("[modbus_tls]\ncertificate = \"x\"\n").find("unknown key 'certificate' in [modbus_tls]"), std::string::npos);
 }
 
 TEST(ApplianceConfig, EmptyFileGivesTheDefaults) {

@@ -568,6 +568,45 @@ TEST_F(Handler, TuningIsLockedUntilTheKeyThenLocksAgain) {
   EXPECT_EQ(unlock_entries, (std::vector<std::string>{"(unlock: nothing changed)", "set unlock from 0 to 1"}));
 }
 
+// Modbus/TCP Security: the role in the client's certificate decides, through the one gate.
+TEST_F(Handler, OnTheSecurePortTheRoleDecidesWhatAClientMayWrite) {
+  const Bytes setpoint = {0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x43, 0x20, 0x00, 0x00};  // 160.0f
+  const Bytes lc = {0x10, 0x00, 0x1C, 0x00, 0x02, 0x04, 0x40, 0x40, 0x00, 0x00};        // lc_mm = 3.0f
+  auto secure = [](const char* port, const char* role, points::Rights rights) {
+    Session s{"10.0.0.9", std::string("10.0.0.9:") + port, 0, ""};
+    s.rights = rights, s.role = role, s.subject = std::string("/CN=") + role;
+    return s;
+  };
+  Session viewer = secure("1", "viewer", points::Rights::kRead), op = secure("2", "operator", points::Rights::kOperate),
+          eng = secure("3", "engineer", points::Rights::kTune);
+  auto on = [&](Session& s, const Bytes& pdu) {
+    const Bytes a = adu(pdu);
+    return handler_->handle(a.data(), static_cast<int>(a.size()), s, 0, image_).exception;
+  };
+  EXPECT_EQ(on(viewer, {0x03, 0x00, 0x00, 0x00, 0x02}), 0);
+  EXPECT_EQ(on(viewer, setpoint), 0x04);
+  EXPECT_EQ(on(op, lc), 0x04);
+  EXPECT_EQ(on(op, unlock_pdu(kKey)), 0x04);  // the right key, but the role decides on this port
+  EXPECT_EQ(on(eng, unlock_pdu(kKey)), 0x04);
+  EXPECT_TRUE(handler_->status(op, 0).locked);
+  EXPECT_FALSE(handler_->status(eng, 0).locked);
+  EXPECT_TRUE(sink_.entries.empty()) << "refused writes and unlock attempts on the secure port leave no audit entry";
+  EXPECT_EQ(on(op, setpoint), 0);
+  EXPECT_EQ(on(eng, lc), 0);
+  ASSERT_EQ(sink_.entries.size(), 2u);
+  EXPECT_EQ(sink_.entries[0].source, "modbus-tls 10.0.0.9:2 /CN=operator (operator)");
+  EXPECT_EQ(sink_.entries[1].point, "lc_mm");
+  EXPECT_EQ(sink_.entries[1].source, "modbus-tls 10.0.0.9:3 /CN=engineer (engineer)");
+}
+
+TEST_F(Handler, AReadOnlyServerRefusesEveryRoleToo) {
+  make(WritePolicy{.read_only = true, .unlock_key = kKey, .unlock_timeout_s = 10, .write_clients = {}});
+  Session eng{"10.0.0.9", "10.0.0.9:3", 0, ""};
+  eng.rights = points::Rights::kTune, eng.role = "engineer";
+  const Bytes a = adu({0x10, 0x00, 0x00, 0x00, 0x02, 0x04, 0x43, 0x20, 0x00, 0x00});
+  EXPECT_EQ(handler_->handle(a.data(), static_cast<int>(a.size()), eng, 0, image_).exception, 0x04);
+}
+
 TEST_F(Handler, TheUnlockBelongsToTheConnectionThatSentTheKey) {
   const Bytes lc = {0x10, 0x00, 0x1C, 0x00, 0x02, 0x04, 0x40, 0x40, 0x00, 0x00};  // lc_mm = 3.0f
   Session hmi{"127.0.0.1", "127.0.0.1:50001", 0, ""}, other{"127.0.0.1", "127.0.0.1:50002", 0, ""};
