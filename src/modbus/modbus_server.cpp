@@ -21,6 +21,7 @@
 #include "modbus/slot_log.hpp"
 #include "modbus/slot_policy.hpp"
 #include "runtime/clock.hpp"
+#include "tls/no_sigpipe.hpp"
 #include "tls/refusal_log.hpp"
 #include "tls/tls_connection.hpp"
 
@@ -373,6 +374,7 @@ void ModbusServer::stop() {
 
 void ModbusServer::serve() {
   Impl& m = *impl_;
+  tls::block_sigpipe_on_this_thread();  // a TLS client gone mid-answer: EPIPE, not the process's end
   bool accept_ready = false, secure_ready = false;
   while (!stop_.load() && m.poll_round(accept_ready, secure_ready)) {
     const std::int64_t now = m.clock.now_ns();

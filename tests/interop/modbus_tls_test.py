@@ -24,6 +24,7 @@ import os
 import socket
 import sqlite3
 import ssl
+import struct
 import subprocess
 import sys
 import time
@@ -172,6 +173,22 @@ def refusal_checks(app, port, pki, other, check):
     check(len(lines) == 1, f"a refused address's next refusals are not logged within its back-off ({len(lines)} lines)")
 
 
+def vanishing_clients(port, pki, check, app):
+    """Clients that send a request and reset the connection before the answer: the answer's write
+    fails (EPIPE), which must close that connection, not end the appliance (SIGPIPE)."""
+    ctx = tls_context(pki, name="view")
+    try:
+        for _ in range(30):
+            s = ctx.wrap_socket(socket.create_connection((HOST, port), timeout=3), server_hostname="localhost")
+            s.sendall(bytes.fromhex("000a00000006010300000002") * 20)
+            s.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))  # close sends RST
+            s.close()
+    except OSError as e:
+        print(f"a vanishing client's connect failed: {e}")
+    time.sleep(0.3)
+    check(app.proc.poll() is None, "clients that reset before their answers leave the appliance running")
+
+
 def audit_checks(db_path, check):
     db = sqlite3.connect(db_path)
     rows = db.execute("SELECT source, point, new_value FROM audit_log ORDER BY id").fetchall()
@@ -228,6 +245,7 @@ def main():
         asyncio.run(role_checks(port, pki, check))
         s_client_checks(port, pki, check)
         refusal_checks(app, port, pki, other, check)
+        vanishing_clients(port, pki, check, app)
         r = app.client.read_holding_registers(SETPOINT, 2, slave=UNIT)
         check(not r.isError(), "plain Modbus still answers beside the secure port")
     finally:
