@@ -20,7 +20,7 @@ elif [ $# -gt 0 ]; then
   shift
 fi
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(fuzz_modbus_request fuzz_register_map fuzz_run_file fuzz_config fuzz_http_params)
+[ ${#targets[@]} -eq 0 ] && targets=(fuzz_modbus_request fuzz_register_map fuzz_run_file fuzz_config fuzz_http_params fuzz_tls_handshake)
 
 scripts/install-deps.sh
 cmake --preset fuzz >/dev/null
