@@ -5,16 +5,20 @@
 #
 #   bench/diagnose_drift.sh [BUILD_DIR=build/release]        (18 cases, about 50 s)
 #   bench/diagnose_drift.sh fast [BUILD_DIR]                 (3 cases: friction, supply, a null)
+#   bench/diagnose_drift.sh smoke [BUILD_DIR]                (1 case, the supply change: CI's smoke step)
+#
+# smoke takes every step of the script (commissioning, a case recorded, diagnosed and judged, the
+# matrix, the score and check lines); fast's three cases are the release suite's diag.drift_fast.
 #
 # Exit 0 when it ran; the issue's thresholds (drift_benchmark.py --check) are reported on the
 # "drift check" line.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-fast=()
-if [ "${1:-}" = fast ]; then
-  fast=(--fast)
-  shift
-fi
+subset=()
+case ${1:-} in
+  fast) subset=(--fast); shift ;;
+  smoke) subset=(--only '^supply-4bar$'); shift ;;
+esac
 build=${1:-build/release}
 cmake --build "$build" --target epa >/dev/null
-/usr/bin/python3 tests/diag/drift/drift_benchmark.py "$build/src/app/epa" "${fast[@]}" --check || true
+/usr/bin/python3 tests/diag/drift/drift_benchmark.py "$build/src/app/epa" "${subset[@]}" --check || true

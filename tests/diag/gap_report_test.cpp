@@ -22,22 +22,30 @@ namespace {
 
 using nlohmann::json;
 
+// A small case: valve lag hidden, 2 training and 1 held-out run of 8 s.
+const epa::testing::CaseData& case_data() {
+  static const epa::testing::CaseData c = [] {
+    epa::testing::Hidden h;
+    h.effects = epa::testing::typical_effect(epa::plant::EffectKind::kValveLag);
+    return epa::testing::make_case(h, 5, 2, 1, 8.0);
+  }();
+  return c;
+}
+
 struct Fixture {
-  epa::testing::CaseData data;
   epa::diag::GapReport report;
   json j;
 };
 
-// A small case: valve lag hidden, 2 training and 1 held-out run of 8 s.
+// Its diagnosis in process, as a report. The DiagnoseCli cases take the runs alone: each ctest
+// entry is a process of its own, where this diagnosis would run again for nothing.
 const Fixture& fixture() {
   static const Fixture f = [] {
     Fixture x;
-    epa::testing::Hidden h;
-    h.effects = epa::testing::typical_effect(epa::plant::EffectKind::kValveLag);
-    x.data = epa::testing::make_case(h, 5, 2, 1, 8.0);
+    const auto& data = case_data();
     const epa::diag::ReplayModel nominal{epa::core::paper::model(), {}, 500.0};
-    const auto d = epa::diag::diagnose(nominal, epa::testing::pointers(x.data.train), epa::testing::pointers(x.data.heldout), {});
-    x.report = epa::diag::build_report(d, {{"a.csv", &x.data.train[0]}, {"b.csv", &x.data.train[1]}}, {{"c.csv", &x.data.heldout[0]}});
+    const auto d = epa::diag::diagnose(nominal, epa::testing::pointers(data.train), epa::testing::pointers(data.heldout), {});
+    x.report = epa::diag::build_report(d, {{"a.csv", &data.train[0]}, {"b.csv", &data.train[1]}}, {{"c.csv", &data.heldout[0]}});
     x.j = json::parse(epa::diag::to_json(x.report));
     return x;
   }();
@@ -101,7 +109,7 @@ class DiagnoseCli : public epa::testing::ScratchDirTest {
 };
 
 TEST_F(DiagnoseCli, NamesTheHiddenEffectAndWritesTheJsonAndTheReport) {
-  const auto& d = fixture().data;
+  const auto& d = case_data();
   const std::string runs = write(d.train[0], "a.csv") + " " + write(d.train[1], "b.csv");
   const auto o = epa::testing::run_epa("diagnose " + runs + " --holdout " + write(d.heldout[0], "c.csv") + " --json " +
                                        path("gap.json") + " --report " + path("gap.html"));
@@ -123,7 +131,7 @@ TEST_F(DiagnoseCli, ReadingsThatDriftWhileTheValveRestsLeaveTheGapUnexplainedAnd
     for (std::size_t k = 0; k < r.size(); ++k) r.y_mm[k] += 1.5 * r.t_s[k];
     return r;
   };
-  const auto& d = fixture().data;
+  const auto& d = case_data();
   const auto o = epa::testing::run_epa("diagnose " + write(drifting(d.train[0]), "a.csv") + " " +
                                        write(drifting(d.train[1]), "b.csv") + " --holdout " +
                                        write(drifting(d.heldout[0]), "c.csv") + " --json " + path("drift.json"));
@@ -156,7 +164,7 @@ TEST_F(DiagnoseCli, NoiseFreeRunsOfItsOwnModelNameNothing) {
 // A run given twice is refused naming it; fewer than 4 training runs get a note that an effect
 // may then be named by chance (an outside walk-through's two runs had named a spurious ceiling).
 TEST_F(DiagnoseCli, ARunGivenTwiceIsRefusedAndFewRunsGetANote) {
-  const auto& d = fixture().data;
+  const auto& d = case_data();
   const std::string a = write(d.train[0], "a.csv"), b = write(d.train[1], "b.csv");
   const auto twice = epa::testing::run_epa("diagnose " + a + " " + b + " --holdout " + path("./a.csv"));
   EXPECT_EQ(twice.exit_code, 1) << twice.output;
@@ -167,7 +175,7 @@ TEST_F(DiagnoseCli, ARunGivenTwiceIsRefusedAndFewRunsGetANote) {
 }
 
 TEST_F(DiagnoseCli, WithoutHeldOutRunsItCrossValidatesByRun) {
-  const auto& d = fixture().data;
+  const auto& d = case_data();
   const auto o = epa::testing::run_epa("diagnose " + write(d.train[0], "a.csv") + " " + write(d.train[1], "b.csv") + " " +
                                        write(d.heldout[0], "c.csv") + " --json " + path("cv.json"));
   ASSERT_EQ(o.exit_code, 0) << o.output;
@@ -203,7 +211,7 @@ TEST_F(DiagnoseCli, RunsRecordedByTheApplianceWithAHiddenLagAreDiagnosed) {
 }
 
 TEST_F(DiagnoseCli, BadInputIsNamed) {
-  const auto& d = fixture().data;
+  const auto& d = case_data();
   const std::string a = write(d.train[0], "a.csv");
   auto o = epa::testing::run_epa("diagnose " + a + " --json -");
   EXPECT_EQ(o.exit_code, 1);
@@ -223,7 +231,7 @@ TEST_F(DiagnoseCli, BadInputIsNamed) {
 // whole-move gap and the changes, and without the model's spread no change is named and the text
 // says why. A stick-slip model too stiff for the model's Ts is refused naming the table.
 TEST_F(DiagnoseCli, AModelFileWithAStickSlipModelIsJudgedOverWholeMoves) {
-  const auto& d = fixture().data;
+  const auto& d = case_data();
   const std::string stick_slip =
       "\n[stick_slip]\nbreak_right_v = 1.2\nbreak_left_v = -1.7\nspeed_right_mm_s_per_v = 200.0\nspeed_left_mm_s_per_v = 130.0\n"
       "spring_rad_s = 50.0\ndamping_ratio = 0.3\ncoulomb_mm = 1.0\nstatic_mm = 1.5\nspool_lag_s = 0.01\ndelay_samples = 0\n";

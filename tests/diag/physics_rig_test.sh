@@ -3,6 +3,9 @@
 # loop steps with FF-IDZ and NG-IDZ, then epa diagnose against the model file. The diagnosis must
 # name static_friction over whole moves, explain at least 70 % of the law's model's gap there, and
 # give the same verdict at --horizon 20 and 100 (the windowed gap's horizon does not judge it).
+# Under the sanitizers (EPA_SANITIZER_RUN=1, the asan test preset) the diagnosis runs at --horizon
+# 20 alone and is judged as above: the run at 100 takes the same paths over longer windows (about
+# 60 % of the test's time), and that the horizon does not change the verdict is the release run's.
 #   physics_rig_test.sh EPA_BINARY
 set -eu
 epa=$1
@@ -16,15 +19,18 @@ sim() { "$epa" simulate --plant physics --model model.toml --controller pp-ffidz
 sim --steps 40,120 --start 150 --seed 3 --out-dir tr
 sim --steps -60,-150 --start 350 --seed 4 --out-dir tr
 sim --steps 75,-90 --start 250 --seed 5 --out-dir ho
-for h in 20 100; do
+horizons="20 100"
+[ "${EPA_SANITIZER_RUN:-}" = 1 ] && horizons=20
+for h in $horizons; do
   "$epa" diagnose tr/*.csv ex1.csv --holdout ho/*.csv ex2.csv --model model.toml --horizon $h --json gap$h.json >/dev/null 2>&1
 done
-python3 - <<'PY'
+python3 - $horizons <<'PY'
 import json, sys
-v20, v100 = (json.load(open(f"gap{h}.json"))["verdict"] for h in (20, 100))
-print(f"horizon 20: {v20['effects']} {v20['reduction_pct']} % on {v20['measure']}; horizon 100: {v100['effects']} {v100['reduction_pct']} %")
+v = [json.load(open(f"gap{h}.json"))["verdict"] for h in sys.argv[1:]]
+print("; ".join(f"horizon {h}: {x['effects']} {x['reduction_pct']} % on {x['measure']}" for h, x in zip(sys.argv[1:], v)))
+v20 = v[0]
 ok = ("static_friction" in v20["effects"] and v20["measure"] == "whole_move" and v20["reduction_pct"] >= 70.0
-      and not v20["unexplained"] and (v20["effects"], v20["reduction_pct"], v20["unexplained"]) ==
-      (v100["effects"], v100["reduction_pct"], v100["unexplained"]))
+      and not v20["unexplained"] and all((x["effects"], x["reduction_pct"], x["unexplained"]) ==
+                                         (v20["effects"], v20["reduction_pct"], v20["unexplained"]) for x in v))
 sys.exit(0 if ok else 1)
 PY

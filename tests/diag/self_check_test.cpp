@@ -26,6 +26,16 @@ using epa::plant::EffectKind;
 // same paths whatever its seed, and three took about 400 s there.
 const int kSeeds = epa::test::sanitizer_run() ? 1 : 3;
 
+// Under the sanitizers the effect-free cases and the hidden effects no other test of that run has
+// diagnose() name; the other four (40 % of this test's time) are named there by Selection.*
+// (gain_change, position_dependent_gain), DiagnoseCli.* (valve_lag) and PhysicsSelfCheck
+// (input_delay), and every case fits all eight effects in its first round.
+bool in_this_run(EffectKind kind) {
+  if (!epa::test::sanitizer_run()) return true;
+  return kind == EffectKind::kDeadzoneShift || kind == EffectKind::kStaticFriction || kind == EffectKind::kFlowSaturation ||
+         kind == EffectKind::kSensorQuantization;
+}
+
 struct Outcome {
   std::string truth, named;  // named: the effect, "none" or "unexplained"
   std::vector<std::string> all_named;
@@ -52,6 +62,7 @@ std::vector<Outcome> run_all() {
       if (which == -1) h.periodic_mm = 1.5, truth = "outside the library";
       if (which >= 0) {
         const auto kind = epa::plant::kAllEffects[static_cast<std::size_t>(which)];
+        if (!in_this_run(kind)) continue;
         h.effects = epa::testing::typical_effect(kind), truth = std::string(epa::plant::to_string(kind));
       }
       const auto c = epa::testing::make_case(h, static_cast<std::uint64_t>(seed));

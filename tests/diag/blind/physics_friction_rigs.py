@@ -6,7 +6,7 @@ axis with almost no friction. Each rig is commissioned as a user would (two `epa
 3 held-out runs) and diagnosed against the model file. The stick-slip model that identify fits
 knows neither form: Coulomb friction with a breakaway, on an air spring.
 
-    physics_friction_rigs.py EPA_BINARY [--fast] [--seeds N] [--keep DIR]
+    physics_friction_rigs.py EPA_BINARY [--fast] [--seeds N] [--excite-seconds S] [--keep DIR]
 
 A friction rig is correct when `static_friction` is named and `unexplained` is false; the
 near-frictionless one when `static_friction` is not named (naming it is false blame). Prints one
@@ -48,12 +48,12 @@ CASES = [
 FAST = {"lugre-default"}
 
 
-def rig(epa, folder, tables, seed):
+def rig(epa, folder, tables, seed, excite_s=90):
     config = os.path.join(folder, "plant.toml")
     db.write_physics_config(config, tables)
     for k in (1, 2):
-        db.run([epa, "excite", "--plant", "physics", "--physics-config", config, "--seed", str(10 * seed + k), "--duration", "90",
-                "--out", f"{folder}/ex{k}.csv"])
+        db.run([epa, "excite", "--plant", "physics", "--physics-config", config, "--seed", str(10 * seed + k),
+                "--duration", str(excite_s), "--out", f"{folder}/ex{k}.csv"])
     db.run([epa, "identify", f"{folder}/ex1.csv", "--validate", f"{folder}/ex2.csv", "--out", f"{folder}/model.toml"])
     for steps, start, out, s in (("40,120", "150", "tr", 3), ("-60,-150", "350", "tr", 4), ("75,-90", "250", "ho", 5)):
         db.run([epa, "simulate", "--plant", "physics", "--physics-config", config, "--model", f"{folder}/model.toml",
@@ -68,6 +68,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("epa")
     ap.add_argument("--fast", action="store_true", help="one LuGre rig, one seed")
+    ap.add_argument("--excite-seconds", type=int, default=90,
+                    help="the commissioning's two excitations (CI's smoke step: 30, the script's path, not its figure)")
     ap.add_argument("--seeds", type=int, default=2)
     ap.add_argument("--keep", help="leave each rig's runs and report here")
     args = ap.parse_args()
@@ -79,7 +81,7 @@ def main():
             for name, category, tables in cases:
                 folder = os.path.join(args.keep or tmp, f"{name}-s{seed}")
                 os.makedirs(folder, exist_ok=True)
-                train, held = rig(args.epa, folder, tables, seed)
+                train, held = rig(args.epa, folder, tables, seed, args.excite_seconds)
                 out = os.path.join(folder, "gap.json")
                 r = subprocess.run([args.epa, "diagnose", *train, "--holdout", *held, "--model", f"{folder}/model.toml",
                                     "--json", out], capture_output=True, text=True, timeout=600)

@@ -19,7 +19,9 @@ matrix and the score line:
 
 --check exits 1 unless the issue's thresholds hold (>= 90 % correct, no false blame on the nulls,
 median reduction >= 70 %, median <= 10 s per case). --guard exits 1 when a diagnosis failed or a
-null was blamed: what a change must never break (ctest diag.drift_fast).
+null was blamed: what a change must never break (ctest diag.drift_fast). Under the sanitizers
+(EPA_SANITIZER_RUN=1, the asan test preset) --fast leaves out friction-x2.5: the supply change and
+the null are diagnosed and guarded, and a third diagnosis of a changed axis takes their paths again.
 """
 import argparse
 import json
@@ -83,6 +85,8 @@ CASES = [
     ("null-4", "null", {}, {}, set(), set()),
 ]
 FAST = {"friction-x2.5", "supply-4bar", "null-1"}
+if os.environ.get("EPA_SANITIZER_RUN") == "1":
+    FAST = {"supply-4bar", "null-1"}
 
 # Recordings per case: (kind, arguments). Step runs use the commissioned law (pp-ffidz designed on
 # the commissioned model); a null gets other targets and seeds than the others.
