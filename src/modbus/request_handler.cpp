@@ -246,8 +246,8 @@ std::uint8_t RequestHandler::apply_writes(const std::vector<Write>& writes, Sess
 points::Requester RequestHandler::requester(const Session& session, std::int64_t now_ns) const {
   points::Requester who;
   if (session.rights) {
-    who = points::requester_with_rights("modbus-tls " + session.peer + " " + session.subject + " (" + session.role + ")", session.role,
-                                        *session.rights);
+    who = points::requester_with_rights("modbus-tls " + session.peer + " " + session.subject + " (" + session.role + ")", session.subject,
+                                        session.role, *session.rights);
   } else {
     who = {"modbus " + session.peer, true, "", now_ns < session.unlocked_until_ns};
     if (!policy_.write_clients.empty() &&

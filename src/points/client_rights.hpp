@@ -23,10 +23,11 @@ inline std::optional<Rights> parse_rights(std::string_view text) {
   return std::nullopt;
 }
 
-// The requester for a client with `rights` by its `role`; `source` names it in the audit trail.
-inline Requester requester_with_rights(std::string source, std::string_view role, Rights rights) {
+// The requester for a client with `rights` by the `role` its certificate of `subject` names;
+// `source` names it in the audit trail.
+inline Requester requester_with_rights(std::string source, std::string_view subject, std::string_view role, Rights rights) {
   Requester who{std::move(source), rights != Rights::kRead, "", rights == Rights::kTune};
-  const std::string quoted_role = "role \"" + std::string(role) + "\"";
+  const std::string quoted_role = "certificate " + std::string(subject) + ": role \"" + std::string(role) + "\"";
   if (rights == Rights::kRead) who.no_write_reason = quoted_role + " has read rights only";
   if (rights == Rights::kOperate) who.tuning_locked_reason = quoted_role + " has no tuning rights";
   return who;

@@ -106,15 +106,22 @@ core::Result<std::unique_ptr<ServerContext>> ServerContext::load(const ServerFil
   // A client that closes without close_notify has closed, not failed (most Modbus clients do).
   SSL_CTX_set_options(ctx.get(), SSL_OP_NO_RENEGOTIATION | SSL_OP_NO_COMPRESSION | SSL_OP_CIPHER_SERVER_PREFERENCE |
                                      SSL_OP_IGNORE_UNEXPECTED_EOF);
-  // No TLS 1.3 session tickets: they arrive after the handshake as records without data, and a
+  // No resumption. TLS 1.3 tickets also arrive after the handshake as records without data, and a
   // client that polls its socket then reads (pymodbus 3.0's) takes them for an answer and fails.
+  // With client certificates asked for, OpenSSL fails a TLS 1.2 client that offers to resume in a
+  // context without a session id context ("internal error"): it is set, though nothing resumes.
   SSL_CTX_set_num_tickets(ctx.get(), 0);
+  SSL_CTX_set_options(ctx.get(), SSL_OP_NO_TICKET);
+  SSL_CTX_set_session_cache_mode(ctx.get(), SSL_SESS_CACHE_OFF);
+  static constexpr unsigned char kSessionContext[] = "epa";
+  SSL_CTX_set_session_id_context(ctx.get(), kSessionContext, sizeof kSessionContext - 1);
   if (SSL_CTX_set_cipher_list(ctx.get(), kTls12Ciphers) != 1) return core::io_error("TLS ciphers: " + take_openssl_errors());
   // Answers leave in one write each; a record the socket cannot take whole is the caller's to handle.
   SSL_CTX_set_mode(ctx.get(), SSL_MODE_ACCEPT_MOVING_WRITE_BUFFER);
   if (auto s = load_files(ctx.get(), files); !s) return s.error();
-  const int mode = SSL_VERIFY_PEER | (policy.certificate == ClientCertificate::kRequired ? SSL_VERIFY_FAIL_IF_NO_PEER_CERT : 0);
-  SSL_CTX_set_verify(ctx.get(), mode, verify_client);
+  const int mode = policy.certificate == ClientCertificate::kNone ? SSL_VERIFY_NONE
+                   : SSL_VERIFY_PEER | (policy.certificate == ClientCertificate::kRequired ? SSL_VERIFY_FAIL_IF_NO_PEER_CERT : 0);
+  SSL_CTX_set_verify(ctx.get(), mode, policy.certificate == ClientCertificate::kNone ? nullptr : verify_client);
   SSL_CTX_set_verify_depth(ctx.get(), kMaxChainDepth);
   std::unique_ptr<ServerContext> out(new ServerContext(std::move(ctx), policy));
   SSL_CTX_set_ex_data(out->get(), policy_index(), &out->policy_);

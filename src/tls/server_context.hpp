@@ -3,7 +3,9 @@
 // 1.3 only, no renegotiation, no compression, forward-secret ciphers (ECDHE with AES-GCM or
 // ChaCha20-Poly1305 in TLS 1.2), the device certificate and key, and the clients verified
 // against the plant's CA (and its CRL, when one is given). A client certificate is required
-// (Modbus/TCP Security) or only asked for (HTTPS, where it is one way to log in). When `roles`
+// (Modbus/TCP Security), only asked for or not asked for (HTTPS, where it is one way to log in).
+// No session is ever resumed: each handshake is a whole one, its certificate checked each time, and
+// there is no cache for a crowd of clients to fill. When `roles`
 // is not empty, a client certificate must carry the Modbus/TCP Security role extension naming
 // one of them, or the handshake fails: a certificate without rights here never gets a session.
 #include <memory>
@@ -23,7 +25,11 @@ struct ServerFiles {
   std::string crl;   // "": no revocation list; else clients are checked against it
 };
 
-enum class ClientCertificate { kRequired, kOptional };
+enum class ClientCertificate {
+  kRequired,  // Modbus/TCP Security: no certificate, no session
+  kOptional,  // asked for; a client without one gets in (HTTPS, where the token is the other way)
+  kNone,      // not asked for at all (a browser then never asks its user to pick one)
+};
 
 struct ClientPolicy {
   ClientCertificate certificate = ClientCertificate::kRequired;

@@ -36,7 +36,9 @@ TlsConnection::Step TlsConnection::handshake() {
 
 TlsConnection::Step TlsConnection::read_into(std::vector<std::uint8_t>& out, std::size_t max_bytes) {
   std::uint8_t chunk[4096];
-  for (std::size_t taken = 0; taken < max_bytes;) {
+  stopped_at_max_ = false;
+  for (std::size_t taken = 0;;) {
+    if (taken >= max_bytes) return stopped_at_max_ = SSL_has_pending(ssl_.get()) == 1, Step::kWantRead;
     ERR_clear_error();
     std::size_t n = 0;
     const int rc = SSL_read_ex(ssl_.get(), chunk, std::min(sizeof chunk, max_bytes - taken), &n);
@@ -47,8 +49,10 @@ TlsConnection::Step TlsConnection::read_into(std::vector<std::uint8_t>& out, std
     }
     out.insert(out.end(), chunk, chunk + n);
     taken += n;
+    // Nothing more read from the socket yet: the next bytes are the socket's to announce (another
+    // read now would only find it empty: a system call of the few a request takes).
+    if (SSL_has_pending(ssl_.get()) != 1) return Step::kWantRead;
   }
-  return Step::kWantRead;
 }
 
 bool TlsConnection::write(std::span<const std::uint8_t> bytes) {
@@ -81,6 +85,9 @@ TlsConnection::Step TlsConnection::failed(int rc, const char* doing) {
   switch (SSL_get_error(ssl_.get(), rc)) {
     case SSL_ERROR_WANT_READ: return Step::kWantRead;
     case SSL_ERROR_WANT_WRITE: return Step::kWantWrite;
+    case SSL_ERROR_ZERO_RETURN:  // an end of file mid-handshake, as SSL_OP_IGNORE_UNEXPECTED_EOF reports it
+      failure_ = fmt::format("TLS {}: the client closed the connection", doing);
+      break;
     case SSL_ERROR_SYSCALL:
       failure_ = fmt::format("TLS {}: {}", doing, errno != 0 ? std::strerror(errno) : "the connection was closed");
       break;

@@ -39,7 +39,10 @@ class TlsConnection {
   // the client closed; kFailed: the connection is broken (failure() says why).
   Step read_into(std::vector<std::uint8_t>& out, std::size_t max_bytes);
   // Whether decrypted bytes wait that the socket's readiness will not announce (read_into takes them).
-  bool has_pending() const { return done_ && SSL_has_pending(ssl_.get()) == 1; }
+  // Bytes read from the socket that read_into left for want of room. Not SSL_has_pending alone:
+  // it is also true for a record not complete yet, whose rest only the socket can bring (a server
+  // polling with no wait for it spun a core).
+  bool has_pending() const { return done_ && (stopped_at_max_ || SSL_pending(ssl_.get()) > 0); }
   // Sends `bytes` whole, or fails (false) when the socket cannot take them now.
   bool write(std::span<const std::uint8_t> bytes);
   // Sends what the socket takes now from the front of `bytes`, for a server that writes as its
@@ -57,6 +60,7 @@ class TlsConnection {
   Step failed(int rc, const char* doing);
   SslHandle ssl_;
   bool done_ = false;
+  bool stopped_at_max_ = false;  // the last read_into stopped at max_bytes with bytes still in OpenSSL
   std::string failure_;
   PeerIdentity peer_;
 };

@@ -189,6 +189,61 @@ def vanishing_clients(port, pki, check, app):
     check(app.proc.poll() is None, "clients that reset before their answers leave the appliance running")
 
 
+def cpu_ticks(pid):
+    fields = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()
+    return int(fields[11]) + int(fields[12])  # utime + stime
+
+
+def half_record_costs_nothing(port, pki, check, app):
+    """A client that sends part of a TLS record and stops: the server waits on the socket for the
+    rest; it must not poll without waiting (that spun a core)."""
+    ctx = tls_context(pki, name="view")
+    incoming, outgoing = ssl.MemoryBIO(), ssl.MemoryBIO()
+    tls = ctx.wrap_bio(incoming, outgoing, server_hostname="localhost")
+    with socket.create_connection((HOST, port), timeout=3) as raw:
+        while True:  # the handshake through memory, so that the record can be cut by hand
+            try:
+                tls.do_handshake()
+                break
+            except ssl.SSLWantReadError:
+                raw.sendall(outgoing.read())
+                incoming.write(raw.recv(65536))
+        raw.sendall(outgoing.read())
+        tls.write(bytes.fromhex("000b00000006010300000002"))
+        record = outgoing.read()
+        raw.sendall(record[:len(record) // 3])
+        time.sleep(0.3)
+        before = cpu_ticks(app.proc.pid)
+        time.sleep(2.0)
+        spent = cpu_ticks(app.proc.pid) - before
+        check(spent < 40, f"a third of a record waiting costs the appliance {spent} ticks of CPU in 2 s (< 40; a spin takes ~200)")
+        raw.sendall(record[len(record) // 3:])
+        answer = b""
+        while len(answer) < 13:
+            incoming.write(raw.recv(65536))
+            try:
+                answer += tls.read(64)
+            except ssl.SSLWantReadError:
+                pass
+        check(answer[:2] == b"\x00\x0b" and answer[7] == 3, f"... and the rest of the record brings the answer ({answer.hex()})")
+
+
+def tls12_reconnect(port, pki, check):
+    """A TLS 1.2 client that offers its last session when it reconnects gets a whole handshake."""
+    ctx = tls_context(pki, name="view")
+    ctx.maximum_version = ssl.TLSVersion.TLSv1_2
+    session = None
+    for attempt in range(2):
+        try:
+            with ctx.wrap_socket(socket.create_connection((HOST, port), timeout=3), server_hostname="localhost", session=session) as s:
+                s.sendall(bytes.fromhex("000c00000006010300000002"))
+                answer = s.recv(64)
+                session = s.session
+        except (ssl.SSLError, OSError) as e:
+            answer = repr(e).encode()
+        check(answer[:2] == b"\x00\x0c", f"TLS 1.2, connection {attempt + 1} (offering its session the second time) is answered ({answer[:80]})")
+
+
 def audit_checks(db_path, check):
     db = sqlite3.connect(db_path)
     rows = db.execute("SELECT source, point, new_value FROM audit_log ORDER BY id").fetchall()
@@ -246,6 +301,8 @@ def main():
         s_client_checks(port, pki, check)
         refusal_checks(app, port, pki, other, check)
         vanishing_clients(port, pki, check, app)
+        half_record_costs_nothing(port, pki, check, app)
+        tls12_reconnect(port, pki, check)
         r = app.client.read_holding_registers(SETPOINT, 2, slave=UNIT)
         check(not r.isError(), "plain Modbus still answers beside the secure port")
     finally:
