@@ -16,6 +16,22 @@ void log_modbus_tls(const modbus::SecureConfig& s, const std::string& bound, boo
                s.files.crl.empty() ? "no CRL" : "CRL " + s.files.crl, roles, read_only ? "; read-only: every write refused" : "");
 }
 
+// How the web port speaks, for its start line: "" for plain HTTP.
+std::string web_tls_text(const config::ApplianceConfig& c) {
+  if (!c.web.tls) return "";
+  if (c.web.client_certificates == web::ClientCertificates::kOff) return "HTTPS only, no client certificates; ";
+  std::string roles;
+  for (const modbus::RoleRights& r : c.modbus.secure.roles) roles += (roles.empty() ? "" : ", ") + r.role + " " + std::string(points::to_string(r.rights));
+  return "HTTPS only, client certificates of CA " + c.modbus.secure.files.ca + " log in by role: " + roles + "; ";
+}
+
+// The status page's address as FC43 names it: https:// when the web port speaks HTTPS.
+std::string status_page_url(const config::ApplianceConfig& c, int web_port) {
+  std::string url = modbus::status_page_url(web_port);
+  if (c.web.tls && url.starts_with("http://")) url.insert(4, "s");
+  return url;
+}
+
 // `status_page_url`: the status page's address (FC43's VendorUrl), "" with none.
 core::Result<std::unique_ptr<modbus::ModbusServer>> start_modbus(const config::ApplianceConfig& c, const modbus::RegisterMap& map,
                                                                  Axis& axis, std::string status_page_url) {
@@ -51,9 +67,12 @@ core::Result<std::unique_ptr<web::WebServer>> start_web(const config::ApplianceC
   };
   web::WebConfig web_config = c.web;
   web_config.log = [](const std::string& line) { spdlog::warn("{}", line); };
+  // HTTPS: the certificate files and the role table of [modbus_tls], whether or not Modbus/TCP Security runs.
+  web_config.tls_files = c.modbus.secure.files;
+  for (const modbus::RoleRights& r : c.modbus.secure.roles) web_config.roles.push_back({r.role, r.rights});
   auto server = web::WebServer::start(web_config, axis.channels(), &axis.gate(), &audit, modbus_stats, store_stats, &axis.commissioning());
   if (!server) return server.error();
-  spdlog::info("web: listening on {} (static files {}, commands {})", (*server)->bound_address(), c.web.static_dir,
+  spdlog::info("web: listening on {} ({}static files {}, commands {})", (*server)->bound_address(), web_tls_text(c), c.web.static_dir,
                c.web.token.empty() ? "disabled: no token configured" : "enabled with the token");
   return server;
 }
@@ -68,7 +87,7 @@ core::Status Interfaces::start(const config::ApplianceConfig& c, const std::opti
     web_ = std::move(*server);
   }
   if (map) {
-    auto server = start_modbus(c, *map, axis, web_ ? modbus::status_page_url(web_->port()) : std::string());
+    auto server = start_modbus(c, *map, axis, web_ ? status_page_url(c, web_->port()) : std::string());
     if (!server) return server.error();
     modbus_ = std::move(*server);
     modbus_for_web_ = modbus_.get();

@@ -436,6 +436,14 @@ void read_web(TableReader& top, ApplianceConfig& c) {
   web.text("static_dir", c.web.static_dir);
   web.integer("max_connections_per_address", c.web.max_connections_per_address, 1, 4096);
   web.text_list("host_names", c.web.host_names);
+  // HTTPS with [modbus_tls]'s files (check_web_tls); the appliance hands them and the roles over at start.
+  web.boolean("tls", c.web.tls);
+  const auto client_certificates = [](std::string_view v) -> core::Result<web::ClientCertificates> {
+    if (v == "off") return web::ClientCertificates::kOff;
+    if (v == "optional") return web::ClientCertificates::kOptional;
+    return core::invalid_argument("'" + std::string(v) + "' is not off or optional");
+  };
+  web.choice<web::ClientCertificates>("client_certificates", c.web.client_certificates, client_certificates);
   web.refuse_unknown_keys();
 }
 
@@ -494,6 +502,15 @@ core::Status check_modbus_tls(const ApplianceConfig& c) {
   return core::ok();
 }
 
+// HTTPS on the web port uses the certificate files of [modbus_tls], even with Modbus/TCP Security off.
+core::Status check_web_tls(const ApplianceConfig& c) {
+  if (!c.web_enabled || !c.web.tls) return core::ok();
+  const auto& files = c.modbus.secure.files;
+  for (const auto& [key, value] : {std::pair{"ca", &files.ca}, {"cert", &files.cert}, {"key", &files.key}})
+    if (value->empty()) return core::invalid_argument(std::string("tls needs [modbus_tls] ") + key + ": the PEM file (epa certs init makes them)");
+  return core::ok();
+}
+
 // Rules across keys and sections, in the runtime's and backends' own validators; write_clients
 // are rewritten into the form a peer's address is compared in.
 core::Status check_across_sections(ApplianceConfig& c, const std::string& file) {
@@ -507,6 +524,7 @@ core::Status check_across_sections(ApplianceConfig& c, const std::string& file) 
     client = core::ip_text(ip->storage);  // ::0:1 is ::1
   }
   if (auto s = check_modbus_tls(c); !s) return core::invalid_argument(file + ": [modbus_tls] " + s.error().message);
+  if (auto s = check_web_tls(c); !s) return core::invalid_argument(file + ": [web] " + s.error().message);
   if (auto s = runtime::validate(c.runtime); !s) return core::invalid_argument(file + ": " + s.error().message);
   if (const auto p = c.health.estimator.problem(); !p.empty()) return core::invalid_argument(file + ": [health] " + p);
   if (c.backend == HalBackend::kModbusIo)

@@ -23,6 +23,9 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "tls/no_sigpipe.hpp"
+#include "web/connection_bytes.hpp"
+#include "web/front_end_tls.hpp"
 #include "web/round_robin_by_key.hpp"
 
 namespace epa::web {
@@ -119,12 +122,18 @@ Framing framing(std::string_view buf, const RequestLimits& limits, std::size_t m
   return body_start + declared > limits.max_request_bytes ? Framing::kTooLarge : Framing::kPartial;
 }
 
-// An answer the front end gives itself (a refusal), written without waiting, then the caller closes.
-void send_refusal(int fd, int status, std::string_view reason, const std::string& message, const httplib::Headers& headers) {
+// An answer the front end gives itself (a refusal), whole, with `headers`.
+std::string refusal_text(int status, std::string_view reason, const std::string& message, const httplib::Headers& headers) {
   const std::string body = R"({"error":")" + message + "\"}";
   std::string all = "HTTP/1.1 " + std::to_string(status) + " " + std::string(reason) + "\r\n";
   for (const auto& [k, v] : headers) all += k + ": " + v + "\r\n";
   all += "Content-Type: application/json\r\nContent-Length: " + std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body;
+  return all;
+}
+
+// A refusal on a plain socket that has no connection yet, written without waiting; the caller closes.
+void send_plain_refusal(int fd, int status, std::string_view reason, const std::string& message, const httplib::Headers& headers) {
+  const std::string all = refusal_text(status, reason, message, headers);
   (void)::send(fd, all.data(), all.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
 }
 
@@ -178,9 +187,22 @@ struct DeadlineHttpServer::Connection {
   std::string out;          // answered, not yet taken by the client
   bool writing = false;     // the front end writes `out` (EPOLLOUT); `deadline` is the client's time to take it
   bool close_after_out = false;
+  std::unique_ptr<tls::TlsConnection> tls;  // HTTPS: the connection's session; null on plain HTTP
+  bool handshake_wants_write = false;       // HTTPS: the handshake waits for the socket to take its bytes (EPOLLOUT)
+  // HTTPS: the handshake is not complete yet; `deadline` is its deadline.
+  bool handshaking() const { return tls && !tls->handshake_done(); }
 };
 
 namespace {
+
+// A refusal the front end or a worker gives on `c`, written without waiting; the caller closes.
+// Over HTTPS it goes through the session, once there is one (before, there is nothing to say it in).
+void send_refusal(DeadlineHttpServer::Connection& c, int status, std::string_view reason, const std::string& message,
+                  const httplib::Headers& headers) {
+  if (c.handshaking()) return;
+  std::string all = refusal_text(status, reason, message, headers);
+  (void)send_some(c.fd, c.tls.get(), all);
+}
 
 enum class Cut { kNone, kDeadline, kTooLarge };
 
@@ -199,7 +221,9 @@ class BufferedStream final : public httplib::Stream {
     pos_ = 0;
   }
 
-  bool is_readable() const override { return pos_ < c_.buffer.size() || poll_for(c_.fd, POLLIN, left()); }
+  bool is_readable() const override {
+    return pos_ < c_.buffer.size() || bytes_pending(c_.tls.get()) || poll_for(c_.fd, POLLIN, left());
+  }
   bool is_writable() const override { return cut_ == Cut::kNone; }
 
   ssize_t read(char* ptr, std::size_t size) override {
@@ -218,16 +242,7 @@ class BufferedStream final : public httplib::Stream {
     return static_cast<ssize_t>(size);
   }
   // Sends what the socket takes now; false when the connection failed.
-  bool flush() {
-    while (!c_.out.empty()) {
-      const ssize_t n = ::send(c_.fd, c_.out.data(), c_.out.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
-      if (n < 0 && errno == EINTR) continue;
-      if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return true;
-      if (n <= 0) return false;
-      c_.out.erase(0, static_cast<std::size_t>(n));
-    }
-    return true;
-  }
+  bool flush() { return send_some(c_.fd, c_.tls.get(), c_.out) != Sent::kFailed; }
 
   void get_remote_ip_and_port(std::string& ip, int& port) const override { endpoint(::getpeername, ip, port); }
   void get_local_ip_and_port(std::string& ip, int& port) const override { endpoint(::getsockname, ip, port); }
@@ -245,14 +260,18 @@ class BufferedStream final : public httplib::Stream {
   }
   // More of the request from the socket, within its deadline and its size cap.
   bool fill() {
-    std::array<char, 4096> chunk{};
+    constexpr std::size_t kChunkBytes = 4096;
+    // TLS may hold bytes already read from the socket; but they may be only part of a record,
+    // which takes the socket's next bytes to decrypt.
+    bool wait_for_socket = !bytes_pending(c_.tls.get());
     for (;;) {
-      if (left().count() <= 0 || !poll_for(c_.fd, POLLIN, left())) return cut_ = Cut::kDeadline, false;
-      const ssize_t n = ::recv(c_.fd, chunk.data(), chunk.size(), 0);
-      if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
-      if (n <= 0) return false;
-      if (c_.buffer.size() + static_cast<std::size_t>(n) > limits_.max_request_bytes) return cut_ = Cut::kTooLarge, false;
-      c_.buffer.append(chunk.data(), static_cast<std::size_t>(n));
+      if (left().count() <= 0 || (wait_for_socket && !poll_for(c_.fd, POLLIN, left()))) return cut_ = Cut::kDeadline, false;
+      const std::size_t had = c_.buffer.size();
+      const Received r = receive_some(c_.fd, c_.tls.get(), c_.buffer, kChunkBytes);
+      wait_for_socket = true;
+      if (r == Received::kNone) continue;
+      if (r == Received::kEnded) return false;
+      if (c_.buffer.size() > limits_.max_request_bytes) return c_.buffer.resize(had), cut_ = Cut::kTooLarge, false;
       return true;
     }
   }
@@ -296,6 +315,7 @@ struct DeadlineHttpServer::Front {
     return ::epoll_ctl(epoll_fd, op, fd, &ev) == 0;
   }
   void close_connection(const std::shared_ptr<Connection>& c) {
+    if (c->tls) c->tls->shut_down();  // close_notify, after a complete handshake only
     ::shutdown(c->fd, SHUT_RDWR);
     ::close(c->fd);
     if (auto it = per_address.find(c->peer); it != per_address.end() && --it->second == 0) per_address.erase(it);
@@ -315,6 +335,8 @@ DeadlineHttpServer::~DeadlineHttpServer() {
   for (int fd : {front_->epoll_fd, front_->wake_fd, front_->reserve_fd})
     if (fd >= 0) ::close(fd);
 }
+
+void DeadlineHttpServer::use_tls(std::unique_ptr<FrontEndTls> tls) { tls_ = std::move(tls); }
 
 bool DeadlineHttpServer::serving() const {
   std::lock_guard lock(front_->mutex);
@@ -348,11 +370,14 @@ void DeadlineHttpServer::hand_back(std::shared_ptr<Connection> c, bool close) {
 void DeadlineHttpServer::answer(std::shared_ptr<Connection> c) {
   BufferedStream stream(*c, limits_);
   bool connection_closed = false;
-  const bool served = process_request(stream, c->requests_left <= 1, connection_closed, nullptr);
+  // Over HTTPS the handlers find the client's session (and its certificate) in Request::ssl.
+  std::function<void(httplib::Request&)> with_session;
+  if (c->tls) with_session = [session = c->tls->ssl()](httplib::Request& req) { req.ssl = session; };
+  const bool served = process_request(stream, c->requests_left <= 1, connection_closed, with_session);
   --c->requests_left;
   if (stream.cut() != Cut::kNone) {
     const bool late = stream.cut() == Cut::kDeadline;
-    send_refusal(c->fd, late ? 408 : 431, late ? "Request Timeout" : "Request Header Fields Too Large",
+    send_refusal(*c, late ? 408 : 431, late ? "Request Timeout" : "Request Header Fields Too Large",
                  late ? "request not complete within its deadline" : "request too large", answer_headers_);
     return hand_back(std::move(c), true);
   }
@@ -394,7 +419,9 @@ void DeadlineHttpServer::accept_waiting(int listen_fd) {
   }
 }
 
-// A new connection: closed at once past the per-address or the total cap, else it waits for its request.
+// A new connection: closed at once past the per-address or the total cap (over HTTPS without an
+// answer: there is no session yet to answer in), else it waits for its request, or over HTTPS
+// for its handshake first.
 void DeadlineHttpServer::admit(int fd, const std::string& peer) {
   Front& f = *front_;
   const auto now = Clock::now();
@@ -405,7 +432,7 @@ void DeadlineHttpServer::admit(int fd, const std::string& peer) {
     (address ? f.over_address_cap : f.over_total_cap)
         .note(now, log_, address ? peer + " holds " + std::to_string(limits_.max_connections_per_address) + ", [web] max_connections_per_address"
                                  : std::to_string(f.max_connections) + " open");
-    send_refusal(fd, 503, "Service Unavailable", address ? "too many connections from " + peer : "too many connections", answer_headers_);
+    if (!tls_) send_plain_refusal(fd, 503, "Service Unavailable", address ? "too many connections from " + peer : "too many connections", answer_headers_);
     ::close(fd);
     return;
   }
@@ -413,6 +440,17 @@ void DeadlineHttpServer::admit(int fd, const std::string& peer) {
   ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &yes, sizeof yes);
   auto c = std::make_shared<Connection>();
   c->fd = fd, c->peer = peer, c->deadline = now + limits_.read_timeout, c->requests_left = limits_.keep_alive_max_requests;
+  if (tls_) {
+    auto session = tls_->accept(fd);
+    if (!session) {
+      if (log_) log_("web: " + peer + ": " + session.error().message);
+      ::close(fd);
+      if (from_peer == 0) f.per_address.erase(peer);
+      return;
+    }
+    c->tls = std::move(*session);
+    c->deadline = now + limits_.handshake_timeout;
+  }
   if (!f.watch(fd, EPOLL_CTL_ADD)) {
     ::close(fd);
     if (from_peer == 0) f.per_address.erase(peer);
@@ -429,26 +467,26 @@ void DeadlineHttpServer::read_from(int fd) {
   const auto it = f.waiting.find(fd);
   if (it == f.waiting.end()) return;
   const std::shared_ptr<Connection> c = it->second;
-  std::array<char, 16384> chunk{};
+  if (c->handshaking() && !shake_hands(c)) return;
+  if (c->handshaking()) return;
+  constexpr std::size_t kChunkBytes = 16384;
   bool ended = false;
   while (c->buffer.size() <= limits_.max_request_bytes) {
-    const ssize_t n = ::recv(fd, chunk.data(), chunk.size(), 0);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0 && errno == EAGAIN) break;
-    if (n <= 0) {
+    const Received r = receive_some(fd, c->tls.get(), c->buffer, kChunkBytes);
+    if (r == Received::kNone) break;
+    if (r == Received::kEnded) {
       ended = true;
       break;
     }
-    c->buffer.append(chunk.data(), static_cast<std::size_t>(n));
   }
   if (!c->buffer.empty() && !c->in_request) c->in_request = true, c->deadline = Clock::now() + limits_.request_deadline;
   const Framing state = c->buffer.empty() ? Framing::kPartial : framing(c->buffer, limits_, payload_max_length_);
   if (state == Framing::kWhole) return dispatch(c);
   if (state == Framing::kNul) {
-    send_refusal(fd, 400, "Bad Request", "request head holds a NUL byte", answer_headers_);
+    send_refusal(*c, 400, "Bad Request", "request head holds a NUL byte", answer_headers_);
     ended = true;
   } else if (state == Framing::kTooLarge || state == Framing::kTooManyFields) {
-    send_refusal(fd, 431, "Request Header Fields Too Large",
+    send_refusal(*c, 431, "Request Header Fields Too Large",
                  state == Framing::kTooLarge ? "request too large (at most " + std::to_string(limits_.max_request_bytes) + " bytes)"
                                              : "request head has more than " + std::to_string(limits_.max_header_fields) + " header fields",
                  answer_headers_);
@@ -458,6 +496,24 @@ void DeadlineHttpServer::read_from(int fd) {
     f.waiting.erase(it);
     f.close_connection(c);
   }
+}
+
+// One step of an HTTPS connection's handshake, as far as its socket allows. Once it is complete the
+// connection waits `read_timeout` for its first request, as a plain one does from its accept.
+bool DeadlineHttpServer::shake_hands(std::shared_ptr<Connection> c) {
+  Front& f = *front_;
+  using Step = tls::TlsConnection::Step;
+  const Step step = tls_->handshake(*c->tls, c->peer, log_);
+  const bool wants_write = step == Step::kWantWrite;
+  const bool rewatched = wants_write == c->handshake_wants_write || f.watch(c->fd, EPOLL_CTL_MOD, wants_write ? EPOLLOUT : EPOLLIN);
+  if (step == Step::kFailed || !rewatched) {
+    f.waiting.erase(c->fd);
+    f.close_connection(c);
+    return false;
+  }
+  c->handshake_wants_write = wants_write;
+  if (step == Step::kDone) c->deadline = Clock::now() + limits_.read_timeout;
+  return true;
 }
 
 void DeadlineHttpServer::dispatch(std::shared_ptr<Connection> c) {
@@ -503,18 +559,13 @@ void DeadlineHttpServer::take_back() {
 void DeadlineHttpServer::wait_for_request(std::shared_ptr<Connection> c) {
   c->in_request = !c->buffer.empty();
   c->deadline = Clock::now() + (c->in_request ? limits_.request_deadline : limits_.keep_alive_timeout);
-  if (c->in_request) read_from(c->fd);  // frames what is buffered, and reads anything new
+  // Frames what is buffered, and reads anything new; TLS may hold decrypted bytes no event announces.
+  if (c->in_request || bytes_pending(c->tls.get())) read_from(c->fd);
 }
 
 void DeadlineHttpServer::write_to(std::shared_ptr<Connection> c) {
   Front& f = *front_;
-  while (!c->out.empty()) {
-    const ssize_t n = ::send(c->fd, c->out.data(), c->out.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return;  // the client reads on: wait for EPOLLOUT
-    if (n <= 0) break;
-    c->out.erase(0, static_cast<std::size_t>(n));
-  }
+  if (send_some(c->fd, c->tls.get(), c->out) == Sent::kWait) return;  // the client reads on: wait for EPOLLOUT
   if (!c->out.empty() || c->close_after_out || !f.watch(c->fd, EPOLL_CTL_MOD)) {
     f.waiting.erase(c->fd);
     f.close_connection(c);
@@ -534,8 +585,10 @@ void DeadlineHttpServer::end_waits(int listen_fd) {
       ++it;
       continue;
     }
-    if (it->second->in_request && !it->second->writing)
-      send_refusal(it->first, 408, "Request Timeout", "request not complete within its deadline", answer_headers_);
+    if (it->second->handshaking())
+      tls_->handshake_too_slow(it->second->peer, log_);
+    else if (it->second->in_request && !it->second->writing)
+      send_refusal(*it->second, 408, "Request Timeout", "request not complete within its deadline", answer_headers_);
     f.close_connection(it->second);
     it = f.waiting.erase(it);
   }
@@ -551,6 +604,10 @@ bool DeadlineHttpServer::serve_after_bind() {
     if (f.stopping || listen_fd == INVALID_SOCKET || f.epoll_fd < 0 || f.wake_fd < 0) return false;
     f.running = true;
   }
+  // HTTPS: OpenSSL's writes to a client gone raise SIGPIPE. httplib::Server's constructor ignores
+  // it for the whole process; blocked here too, so HTTPS does not rest on that (the workers this
+  // thread starts inherit the mask).
+  tls::block_sigpipe_on_this_thread();
   std::unique_ptr<httplib::TaskQueue> queue(new_task_queue());
   f.queue = queue.get();
   const std::size_t fd_limit = descriptor_limit();

@@ -17,6 +17,12 @@
 // `keep_alive_timeout` for each next one, an address holds at most `max_connections_per_address`
 // connections (more are closed at once), and all connections together at most `max_connections`.
 // Refused connections and a full descriptor table are logged once a minute with a count.
+//
+// With use_tls() the port speaks HTTPS only (front_end_tls.hpp): each connection's handshake is
+// driven by the front end a step at a time and must be complete within `handshake_timeout`; a
+// connection over the caps is closed without an answer (there is no session to answer in); a
+// request's bytes are decrypted into its buffer and its answer encrypted as the client reads it.
+// A handler finds the client's session, and so its certificate, in Request::ssl.
 #include <httplib.h>
 
 #include <chrono>
@@ -30,9 +36,12 @@
 
 namespace epa::web {
 
+class FrontEndTls;
+
 struct RequestLimits {
   std::chrono::milliseconds request_deadline{2000};    // first byte of a request -> its last byte
   std::chrono::milliseconds read_timeout{2000};        // a new connection waits this long for its first byte
+  std::chrono::milliseconds handshake_timeout{2000};   // HTTPS: a new connection's TLS handshake is complete within this
   std::chrono::milliseconds write_timeout{2000};       // an answer must be taken by the client within this
   std::chrono::milliseconds keep_alive_timeout{2000};  // a kept-alive connection waits this long for the next request
   std::size_t keep_alive_max_requests = 100;
@@ -49,6 +58,8 @@ class DeadlineHttpServer final : public httplib::Server {
   explicit DeadlineHttpServer(const RequestLimits& limits, Log log = {}, httplib::Headers answer_headers = {});
   ~DeadlineHttpServer() override;
 
+  // HTTPS only on the port, with `tls`; before serve_after_bind.
+  void use_tls(std::unique_ptr<FrontEndTls> tls);
   // Serves the socket bound by bind_to_port/bind_to_any_port until stop_serving(); call on its own
   // thread (in place of httplib's listen_after_bind). False if it could not start.
   bool serve_after_bind();
@@ -71,6 +82,7 @@ class DeadlineHttpServer final : public httplib::Server {
   // These take the connection by value: each may erase the `waiting` entry it was called with,
   // and a reference to that entry's pointer would then dangle (a client that reset its connection
   // while its answer was being written crashed the appliance).
+  bool shake_hands(std::shared_ptr<Connection> c);  // HTTPS: false when the connection was closed
   void write_to(std::shared_ptr<Connection> c);  // the rest of an answer, as the client reads it
   void wait_for_request(std::shared_ptr<Connection> c);  // back to reading: the next request
   void dispatch(std::shared_ptr<Connection> c);
@@ -80,6 +92,7 @@ class DeadlineHttpServer final : public httplib::Server {
   RequestLimits limits_;
   Log log_;
   httplib::Headers answer_headers_;
+  std::unique_ptr<FrontEndTls> tls_;  // null: plain HTTP
   std::unique_ptr<Front> front_;
 };
 

@@ -12,16 +12,19 @@
 #include <fstream>
 #include <sstream>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "core/address_backoff.hpp"
 #include "core/ip_address.hpp"
 #include "core/listen_backlog.hpp"
 #include "runtime/clock.hpp"
+#include "tls/certificate_role.hpp"
 #include "web/command_body.hpp"
 #include "web/commission_port.hpp"
 #include "web/deadline_http_server.hpp"
 #include "web/elastic_task_queue.hpp"
+#include "web/front_end_tls.hpp"
 #include "web/host_check.hpp"
 #include "web/prometheus.hpp"
 #include "web/recent_audit.hpp"
@@ -67,11 +70,33 @@ constexpr const char* kPageCsp =
 // The commissioning report is one self-contained HTML file with its own <style> and no script.
 constexpr const char* kReportCsp = "default-src 'none'; style-src 'unsafe-inline'; img-src data:; frame-ancestors 'none'";
 
+// Who a request's client certificate says its client is; none over plain HTTP, without a
+// certificate, or with one the handshake did not verify (it refuses those; checked again here).
+struct CertifiedClient {
+  std::string subject;  // "/CN=eng"
+  std::string role;     // "" when it names none
+};
+
+std::optional<CertifiedClient> certified_client(const httplib::Request& req) {
+  if (!req.ssl || SSL_get_verify_result(req.ssl) != X509_V_OK) return std::nullopt;
+  X509* cert = SSL_get0_peer_certificate(req.ssl);
+  if (!cert) return std::nullopt;
+  CertifiedClient who{tls::subject_of(cert), ""};
+  if (auto role = tls::role_of(cert); role && *role) who.role = **role;
+  return who;
+}
+
 httplib::Headers security_headers() {
   return {{"X-Frame-Options", "DENY"},
           {"X-Content-Type-Options", "nosniff"},
           {"Referrer-Policy", "no-referrer"},
           {"Content-Security-Policy", kPageCsp}};
+}
+
+HttpsSettings https_settings(const WebConfig& c) {
+  HttpsSettings s{c.tls_files, c.client_certificates, {}};
+  for (const CertificateRole& r : c.roles) s.roles.push_back(r.role);
+  return s;
 }
 
 }  // namespace
@@ -141,6 +166,7 @@ struct WebServer::Impl {
   static RequestLimits request_limits(const WebConfig& c) {
     RequestLimits limits;
     limits.request_deadline = std::chrono::milliseconds(c.request_deadline_ms);
+    limits.handshake_timeout = limits.request_deadline;  // a TLS handshake is bounded as a request is
     limits.max_request_bytes = kMaxRequestBytes;
     limits.max_header_fields = kMaxHeaderFields;
     limits.max_connections_per_address = static_cast<std::size_t>(c.max_connections_per_address);
@@ -149,7 +175,8 @@ struct WebServer::Impl {
 
   ModbusStats modbus() const { return modbus_stats ? modbus_stats() : ModbusStats{}; }
   StoreStats store() const { return store_stats ? store_stats() : StoreStats{}; }
-  bool commands_enabled() const { return !config.token.empty(); }
+  bool commands_enabled() const { return !config.token.empty(); }  // the page's command panel: it sends the token
+  bool certificates_log_in() const { return config.tls && config.client_certificates == ClientCertificates::kOptional; }
 
   void sample_until_stopped() {
     std::unique_lock lock(stop_mutex);
@@ -169,7 +196,8 @@ struct WebServer::Impl {
   // connection was opened: "ip:port" is the connection, its first command starts its clock.
   bool authorised(const httplib::Request& req, httplib::Response& res) {
     if (config.token.empty()) {
-      send_error(res, 403, "commands are disabled: configure [web] token to enable them");
+      send_error(res, 403, certificates_log_in() ? "commands need a client certificate whose role may write, or a [web] token"
+                                                 : "commands are disabled: configure [web] token to enable them");
       return false;
     }
     const std::int64_t now_ns = clock.now_ns();
@@ -203,6 +231,35 @@ struct WebServer::Impl {
     return false;
   }
 
+  // Who sends a command, with what rights: a client certificate by its role, else the token
+  // (authorised()). None when the request is refused; `res` then holds the refusal. Commissioning
+  // (`tuning`) needs the rights to tune; the token gives them.
+  std::optional<points::Requester> commander(const httplib::Request& req, httplib::Response& res, bool tuning = false) {
+    if (const auto cert = certified_client(req)) return by_certificate(*cert, req, res, tuning);
+    if (!authorised(req, res)) return std::nullopt;
+    return points::Requester{"web " + req.remote_addr, true, "", /*tuning_unlocked=*/true};  // the token is the unlock
+  }
+
+  // A client certificate's role and its rights in the role table; a token it may carry is not looked at.
+  std::optional<points::Requester> by_certificate(const CertifiedClient& cert, const httplib::Request& req, httplib::Response& res,
+                                                  bool tuning) {
+    const auto role = std::ranges::find(config.roles, cert.role, &CertificateRole::role);
+    if (cert.role.empty() || role == config.roles.end()) {
+      send_error(res, 403, "certificate " + cert.subject + ": " +
+                               (cert.role.empty() ? "it names no role" : "its role \"" + cert.role + "\" is not in [modbus_tls.roles]"));
+      return std::nullopt;
+    }
+    const std::string source = "web " + req.remote_addr + " " + cert.subject + " (" + cert.role + ")";
+    points::Requester who = points::requester_with_rights(source, cert.subject, cert.role, role->rights);
+    // A command goes to the write gate, which refuses what the role may not write; commissioning
+    // does not go through it, so its rights are checked here.
+    if (tuning && !who.tuning_unlocked) {
+      send_error(res, 403, who.may_write ? who.tuning_locked_reason : who.no_write_reason);
+      return std::nullopt;
+    }
+    return who;
+  }
+
   // The page's files, from memory (static_files.hpp).
   void serve_static(const httplib::Request& req, httplib::Response& res) {
     const StaticFile* file = static_files.find(req.path);
@@ -210,21 +267,22 @@ struct WebServer::Impl {
     res.set_content(file->body, file->content_type);
   }
 
-  // A command: the token, then the body read into point writes, then the write gate decides (and
-  // audits what it takes); its refusal becomes 400, 403, 409 or 503 with the gate's reason.
+  // A command: the client's rights (certificate or token), then the body read into point writes,
+  // then the write gate decides (and audits what it takes); its refusal becomes 400, 403, 409 or
+  // 503 with the gate's reason.
   void command(CommandEndpoint endpoint, const httplib::Request& req, httplib::Response& res) {
-    if (!authorised(req, res)) return;
+    const auto who = commander(req, res);
+    if (!who) return;
     const CommandBody body = parse_command_body(endpoint, req.body);
     if (!body.error.empty()) return send_error(res, 400, body.error);
     if (!gate) return send_error(res, 503, "this server takes no commands (no write gate)");
-    const points::Requester who{"web " + req.remote_addr, true, "", /*tuning_unlocked=*/true};  // the token is the unlock
-    const points::GateResult r = gate->submit(body.writes, who);
+    const points::GateResult r = gate->submit(body.writes, *who);
     if (!r.accepted()) return send_error(res, http_status(r.refusal), r.reason);
     res.set_content(R"({"accepted":true})", kJson);
   }
 
-  // Commissioning: starting and aborting need the token; progress, result and report
-  // are read like the status.
+  // Commissioning: starting and aborting need the token or a certificate with tuning rights;
+  // progress, result and report are read like the status.
   void commission_routes() {
     auto& s = server;
     auto none = [](httplib::Response& res) { send_error(res, 404, "this appliance runs no commissioning service"); };
@@ -247,18 +305,20 @@ struct WebServer::Impl {
       res.set_content(*html, "text/html; charset=utf-8");
     });
     s.Post("/api/commission", [this, none](const httplib::Request& req, httplib::Response& res) {
-      if (!authorised(req, res)) return;
+      const auto who = commander(req, res, /*tuning=*/true);
+      if (!who) return;
       if (!commission) return none(res);
-      const auto r = commission->start(req.body, "web " + req.remote_addr);
+      const auto r = commission->start(req.body, who->source);
       if (r.result == points::CommissionStart::kBadSpec) return send_error(res, 400, r.message);
       if (r.result == points::CommissionStart::kBusy) return send_error(res, 409, r.message);
       res.status = 202;
       res.set_content(R"({"accepted":true})", kJson);
     });
     s.Post("/api/commission/abort", [this, none](const httplib::Request& req, httplib::Response& res) {
-      if (!authorised(req, res)) return;
+      const auto who = commander(req, res, /*tuning=*/true);
+      if (!who) return;
       if (!commission) return none(res);
-      if (!commission->abort("web " + req.remote_addr)) return send_error(res, 409, "no commissioning run is under way");
+      if (!commission->abort(who->source)) return send_error(res, 409, "no commissioning run is under way");
       res.set_content(R"({"accepted":true})", kJson);
     });
   }
@@ -370,6 +430,11 @@ core::Result<std::unique_ptr<WebServer>> WebServer::start(const WebConfig& confi
   if (config.worker_threads < 1) return core::invalid_argument("web: worker_threads must be >= 1");
   auto impl = std::make_unique<Impl>(config, channels, gate, audit, std::move(modbus_stats), std::move(store_stats), commission);
   if (config.max_connections_per_address < 1) return core::invalid_argument("web: max_connections_per_address must be >= 1");
+  if (config.tls) {
+    auto tls = FrontEndTls::load(https_settings(config));
+    if (!tls) return core::io_error("web: tls: " + tls.error().message);
+    impl->server.use_tls(std::move(*tls));
+  }
   auto files = StaticFiles::load(config.static_dir, {"index.html", "app.js", "style.css"});
   if (!files) return files.error();
   impl->static_files = std::move(*files);

@@ -6,6 +6,10 @@
 // thread fills the 30 s trend), so it cannot slow the scan cycle; workers started per connection up to a cap (elastic_task_queue.hpp),
 // a deadline per request (deadline_http_server.hpp), caps on the request head and body, and a token
 // back-off bound what a crowd of clients can cost.
+//
+// With `tls` the port speaks HTTPS only (front_end_tls.hpp), with the certificate files of
+// [modbus_tls]. A client certificate signed by its CA logs in: its role's rights decide the
+// commands (a viewer's are refused 403), with no token; without one, the token rule holds.
 #include <functional>
 #include <memory>
 #include <string>
@@ -13,11 +17,20 @@
 
 #include "core/audit.hpp"
 #include "core/result.hpp"
+#include "points/client_rights.hpp"
 #include "points/write_gate.hpp"
 #include "runtime/loop_channels.hpp"
+#include "tls/server_context.hpp"
+#include "web/front_end_tls.hpp"
 #include "web/json_api.hpp"
 
 namespace epa::web {
+
+// A role a client certificate may name, and what it may do ([modbus_tls.roles]).
+struct CertificateRole {
+  std::string role;
+  points::Rights rights = points::Rights::kRead;
+};
 
 struct WebConfig {
   std::string address = "0.0.0.0";  // IPv4 or IPv6 address to listen on ("::": IPv6 and IPv4)
@@ -35,6 +48,12 @@ struct WebConfig {
   // Names (or addresses) besides the host's own addresses, "localhost" and its host name that a
   // request's Host may carry; any other is refused 421 (a DNS-rebinding page carries its own name).
   std::vector<std::string> host_names;
+  // HTTPS ([web] tls): the port speaks TLS only. The files and the roles are [modbus_tls]'s, which
+  // the appliance fills in (config/appliance_config.cpp reads only the two [web] keys).
+  bool tls = false;
+  ClientCertificates client_certificates = ClientCertificates::kOptional;
+  tls::ServerFiles tls_files;
+  std::vector<CertificateRole> roles;
   std::function<void(const std::string&)> log;  // token lock-outs; may be empty
 };
 

@@ -108,6 +108,27 @@ TEST(ApplianceConfig, ModbusTlsMistakesAreNamed) {
   EXPECT_NE(error_of("[modbus_tls]\ncertificate = \"x\"\n").find("unknown key 'certificate' in [modbus_tls]"), std::string::npos);
 }
 
+// [web] tls: HTTPS with [modbus_tls]'s files, which may be set with Modbus/TCP Security off.
+TEST(ApplianceConfig, WebTlsTakesTheModbusTlsFilesAndAClientCertificateMode) {
+  const std::string files = "[modbus_tls]\nca = \"ca.pem\"\ncert = \"d.pem\"\nkey = \"d.key\"\n";
+  auto c = parse_appliance_config(files + "[web]\ntls = true\n", "x.toml");
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  EXPECT_TRUE(c->web.tls);
+  EXPECT_FALSE(c->modbus.secure.enabled);
+  EXPECT_EQ(c->web.client_certificates, web::ClientCertificates::kOptional);
+  auto off = parse_appliance_config(files + "[web]\ntls = true\nclient_certificates = \"off\"\n", "x.toml");
+  ASSERT_TRUE(off.has_value()) << off.error().message;
+  EXPECT_EQ(off->web.client_certificates, web::ClientCertificates::kOff);
+  auto defaults = parse_appliance_config("", "empty.toml");
+  ASSERT_TRUE(defaults.has_value());
+  EXPECT_FALSE(defaults->web.tls);
+
+  EXPECT_NE(error_of("[web]\ntls = true\n").find("test.toml: [web] tls needs [modbus_tls] ca"), std::string::npos) << error_of("[web]\ntls = true\n");
+  EXPECT_TRUE(parse_appliance_config("[web]\nenabled = false\ntls = true\n", "x.toml").has_value()) << "no web server, no files needed";
+  EXPECT_NE(error_of("[web]\nclient_certificates = \"required\"\n").find("web.client_certificates"), std::string::npos);
+  EXPECT_NE(error_of("[web]\ntls = \"yes\"\n").find("web.tls"), std::string::npos);
+}
+
 TEST(ApplianceConfig, EmptyFileGivesTheDefaults) {
   auto c = parse_appliance_config("", "empty.toml");
   ASSERT_TRUE(c.has_value());

@@ -113,13 +113,16 @@ unlock_key="5e3a9c17d24b086f"  # [modbus] unlock_key of the test appliances (as 
 # its log to "$tmp/epa.log" and waits (at most 10 s) until it accepts Modbus connections. Sets
 # `port` (Modbus) and `pid`. With `web_static_dir` set (and `web_token`, empty: commands off) the
 # web server runs too, on a free port, and is waited for by GET /api/status: sets `web_port` and
-# `url` (http://127.0.0.1:PORT/). Aborts when the appliance exits or never answers.
+# `url` (http://127.0.0.1:PORT/). With `web_tls_dir` too (a folder of `epa certs init`), the web
+# port speaks HTTPS with its files ([modbus_tls] ca, cert, key, crl): `url` is https://localhost:PORT/
+# and `curl_tls` holds curl's --cacert option for it. Aborts when the appliance exits or never answers.
 start_appliance() {
   local map=$1 extra=${2:-}
   shift $(( $# < 2 ? $# : 2 ))
   [ $# -gt 0 ] || set -- --mode stop
   port=$(free_port)
-  local web="enabled = false"
+  local web="enabled = false" tls_files=""
+  curl_tls=()
   if [ -n "${web_static_dir:-}" ]; then
     web_port=$(free_port)
     url="http://127.0.0.1:$web_port/"
@@ -127,6 +130,18 @@ start_appliance() {
 port = $web_port
 static_dir = \"$web_static_dir\"
 token = \"${web_token:-}\""
+    if [ -n "${web_tls_dir:-}" ]; then
+      url="https://localhost:$web_port/"
+      curl_tls=(--cacert "$web_tls_dir/ca.pem")
+      web="$web
+tls = true"
+      tls_files="[modbus_tls]
+ca = \"$web_tls_dir/ca.pem\"
+cert = \"$web_tls_dir/device.pem\"
+key = \"$web_tls_dir/device.key\"
+crl = \"$web_tls_dir/crl.pem\"
+"
+    fi
   fi
   cat >"$tmp/epa.toml" <<CONFIG
 # written by tests/support/appliance.sh
@@ -136,7 +151,7 @@ port = $port
 register_map = "$map"
 unlock_key = "$unlock_key"
 
-[web]
+$tls_files[web]
 $web
 
 [log]
@@ -154,7 +169,7 @@ CONFIG
     kill -0 "$pid" 2>/dev/null || abort "the appliance exited during start-up"
     if (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null; then
       [ -z "${web_static_dir:-}" ] && return 0
-      curl -s --max-time 2 "${url}api/status" 2>/dev/null | grep -q '"mode"' && return 0
+      curl -s --max-time 2 "${curl_tls[@]}" "${url}api/status" 2>/dev/null | grep -q '"mode"' && return 0
     fi
     sleep 0.05
   done
