@@ -22,11 +22,12 @@ packages=(
   # sanitizer and fuzz builds (scripts/test-sanitizers.sh, test-tsan.sh, fuzz.sh)
   clang libclang-rt-14-dev
   # programs the tests and scripts call: Modbus clients (mbpoll, Debian's python3 with pymodbus),
-  # the browser, HTTP (curl), TLS (openssl s_client), taskset/chrt (util-linux), mount (fault injection), promtool
+  # the browser and its certificate database (certutil: the CA trusted as a user imports it),
+  # HTTP (curl), TLS (openssl s_client), taskset/chrt (util-linux), mount (fault injection), promtool
   # (/metrics checked by Prometheus' own linter; Debian ships it only in prometheus, which also
   # installs the Prometheus server as a service: the tests use promtool alone); sqlite3 is the
   # database's own shell, for looking into the tuning store (epa.db)
-  python3 python3-pymodbus python3-serial-asyncio mbpoll chromium curl sqlite3 util-linux mount prometheus openssl
+  python3 python3-pymodbus python3-serial-asyncio mbpoll chromium libnss3-tools curl sqlite3 util-linux mount prometheus openssl
   # Node.js and npm: the modbus-serial interop test (tests/interop/node, its modules by `npm ci` below)
   nodejs npm
 )

@@ -4,9 +4,10 @@
 #
 #   https_page_test.sh <epa binary> <source dir> <artifacts dir>
 #
-# Chromium is told to trust the appliance's own certificate by the hash of its public key
-# (--ignore-certificate-errors-spki-list, which needs no NSS database). (1) Without that, Chromium
-# refuses the certificate and the page never runs; (2) with it, https://localhost:PORT/ shows live
+# Chromium trusts the plant's CA (ca.pem of `epa certs init`) as a user's browser does once the CA
+# is imported: in the NSS database of its user ($HOME/.pki/nssdb, made with certutil in a home of
+# the test's own). (1) With a home whose database does not hold the CA, Chromium refuses the
+# certificate and the page never runs; (2) with the CA trusted, https://localhost:PORT/ shows live
 # status: trend points and the position at the setpoint (50 mm); (3) a setpoint of 150 mm sent
 # over HTTPS with the token (curl, the CA trusted) shows up as a position that rose by more than
 # 50 mm; (4) a screenshot to <artifacts dir>. The appliance is stopped by its PID.
@@ -19,15 +20,18 @@ token="Zt4kPq9WmXc2LvB7nR5sHy8J"
 need chromium
 need curl
 need openssl
+need certutil
 mkdir -p "$artifacts"
 source "$(dirname "$0")/../support/chromium.sh"
 
-# ---- the certificates, and the hash Chromium trusts ----
+# ---- the certificates, and a browser user who trusts the CA ----
 "$epa" certs init "$tmp/pki" >/dev/null || abort "epa certs init $tmp/pki failed"
-# base64 of the SHA-256 of the device certificate's SubjectPublicKeyInfo (DER)
-spki=$(openssl x509 -in "$tmp/pki/device.pem" -pubkey -noout | openssl pkey -pubin -outform der | openssl dgst -sha256 -binary | base64)
-[ -n "$spki" ] || abort "could not hash the device certificate's public key"
-trusted=(--ignore-certificate-errors-spki-list="$spki")
+trusting_home=$tmp/trusting-home untrusting_home=$tmp/untrusting-home
+mkdir -p "$trusting_home/.pki/nssdb" "$untrusting_home/.pki/nssdb"
+for home in "$trusting_home" "$untrusting_home"; do
+  certutil -d "sql:$home/.pki/nssdb" -N --empty-password || abort "certutil: cannot make an NSS database in $home"
+done
+certutil -d "sql:$trusting_home/.pki/nssdb" -A -n "epa test CA" -t "C,," -i "$tmp/pki/ca.pem" || abort "certutil: cannot import the CA"
 
 # ---- the appliance: HTTPS only on its web port ----
 web_static_dir="$src/web" web_tls_dir="$tmp/pki" web_token=$token
@@ -38,19 +42,20 @@ status_field() { api /api/status | grep -o "\"$1\":[^,}]*" | head -1 | sed 's/.*
 at_50() { awk -v p="$(status_field position_mm)" 'BEGIN { exit !(p != "" && p > 48 && p < 52) }'; }
 wait_until 10000 at_50 || true  # the trend then has a story to show ((2) judges the page)
 
-# The page after 3 s of its own polling (virtual time: chromium runs the timers and fetches).
-dump_dom() { browser --virtual-time-budget=3000 "$@" --dump-dom "$url"; }
+# The page after 3 s of its own polling (virtual time: chromium runs the timers and fetches), as
+# the user of the home $1 sees it.
+dump_dom() { HOME=$1 browser --virtual-time-budget=3000 --dump-dom "$url"; }
 
 # ---- (1) not trusted: no page ----
-dom=$(dump_dom)
+dom=$(dump_dom "$untrusting_home")
 if [ -z "$(body_attr data-trend-points <<<"$dom")" ] && ! grep -q 'id="position-chart"' <<<"$dom"; then
-  pass "(1) without trusting the certificate, Chromium does not show the page"
+  pass "(1) without the CA trusted, Chromium does not show the page"
 else
-  fail "(1) Chromium showed the page over HTTPS without trusting the appliance's certificate"
+  fail "(1) Chromium showed the page over HTTPS without the CA trusted"
 fi
 
 # ---- (2) trusted: live status ----
-dom=$(dump_dom "${trusted[@]}")
+dom=$(dump_dom "$trusting_home")
 points=$(body_attr data-trend-points <<<"$dom")
 pos1=$(body_attr data-position-mm <<<"$dom")
 if [ -n "$points" ] && [ "$points" -gt 0 ] 2>/dev/null; then
@@ -72,7 +77,7 @@ pos2=""
 deadline=$(( $(now_ms) + 20000 ))
 while [ "$(now_ms)" -lt "$deadline" ]; do
   sleep 1  # the pacing of the poll: each look is a Chromium run
-  pos2=$(dump_dom "${trusted[@]}" | body_attr data-position-mm)
+  pos2=$(dump_dom "$trusting_home" | body_attr data-position-mm)
   awk -v a="$pos1" -v b="$pos2" 'BEGIN { exit !(b != "" && b - a > 50) }' && break
 done
 if awk -v a="$pos1" -v b="$pos2" 'BEGIN { exit !(b != "" && b - a > 50) }'; then
@@ -83,7 +88,7 @@ fi
 
 # ---- (4) a screenshot ----
 rm -f "$artifacts/status_page_https.png"
-browser --virtual-time-budget=3000 "${trusted[@]}" --window-size=1280,900 --screenshot="$artifacts/status_page_https.png" "$url" >/dev/null
+HOME=$trusting_home browser --virtual-time-budget=3000 --window-size=1280,900 --screenshot="$artifacts/status_page_https.png" "$url" >/dev/null
 if [ -s "$artifacts/status_page_https.png" ]; then pass "(4) screenshot $artifacts/status_page_https.png"; else fail "(4) no screenshot"; fi
 
 finish_test
