@@ -110,7 +110,7 @@ function showStatus(s) {
   setText("s-store", !s.store.enabled ? "off"
     : `${s.store.saved} / ${s.store.accepted}` + (s.store.ok ? "" : ` \u2014 NOT SAVING: ${s.store.last_error}`));
   setText("s-tuning-set", s.store.enabled ? s.store.tuning_set : "\u2013");
-  setText("s-web", s.commands_enabled ? "enabled (token)" : "read-only");
+  showWebLogin(s);
   const m = s.last_move;
   setText("last-move-head", m ? `#${m.number}: ${num(m.from_mm, 1)} → ${num(m.to_mm, 1)} mm, ${m.controller}, ${m.end.replace("_", " ")}`
     : "none yet");
@@ -200,6 +200,19 @@ function showAudit(a) {
     `<td>${auditValue(e.point, e.new_value)}</td></tr>`);
   const html = rows.length ? rows.join("") : `<tr><td colspan="5" class="muted">no changes yet</td></tr>`;
   if (body.innerHTML !== html) body.innerHTML = html;
+}
+
+// Who commands from this page: the token, or over HTTPS this browser's client certificate by its
+// role (/api/status client_certificate); with a role that may, the token fields are not needed.
+function showWebLogin(s) {
+  const cert = s.client_certificate;
+  const operates = !!cert && (cert.rights === "operate" || cert.rights === "tune");
+  const tunes = !!cert && cert.rights === "tune";
+  const who = cert ? `certificate ${cert.subject}, role ${cert.role || "none"}: ${cert.rights || "not in the role table"}` : "";
+  setText("s-web", operates ? `enabled (${who})` : s.commands_enabled ? "enabled (token)" : cert ? `read-only (${who})` : "read-only");
+  $("cmd-token").placeholder = operates ? "not needed: your certificate" : "[web] token";
+  $("c-token").required = !tunes;
+  $("c-token").placeholder = tunes ? "not needed: your certificate" : "[web] token";
 }
 
 // Commissioning: start and abort need the [web] token (sent as a bearer token, kept only in this

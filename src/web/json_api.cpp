@@ -81,7 +81,7 @@ std::string health_json(const points::HealthReport& health) {
 }
 
 std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled, const StoreStats& store,
-                        const points::HealthReport& health) {
+                        const points::HealthReport& health, const std::optional<CertificateLogin>& login) {
   const bool faulted = s.mode == runtime::Mode::kFault;
   const std::uint16_t word = points::status_word(s, store.ok && !store.disk_low, points::health_warns(health.view.state));
   json j = {
@@ -131,6 +131,7 @@ std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, b
       {"status_bits", status_bits(word)},
       {k(P::kControlWord), s.axis.control_word},
       {"commands_enabled", commands_enabled},
+      {"client_certificate", login ? json{{"subject", login->subject}, {"role", login->role}, {"rights", login->rights}} : json(nullptr)},
       {"any_address_may_command", modbus.any_address_may_command},
       {"health", health_object(health)},
   };

@@ -39,8 +39,17 @@ struct StoreStats {
 // the bits' point names), the control word as the loop applied it, and the model-health verdict
 // as "health": {"state", "effect", "size", "ratio", "moves_since_onset", "moves_seen", "value",
 // "commissioned", "unit", "reason"} (effect, size, unit "" and the numbers null when they do not apply).
+// The client's certificate, over HTTPS: who the request's client is and what its role may do.
+struct CertificateLogin {
+  std::string subject;  // "/CN=eng"
+  std::string role;     // "engineer"; "" when it names none
+  std::string rights;   // "read", "operate" or "tune"; "" when the role is not in the table
+};
+
+// With "client_certificate": {"subject", "role", "rights"} of `login`, null without one.
 std::string status_json(const runtime::Snapshot& s, const ModbusStats& modbus, bool commands_enabled,
-                        const StoreStats& store = {}, const points::HealthReport& health = {});
+                        const StoreStats& store = {}, const points::HealthReport& health = {},
+                        const std::optional<CertificateLogin>& login = std::nullopt);
 // The model-health verdict as in /api/status, with its gaps, the moves not judged and "trend":
 // the newest judgements, oldest first, each {"move", "estimates": [{"effect", "ratio", "reduction"}]}.
 std::string health_json(const points::HealthReport& health);

@@ -240,6 +240,15 @@ struct WebServer::Impl {
     return points::Requester{"web " + req.remote_addr, true, "", /*tuning_unlocked=*/true};  // the token is the unlock
   }
 
+  // Who the request's client certificate says its client is, and its role's rights ("" when the
+  // role is not in the table); none without one.
+  std::optional<CertificateLogin> certificate_login(const httplib::Request& req) const {
+    const auto cert = certified_client(req);
+    if (!cert) return std::nullopt;
+    const auto role = std::ranges::find(config.roles, cert->role, &CertificateRole::role);
+    return CertificateLogin{cert->subject, cert->role, role == config.roles.end() ? "" : std::string(points::to_string(role->rights))};
+  }
+
   // A client certificate's role and its rights in the role table; a token it may carry is not looked at.
   std::optional<points::Requester> by_certificate(const CertifiedClient& cert, const httplib::Request& req, httplib::Response& res,
                                                   bool tuning) {
@@ -353,8 +362,11 @@ struct WebServer::Impl {
       }
       return httplib::Server::HandlerResponse::Unhandled;
     });
-    s.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
-      res.set_content(status_json(snapshot(), modbus(), commands_enabled(), store(), health_report(false)), kJson);
+    s.Get("/api/status", [this](const httplib::Request& req, httplib::Response& res) {
+      // A client whose certificate's role may command sees the command panel without a token.
+      const std::optional<CertificateLogin> login = certificate_login(req);
+      const bool commands = commands_enabled() || (login && !login->rights.empty() && login->rights != points::to_string(points::Rights::kRead));
+      res.set_content(status_json(snapshot(), modbus(), commands, store(), health_report(false), login), kJson);
     });
     s.Get("/api/health", [this](const httplib::Request&, httplib::Response& res) { res.set_content(health_json(health_report(true)), kJson); });
     s.Get("/api/trend", [this](const httplib::Request&, httplib::Response& res) { res.set_content(*trend_body(), kJson); });

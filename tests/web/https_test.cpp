@@ -290,6 +290,22 @@ TEST_F(HttpsTest, TheApiAndThePageAreServedOverTlsOnly) {
   EXPECT_TRUE(epa::test::wait_until([&] { return log_lines_with("127.0.0.1 refused in the TLS handshake") == 1; })) << log_text();
 }
 
+TEST_F(HttpsTest, TheStatusSaysWhoTheCertificateIsAndWhetherItsRoleCommands) {
+  start();  // no token: only a certificate's role can enable commands
+  auto status_of = [&](const std::string& name) { return json::parse(client(name)->Get("/api/status")->body); };
+  const json op = status_of("operator");
+  EXPECT_TRUE(op["commands_enabled"].get<bool>()) << "the page's command panel shows for a role that may command";
+  EXPECT_EQ(op["client_certificate"]["subject"], "/CN=operator");
+  EXPECT_EQ(op["client_certificate"]["role"], "operator");
+  EXPECT_EQ(op["client_certificate"]["rights"], "operate");
+  const json viewer = status_of("viewer");
+  EXPECT_FALSE(viewer["commands_enabled"].get<bool>());
+  EXPECT_EQ(viewer["client_certificate"]["rights"], "read");
+  const json none = status_of("");
+  EXPECT_FALSE(none["commands_enabled"].get<bool>());
+  EXPECT_TRUE(none["client_certificate"].is_null());
+}
+
 TEST_F(HttpsTest, AViewersCommandIsRefused403NamingItsRoleEvenWithTheToken) {
   start(kToken);
   auto viewer = client("viewer");
