@@ -336,6 +336,20 @@ DeadlineHttpServer::~DeadlineHttpServer() {
     if (fd >= 0) ::close(fd);
 }
 
+// One request answered here, before any worker exists. httplib builds some of its parsers as
+// function-local statics on the first request that needs them; built by whichever worker came
+// first, the others then read them past a guard check that an uninstrumented library does without
+// a call, which ThreadSanitizer cannot see (it reported a race between two workers' first
+// requests). Built here, they are there before the workers start. Its answer goes nowhere.
+void DeadlineHttpServer::warm_up() {
+  Connection c;
+  c.buffer = "GET / HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n";
+  c.deadline = Clock::now() + limits_.request_deadline;
+  BufferedStream stream(c, limits_);
+  bool closed = false;
+  process_request(stream, true, closed, nullptr);
+}
+
 void DeadlineHttpServer::use_tls(std::unique_ptr<FrontEndTls> tls) { tls_ = std::move(tls); }
 
 bool DeadlineHttpServer::serving() const {
@@ -608,6 +622,7 @@ bool DeadlineHttpServer::serve_after_bind() {
   // it for the whole process; blocked here too, so HTTPS does not rest on that (the workers this
   // thread starts inherit the mask).
   tls::block_sigpipe_on_this_thread();
+  warm_up();
   std::unique_ptr<httplib::TaskQueue> queue(new_task_queue());
   f.queue = queue.get();
   const std::size_t fd_limit = descriptor_limit();

@@ -71,6 +71,7 @@ class DeadlineHttpServer final : public httplib::Server {
   struct Connection;  // one client's socket, its unread bytes and its deadline (in the .cpp)
 
  private:
+  void warm_up();  // one request on the serving thread before the workers start (in the .cpp)
   struct Front;
   // A worker: answers the whole request(s) buffered on `c`, then hands it back to the front end.
   void answer(std::shared_ptr<Connection> c);
