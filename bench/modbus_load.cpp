@@ -27,6 +27,8 @@
 #include <thread>
 #include <vector>
 
+#include "latency_tally.hpp"
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -104,17 +106,9 @@ int read_floats(const Target& t, const std::vector<int>& addresses) {
   return 0;
 }
 
-constexpr std::size_t kBins = 100'000;  // 1 us each: 0 .. 100 ms; one more bin for everything beyond
+using LatencyTally = epa::bench::LatencyTally;
 
-struct ThreadResult {
-  std::vector<std::uint32_t> histogram = std::vector<std::uint32_t>(kBins + 1, 0);
-  std::uint64_t requests = 0;
-  std::uint64_t errors = 0;
-  std::int64_t max_ns = 0;
-  bool connected = false;
-};
-
-void client_thread(const Target& t, Clock::time_point measure_from, Clock::time_point measure_until, ThreadResult& r) {
+void client_thread(const Target& t, Clock::time_point measure_from, Clock::time_point measure_until, LatencyTally& r) {
   std::vector<std::uint16_t> regs(static_cast<std::size_t>(t.count));
   modbus_t* ctx = connect_client(t);
   r.connected = ctx != nullptr;
@@ -135,31 +129,9 @@ void client_thread(const Target& t, Clock::time_point measure_from, Clock::time_
       continue;
     }
     if (start < measure_from) continue;
-    const std::int64_t ns = std::chrono::duration_cast<std::chrono::nanoseconds>(end - start).count();
-    ++r.histogram[std::min(static_cast<std::size_t>(ns / 1000), kBins)];
-    ++r.requests;
-    r.max_ns = std::max(r.max_ns, ns);
+    r.record(start, end);
   }
   disconnect(ctx);
-}
-
-// Upper edge (us) of the bin holding the p-quantile; the overflow bin reports the exact maximum.
-double percentile_us(const std::vector<std::uint64_t>& histogram, std::uint64_t total, double p, double max_us) {
-  if (total == 0) return std::nan("");
-  const auto want = static_cast<std::uint64_t>(std::ceil(p * static_cast<double>(total)));
-  std::uint64_t seen = 0;
-  for (std::size_t i = 0; i < kBins; ++i) {
-    seen += histogram[i];
-    if (seen >= std::max<std::uint64_t>(want, 1)) return std::min(static_cast<double>(i + 1), max_us);
-  }
-  return max_us;
-}
-
-std::string number(double v, const char* format = "%.1f") {
-  if (!std::isfinite(v)) return "null";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
 }
 
 }  // namespace
@@ -192,30 +164,19 @@ int main(int argc, char** argv) {
   const auto t0 = Clock::now();
   const auto measure_from = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(warmup_s));
   const auto measure_until = measure_from + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
-  std::vector<ThreadResult> results(static_cast<std::size_t>(clients));
+  std::vector<LatencyTally> results(static_cast<std::size_t>(clients));
   {
     std::vector<std::jthread> threads;
     for (auto& r : results) threads.emplace_back(client_thread, std::cref(target), measure_from, measure_until, std::ref(r));
   }
 
-  std::vector<std::uint64_t> histogram(kBins + 1, 0);
-  std::uint64_t requests = 0, errors = 0;
-  std::int64_t max_ns = 0;
-  int connected = 0;
-  for (const auto& r : results) {
-    for (std::size_t i = 0; i <= kBins; ++i) histogram[i] += r.histogram[i];
-    requests += r.requests;
-    errors += r.errors;
-    max_ns = std::max(max_ns, r.max_ns);
-    connected += r.connected ? 1 : 0;
-  }
-  if (connected < clients) std::fprintf(stderr, "modbus_load: only %d of %d clients connected at first\n", connected, clients);
-  const double max_us = requests ? static_cast<double>(max_ns) / 1000.0 : std::nan("");
+  const epa::bench::LatencySummary all(results);
+  if (all.connected < clients) std::fprintf(stderr, "modbus_load: only %d of %d clients connected at first\n", all.connected, clients);
   std::printf("{\"clients\":%d,\"seconds\":%g,\"requests\":%llu,\"throughput_rps\":%s,\"p50_us\":%s,\"p99_us\":%s,\"max_us\":%s,\"errors\":%llu}\n",
-              clients, seconds, static_cast<unsigned long long>(requests),
-              number(static_cast<double>(requests) / seconds).c_str(),
-              number(percentile_us(histogram, requests, 0.50, max_us), "%.0f").c_str(),
-              number(percentile_us(histogram, requests, 0.99, max_us), "%.0f").c_str(), number(max_us).c_str(),
-              static_cast<unsigned long long>(errors));
-  return requests > 0 ? 0 : 1;
+              clients, seconds, static_cast<unsigned long long>(all.requests),
+              epa::bench::json_number(static_cast<double>(all.requests) / seconds).c_str(),
+              epa::bench::json_number(all.percentile_us(0.50), "%.0f").c_str(),
+              epa::bench::json_number(all.percentile_us(0.99), "%.0f").c_str(), epa::bench::json_number(all.max_us()).c_str(),
+              static_cast<unsigned long long>(all.errors));
+  return all.requests > 0 ? 0 : 1;
 }

@@ -44,6 +44,8 @@
 #include <thread>
 #include <vector>
 
+#include "latency_tally.hpp"
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -213,22 +215,7 @@ bool wait_ready(const Options& o, SSL_CTX* ctx, double timeout_s) {
   return false;
 }
 
-constexpr std::size_t kBins = 100'000;  // 1 us each: 0 .. 100 ms; one more bin for everything beyond
-
-struct ThreadResult {
-  std::vector<std::uint32_t> histogram = std::vector<std::uint32_t>(kBins + 1, 0);
-  std::uint64_t requests = 0;
-  std::uint64_t errors = 0;
-  std::int64_t max_ns = 0;
-  bool connected = false;
-
-  void record(Clock::time_point start, Clock::time_point end) {
-    const std::int64_t ns = std::chrono::duration_cast<std::chrono::nanoseconds>(end - start).count();
-    ++histogram[std::min(static_cast<std::size_t>(ns / 1000), kBins)];
-    ++requests;
-    max_ns = std::max(max_ns, ns);
-  }
-};
+using LatencyTally = epa::bench::LatencyTally;
 
 struct Run {
   Clock::time_point from, until;  // measured: requests begun in [from, until)
@@ -236,7 +223,7 @@ struct Run {
 };
 
 // One persistent connection (reconnecting when it breaks), requests closed-loop or on a schedule.
-void poll_thread(const Options& o, SSL_CTX* ctx, const Run& run, ThreadResult& r) {
+void poll_thread(const Options& o, SSL_CTX* ctx, const Run& run, LatencyTally& r) {
   Connection c(o, ctx);
   r.connected = c.open();
   std::uint16_t tid = 0;
@@ -267,7 +254,7 @@ void poll_thread(const Options& o, SSL_CTX* ctx, const Run& run, ThreadResult& r
 }
 
 // Connect, handshake, one read, close: each whole cycle is one sample.
-void handshake_thread(const Options& o, SSL_CTX* ctx, const Run& run, ThreadResult& r) {
+void handshake_thread(const Options& o, SSL_CTX* ctx, const Run& run, LatencyTally& r) {
   std::uint16_t tid = 0;
   for (Clock::time_point start = Clock::now(); start < run.until; start = Clock::now()) {
     Connection c(o, ctx);
@@ -283,25 +270,6 @@ void handshake_thread(const Options& o, SSL_CTX* ctx, const Run& run, ThreadResu
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
   }
-}
-
-// Upper edge (us) of the bin holding the p-quantile; the overflow bin reports the exact maximum.
-double percentile_us(const std::vector<std::uint64_t>& histogram, std::uint64_t total, double p, double max_us) {
-  if (total == 0) return std::nan("");
-  const auto want = static_cast<std::uint64_t>(std::ceil(p * static_cast<double>(total)));
-  std::uint64_t seen = 0;
-  for (std::size_t i = 0; i < kBins; ++i) {
-    seen += histogram[i];
-    if (seen >= std::max<std::uint64_t>(want, 1)) return std::min(static_cast<double>(i + 1), max_us);
-  }
-  return max_us;
-}
-
-std::string number(double v, const char* format = "%.1f") {
-  if (!std::isfinite(v)) return "null";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
 }
 
 }  // namespace
@@ -353,33 +321,22 @@ int main(int argc, char** argv) {
   run.from = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(warmup_s));
   run.until = run.from + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
   run.interval = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double, std::milli>(interval_ms));
-  std::vector<ThreadResult> results(static_cast<std::size_t>(clients));
+  std::vector<LatencyTally> results(static_cast<std::size_t>(clients));
   {
     std::vector<std::jthread> threads;
     for (auto& r : results)
       threads.emplace_back(handshakes ? handshake_thread : poll_thread, std::cref(o), ctx, std::cref(run), std::ref(r));
   }
 
-  std::vector<std::uint64_t> histogram(kBins + 1, 0);
-  std::uint64_t requests = 0, errors = 0;
-  std::int64_t max_ns = 0;
-  int connected = 0;
-  for (const auto& r : results) {
-    for (std::size_t i = 0; i <= kBins; ++i) histogram[i] += r.histogram[i];
-    requests += r.requests;
-    errors += r.errors;
-    max_ns = std::max(max_ns, r.max_ns);
-    connected += r.connected ? 1 : 0;
-  }
-  if (connected < clients) std::fprintf(stderr, "modbus_tls_load: only %d of %d clients connected at first\n", connected, clients);
-  const double max_us = requests ? static_cast<double>(max_ns) / 1000.0 : std::nan("");
-  const std::string rate = number(static_cast<double>(requests) / seconds);
+  const epa::bench::LatencySummary all(results);
+  if (all.connected < clients) std::fprintf(stderr, "modbus_tls_load: only %d of %d clients connected at first\n", all.connected, clients);
+  const std::string rate = epa::bench::json_number(static_cast<double>(all.requests) / seconds);
   std::printf("{\"mode\":\"%s\",\"clients\":%d,\"seconds\":%g,\"interval_ms\":%g,\"%s\":%llu,\"%s\":%s,\"p50_us\":%s,\"p99_us\":%s,"
               "\"max_us\":%s,\"errors\":%llu}\n",
               handshakes ? "handshakes" : o.tls ? "tls" : "plain", clients, seconds, interval_ms, handshakes ? "handshakes" : "requests",
-              static_cast<unsigned long long>(requests), handshakes ? "handshakes_per_s" : "throughput_rps", rate.c_str(),
-              number(percentile_us(histogram, requests, 0.50, max_us), "%.0f").c_str(),
-              number(percentile_us(histogram, requests, 0.99, max_us), "%.0f").c_str(), number(max_us).c_str(),
-              static_cast<unsigned long long>(errors));
-  return requests > 0 ? 0 : 1;
+              static_cast<unsigned long long>(all.requests), handshakes ? "handshakes_per_s" : "throughput_rps", rate.c_str(),
+              epa::bench::json_number(all.percentile_us(0.50), "%.0f").c_str(),
+              epa::bench::json_number(all.percentile_us(0.99), "%.0f").c_str(), epa::bench::json_number(all.max_us()).c_str(),
+              static_cast<unsigned long long>(all.errors));
+  return all.requests > 0 ? 0 : 1;
 }
