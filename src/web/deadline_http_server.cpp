@@ -340,14 +340,17 @@ DeadlineHttpServer::~DeadlineHttpServer() {
 // function-local statics on the first request that needs them; built by whichever worker came
 // first, the others then read them past a guard check that an uninstrumented library does without
 // a call, which ThreadSanitizer cannot see (it reported a race between two workers' first
-// requests). Built here, they are there before the workers start. Its answer goes nowhere.
+// requests). Built here, they are there before the workers start. Its answer goes nowhere, and it
+// is no client's: warming_up() says so to the handlers while it runs.
 void DeadlineHttpServer::warm_up() {
   Connection c;
   c.buffer = "GET / HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n";
   c.deadline = Clock::now() + limits_.request_deadline;
   BufferedStream stream(c, limits_);
   bool closed = false;
+  warming_up_ = true;
   process_request(stream, true, closed, nullptr);
+  warming_up_ = false;
 }
 
 void DeadlineHttpServer::use_tls(std::unique_ptr<FrontEndTls> tls) { tls_ = std::move(tls); }

@@ -66,12 +66,16 @@ class DeadlineHttpServer final : public httplib::Server {
   // Ends serve_after_bind: the listening socket and every connection are closed, workers joined.
   void stop_serving();
   bool serving() const;
+  // True while the serving thread answers its own warm-up request (before any client's): a
+  // handler that counts requests leaves it out.
+  bool warming_up() const { return warming_up_; }
   std::size_t connections() const;  // open now (front end and workers)
 
   struct Connection;  // one client's socket, its unread bytes and its deadline (in the .cpp)
 
  private:
   void warm_up();  // one request on the serving thread before the workers start (in the .cpp)
+  bool warming_up_ = false;  // written and read on the serving thread before the workers exist
   struct Front;
   // A worker: answers the whole request(s) buffered on `c`, then hands it back to the front end.
   void answer(std::shared_ptr<Connection> c);

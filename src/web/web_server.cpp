@@ -335,7 +335,7 @@ struct WebServer::Impl {
   void routes() {
     auto& s = server;
     s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-      requests.fetch_add(1, std::memory_order_relaxed);
+      if (!server.warming_up()) requests.fetch_add(1, std::memory_order_relaxed);  // clients' requests only
       res.set_header("Cache-Control", "no-store");
       if (!hosts.allowed(req.get_header_value("Host"), req.local_addr)) {
         res.set_header("Connection", "close");

@@ -322,6 +322,15 @@ TEST_F(WebServerTest, FaultsListTheHistoryNewestFirstWithoutAToken) {
   EXPECT_DOUBLE_EQ(e["sensor_v"].get<double>(), 2.27);
 }
 
+// The server answers one request of its own before its workers start (deadline_http_server.cpp):
+// it is no client's, and the count says so.
+TEST_F(WebServerTest, TheRequestCountIsTheClientsAlone) {
+  start();
+  auto res = client_->Get("/metrics");
+  ASSERT_TRUE(res);
+  EXPECT_NE(res->body.find("\nepa_web_requests_total 1\n"), std::string::npos) << res->body.substr(0, 2000);
+}
+
 TEST_F(WebServerTest, MetricsAreValidPrometheusText) {
   start();
   auto res = client_->Get("/metrics");
