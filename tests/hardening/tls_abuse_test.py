@@ -50,6 +50,7 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from epa_appliance import HOST, UNIT, Appliance, Checks, free_port, wait_until  # noqa: E402
+from modbus_tls import client_context, make_pki, tls_section  # noqa: E402
 
 HANDSHAKE_TIMEOUT_S = 3.0
 MAX_CLIENTS = 16
@@ -61,34 +62,6 @@ WRONG_CA = "127.0.0.10"
 FINAL = "127.0.0.11"
 STALLED = "127.0.0.12"
 ATTACKERS = [GARBAGE, TRUNCATED, SLOW, *CROWD, WRONG_CA]
-
-
-def run(cmd):
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=60)
-    if r.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)} failed ({r.returncode}): {r.stderr}")
-
-
-def make_pki(epa, root):
-    pki, other = os.path.join(root, "pki"), os.path.join(root, "other")
-    run([epa, "certs", "init", pki])
-    run([epa, "certs", "client", pki, "hmi", "--role", "operator"])
-    run([epa, "certs", "client", pki, "view", "--role", "viewer"])
-    run([epa, "certs", "init", other])
-    run([epa, "certs", "client", other, "hmi", "--role", "operator"])
-    return pki, other
-
-
-def tls_section(pki, port):
-    return ("[modbus_tls]\nenabled = true\naddress = \"127.0.0.1\"\n"
-            f"port = {port}\nhandshake_timeout_s = {HANDSHAKE_TIMEOUT_S}\n"
-            f'ca = "{pki}/ca.pem"\ncert = "{pki}/device.pem"\nkey = "{pki}/device.key"\ncrl = "{pki}/crl.pem"\n')
-
-
-def tls_context(ca_dir, cert_dir, name):
-    ctx = ssl.create_default_context(ssl.Purpose.SERVER_AUTH, cafile=os.path.join(ca_dir, "ca.pem"))
-    ctx.load_cert_chain(os.path.join(cert_dir, name + ".pem"), os.path.join(cert_dir, name + ".key"))
-    return ctx
 
 
 # ---- raw Modbus frames ----
@@ -122,7 +95,7 @@ def hmi(port, pki, stop, results, limit_s=90.0):
     """FC3 of 10 registers every 100 ms from LEGIT on one TLS connection, reconnecting when dropped,
     until `stop` is set (at most `limit_s`); puts [(start, answered, seconds, modbus_clients or None,
     error)] on `results`."""
-    ctx = tls_context(pki, pki, "hmi")
+    ctx = client_context(pki, pki, "hmi")
     polls, conn, tid = [], None, 0
     end = time.monotonic() + limit_s
     while time.monotonic() < end and not stop.is_set():
@@ -394,7 +367,7 @@ async def crowd(port, hello, seconds):
 
 def wrong_ca(port, pki, other, n):
     """`n` connects from WRONG_CA with another CA's certificate: how many were refused."""
-    ctx = tls_context(pki, other, "hmi")
+    ctx = client_context(pki, other, "hmi")
     refused = 0
     for i in range(n):
         try:
@@ -462,7 +435,7 @@ def cpu_seconds(pid):
 def stalled_record(port, pki, pid, check):
     """A viewer that, after its handshake and a read, sends 3 bytes of a record header and stalls: the
     appliance waits for the rest on the socket, it does not spin (its CPU time over 2 s)."""
-    ctx = tls_context(pki, pki, "view")
+    ctx = client_context(pki, pki, "view")
     with socket.create_connection((HOST, port), timeout=3, source_address=(STALLED, 0)) as raw:
         with ctx.wrap_socket(raw, server_hostname="localhost") as s:
             s.sendall(fc3(1))
@@ -475,7 +448,7 @@ def stalled_record(port, pki, pid, check):
 
 
 def still_answers(app, port, pki, check):
-    ctx = tls_context(pki, pki, "view")
+    ctx = client_context(pki, pki, "view")
     try:
         with socket.create_connection((HOST, port), timeout=3, source_address=(FINAL, 0)) as raw:
             with ctx.wrap_socket(raw, server_hostname="localhost") as s:
@@ -518,9 +491,9 @@ def main():
     reg_map = os.path.join(src, "registers", "epa.csv")
     check = Checks()
     root = Appliance(epa, reg_map, start=False)  # a temporary folder for the certificates
-    pki, other = make_pki(epa, root.dir)
+    pki, other = make_pki(epa, root.dir, [("hmi", "operator"), ("view", "viewer")])
     port = free_port()
-    app = Appliance(epa, reg_map, extra_config=tls_section(pki, port),
+    app = Appliance(epa, reg_map, extra_config=tls_section(pki, port, f"handshake_timeout_s = {HANDSHAKE_TIMEOUT_S}\n"),
                     modbus_extra=f"max_clients = {MAX_CLIENTS}\nmax_clients_per_address = {PER_ADDRESS}\n")
     app.client.close()  # its slot is not needed: the checks count the slots
     app.client = None

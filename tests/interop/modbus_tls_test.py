@@ -32,6 +32,7 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from epa_appliance import HOST, UNIT, Appliance, Checks, f32_value, f32_words, free_port, key_words, stop_process  # noqa: E402
 
+from modbus_tls import client_context, make_pki, tls_section  # noqa: E402
 from pymodbus.client import AsyncModbusTlsClient  # noqa: E402
 from pymodbus.framer.socket_framer import ModbusSocketFramer  # noqa: E402
 from pymodbus.pdu import ExceptionResponse  # noqa: E402
@@ -41,32 +42,11 @@ M_R = 20         # holding, float32: a tuning point
 UNLOCK = 9       # holding, key64
 
 
-def run(cmd):
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=60)
-    if r.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)} failed ({r.returncode}): {r.stderr}")
-    return r.stdout
-
-
-def make_pki(epa, root):
+def make_test_pki(epa, root):
     """The plant's CA with clients of each role, one revoked, one with a role not in the table;
     and another CA with a client of its own."""
-    pki, other = os.path.join(root, "pki"), os.path.join(root, "other")
-    run([epa, "certs", "init", pki])
-    for name, role in [("view", "viewer"), ("hmi", "operator"), ("eng", "engineer"), ("gone", "operator"), ("guest", "guest")]:
-        run([epa, "certs", "client", pki, name, "--role", role])
-    run([epa, "certs", "revoke", pki, os.path.join(pki, "gone.pem")])
-    run([epa, "certs", "init", other])
-    run([epa, "certs", "client", other, "hmi", "--role", "operator"])
-    return pki, other
-
-
-def tls_context(pki, client_dir=None, name=None):
-    """A client's TLS context: the plant's CA trusted, the client's certificate when named."""
-    ctx = ssl.create_default_context(ssl.Purpose.SERVER_AUTH, cafile=os.path.join(pki, "ca.pem"))
-    if name:
-        ctx.load_cert_chain(os.path.join(client_dir or pki, name + ".pem"), os.path.join(client_dir or pki, name + ".key"))
-    return ctx
+    return make_pki(epa, root, [("view", "viewer"), ("hmi", "operator"), ("eng", "engineer"), ("gone", "operator"), ("guest", "guest")],
+                    revoked=["gone"])
 
 
 async def session(port, ctx, steps):
@@ -89,7 +69,7 @@ async def role_checks(port, pki, check):
         read = await c.read_holding_registers(SETPOINT, 2, slave=UNIT)
         write = await c.write_registers(SETPOINT, f32_words(120.0, "ABCD"), slave=UNIT)
         return read, write
-    read, write = await session(port, tls_context(pki, name="view"), viewer)
+    read, write = await session(port, client_context(pki, name="view"), viewer)
     check(not read.isError(), f"a viewer reads the setpoint ({read})")
     check(exception_code(write) == 4, f"a viewer's setpoint write is refused with exception 04 ({write})")
 
@@ -99,7 +79,7 @@ async def role_checks(port, pki, check):
         tuning = await c.write_registers(M_R, f32_words(1.5, "ABCD"), slave=UNIT)
         unlock = await c.write_registers(UNLOCK, key_words(), slave=UNIT)
         return write, back, tuning, unlock
-    write, back, tuning, unlock = await session(port, tls_context(pki, name="hmi"), operator)
+    write, back, tuning, unlock = await session(port, client_context(pki, name="hmi"), operator)
     check(not write.isError() and f32_value(back.registers, "ABCD") == 123.0, f"an operator writes the setpoint ({write}, {back})")
     check(exception_code(tuning) == 4, f"an operator's tuning write is refused with exception 04 ({tuning})")
     check(exception_code(unlock) == 4, f"the unlock key is refused on the secure port: the role decides ({unlock})")
@@ -108,7 +88,7 @@ async def role_checks(port, pki, check):
         tuning = await c.write_registers(M_R, f32_words(1.5, "ABCD"), slave=UNIT)
         back = await c.read_holding_registers(M_R, 2, slave=UNIT)
         return tuning, back
-    tuning, back = await session(port, tls_context(pki, name="eng"), engineer)
+    tuning, back = await session(port, client_context(pki, name="eng"), engineer)
     check(not tuning.isError() and f32_value(back.registers, "ABCD") == 1.5,
           f"an engineer writes a tuning point without the unlock key ({tuning}, {back})")
 
@@ -156,10 +136,10 @@ def refused(port, ctx, source):
 
 
 def refusal_checks(app, port, pki, other, check):
-    cases = [("no certificate", tls_context(pki), "certificate"),
-             ("a certificate of another CA", tls_context(pki, other, "hmi"), "unable to get local issuer certificate"),
-             ("a revoked certificate", tls_context(pki, name="gone"), "certificate revoked"),
-             ("a role not in the table", tls_context(pki, name="guest"), 'role "guest" is not in the role table')]
+    cases = [("no certificate", client_context(pki), "certificate"),
+             ("a certificate of another CA", client_context(pki, other, "hmi"), "unable to get local issuer certificate"),
+             ("a revoked certificate", client_context(pki, name="gone"), "certificate revoked"),
+             ("a role not in the table", client_context(pki, name="guest"), 'role "guest" is not in the role table')]
     # Each from its own loopback address: refusals are logged once per address, then held back.
     for n, (what, ctx, reason) in enumerate(cases):
         check(refused(port, ctx, f"127.0.0.{10 + n}"), f"{what}: refused in the handshake")
@@ -176,7 +156,7 @@ def refusal_checks(app, port, pki, other, check):
 def vanishing_clients(port, pki, check, app):
     """Clients that send a request and reset the connection before the answer: the answer's write
     fails (EPIPE), which must close that connection, not end the appliance (SIGPIPE)."""
-    ctx = tls_context(pki, name="view")
+    ctx = client_context(pki, name="view")
     try:
         for _ in range(30):
             s = ctx.wrap_socket(socket.create_connection((HOST, port), timeout=3), server_hostname="localhost")
@@ -197,7 +177,7 @@ def cpu_ticks(pid):
 def half_record_costs_nothing(port, pki, check, app):
     """A client that sends part of a TLS record and stops: the server waits on the socket for the
     rest; it must not poll without waiting (that spun a core)."""
-    ctx = tls_context(pki, name="view")
+    ctx = client_context(pki, name="view")
     incoming, outgoing = ssl.MemoryBIO(), ssl.MemoryBIO()
     tls = ctx.wrap_bio(incoming, outgoing, server_hostname="localhost")
     with socket.create_connection((HOST, port), timeout=3) as raw:
@@ -230,7 +210,7 @@ def half_record_costs_nothing(port, pki, check, app):
 
 def tls12_reconnect(port, pki, check):
     """A TLS 1.2 client that offers its last session when it reconnects gets a whole handshake."""
-    ctx = tls_context(pki, name="view")
+    ctx = client_context(pki, name="view")
     ctx.maximum_version = ssl.TLSVersion.TLSv1_2
     session = None
     for attempt in range(2):
@@ -271,7 +251,7 @@ def secure_only_checks(epa, reg_map, pki, check):
 
         async def read(c):
             return await c.read_holding_registers(SETPOINT, 2, slave=UNIT)
-        r = asyncio.run(session(port, tls_context(pki, name="view"), read))
+        r = asyncio.run(session(port, client_context(pki, name="view"), read))
         check(not r.isError(), f"... and answers ({r})")
         with socket.socket() as s:
             check(s.connect_ex((HOST, app.port)) != 0, "... and the plain port is closed")
@@ -281,18 +261,12 @@ def secure_only_checks(epa, reg_map, pki, check):
         app.remove()
 
 
-def tls_section(pki, port):
-    return ("[modbus_tls]\nenabled = true\naddress = \"127.0.0.1\"\n"
-            f"port = {port}\n"
-            f'ca = "{pki}/ca.pem"\ncert = "{pki}/device.pem"\nkey = "{pki}/device.key"\ncrl = "{pki}/crl.pem"\n')
-
-
 def main():
     epa, src = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     reg_map = os.path.join(src, "registers", "epa.csv")
     check = Checks()
     root = Appliance(epa, reg_map, start=False)  # a temporary folder for the certificates
-    pki, other = make_pki(epa, root.dir)
+    pki, other = make_test_pki(epa, root.dir)
     port = free_port()
     app = Appliance(epa, reg_map, extra_config=tls_section(pki, port))
     try:
