@@ -34,10 +34,7 @@ py=/usr/bin/python3  # Debian's interpreter: python3-pymodbus lives there
 command -v taskset >/dev/null && command -v chrt >/dev/null || { echo "taskset, chrt missing: run scripts/install-deps.sh" >&2; exit 1; }
 [[ $EUID -eq 0 ]] || echo "warning: not root: the appliance's loop runs without SCHED_FIFO and memory locking" >&2
 
-online_cpus=$(cat /sys/devices/system/cpu/online)  # e.g. 0-1
-pin_cpu=${PIN_CPU:-$(($(getconf _NPROCESSORS_ONLN) - 1))}
-pin=()
-[[ $pin_cpu == none ]] || pin=(taskset -c "$pin_cpu")
+source bench/cpu_pinning.sh  # pin_cpu, pin, online_cpus, unpin_scan_cycle
 
 cmake --build --preset release --target epa modbus_load modbus_minimal_server >/dev/null
 epa=build/release/src/app/epa
@@ -111,24 +108,6 @@ EOF
     exit 1
   fi
   if [[ $kind == epa ]]; then unpin_scan_cycle "$server_pid"; fi
-}
-
-# Gives the appliance's SCHED_FIFO thread (the scan cycle) all online CPUs back when the process
-# was pinned. The loop thread switches to SCHED_FIFO as it starts, just after the Modbus server
-# answers, so it is looked for during at most 2 s.
-unpin_scan_cycle() {
-  local pid=$1 task
-  [[ $pin_cpu != none ]] || return 0
-  for _ in $(seq 40); do
-    for task in /proc/"$pid"/task/*; do
-      if chrt -p "${task##*/}" 2>/dev/null | grep -q SCHED_FIFO; then
-        taskset -p -c "$online_cpus" "${task##*/}" >/dev/null
-        return 0
-      fi
-    done
-    sleep 0.05
-  done
-  echo "warning: no SCHED_FIFO thread in the appliance (not root?): its scan cycle stays on CPU $pin_cpu" >&2
 }
 
 # The scan cycle's statistics as JSON, read from the appliance's input registers (float32 ABCD).
