@@ -108,6 +108,10 @@ struct ModbusServer::Impl {
   bool receive(std::size_t i, std::int64_t now_ns);
   bool receive_tls(std::size_t i, std::int64_t now_ns);
   bool finish_handshake(std::size_t i, std::int64_t now_ns);
+  // A refused handshake, logged as the refusal log allows (once per address, then backed off).
+  void log_refusal(const std::string& address, const std::string& why, std::int64_t now_ns) {
+    if (const std::string line = refusal_log.refused(address, why, now_ns); log && !line.empty()) log("modbus-tls: " + line);
+  }
   bool timed_out(std::size_t i, std::int64_t now_ns);
   int send_reply(ClientConnection& cl, std::size_t total, const Reply& reply);
   std::vector<std::uint8_t> answer_bytes(ClientConnection& cl, std::size_t total, const Reply& reply);
@@ -239,8 +243,7 @@ bool ModbusServer::Impl::finish_handshake(std::size_t i, std::int64_t now_ns) {
   const tls::TlsConnection::Step step = cl.tls->handshake();
   cl.tls_wants_write = step == tls::TlsConnection::Step::kWantWrite;
   if (step == tls::TlsConnection::Step::kFailed) {
-    if (const std::string line = refusal_log.refused(cl.session.address, cl.tls->failure(), now_ns); log && !line.empty())
-      log("modbus-tls: " + line);
+    log_refusal(cl.session.address, cl.tls->failure(), now_ns);
     return drop(i, nullptr), false;
   }
   if (step != tls::TlsConnection::Step::kDone) return true;
@@ -260,8 +263,7 @@ bool ModbusServer::Impl::finish_handshake(std::size_t i, std::int64_t now_ns) {
 bool ModbusServer::Impl::timed_out(std::size_t i, std::int64_t now_ns) {
   const ClientConnection& cl = clients[i];
   if (cl.tls && !cl.tls->handshake_done() && now_ns - cl.connected_ns > static_cast<std::int64_t>(config.secure.handshake_timeout_s * 1e9)) {
-    if (const std::string line = refusal_log.refused(cl.session.address, "no handshake within handshake_timeout_s", now_ns); log && !line.empty())
-      log("modbus-tls: " + line);
+    log_refusal(cl.session.address, "no handshake within handshake_timeout_s", now_ns);
     return drop(i, nullptr), true;
   }
   if (cl.frame_started_ns >= 0 && now_ns - cl.frame_started_ns > static_cast<std::int64_t>(config.frame_timeout_s * 1e9))
