@@ -1,5 +1,6 @@
 #include "commission/commission_sequence.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -15,6 +16,12 @@ namespace epa::commission {
 namespace {
 
 constexpr double kIdentifyWeightS = 20.0;  // what identification and design weigh in the progress, as seconds
+// A split's Hammerstein model that follows the very runs it was estimated on this badly (free-run
+// fit) says those runs are not one experiment on one axis: a run disturbed on its way (the I/O, a
+// hand on the piston). On the physics rig a sound experiment gives 74-82 % (tests/commission/
+// commission_physics_sweep.cpp); a run through a disturbed remote I/O path gave 37.5 %, and the
+// law designed on it without its stick-slip model overshot a later 50 mm move by 8.7 %.
+constexpr double kDescribedRunsFitPct = 50.0;
 
 nlohmann::json optional_number(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
 
@@ -155,8 +162,10 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
   out.previous_set = previous->set.name;
   out.previous_set_id = previous->set.id;
 
-  if (!excite_the_axis(spec, out)) return out;
-  const auto identified = identify_cross_validated(previous->model.model.Ts, out);
+  if (!excite_the_axis(spec, spec.seed, out)) return out;
+  auto identified = identify_cross_validated(previous->model.model.Ts, out);
+  if (!identified) return out;
+  identified = identify_once_more_if_undescribed(spec, previous->model.model.Ts, std::move(*identified), out);
   if (!identified) return out;
   auto set = design_tuning_set(*identified, previous->set, spec, out);
   if (!set) return out;
@@ -183,10 +192,10 @@ const CommissionSpec& CommissionSequence::start(CommissionOutcome& out) {
 
 double CommissionSequence::percent_done() const { return 100.0 * done_s_ / total_s_; }
 
-// 1. The experiment: the excitation runs, one seed each.
-bool CommissionSequence::excite_the_axis(const CommissionSpec& spec, CommissionOutcome& out) {
+// 1. The experiment: the excitation runs, one seed each from first_seed on.
+bool CommissionSequence::excite_the_axis(const CommissionSpec& spec, std::uint64_t first_seed, CommissionOutcome& out) {
   for (int i = 0; i < spec.excitation_runs; ++i) {
-    const std::uint64_t seed = spec.seed + static_cast<std::uint64_t>(i);
+    const std::uint64_t seed = first_seed + static_cast<std::uint64_t>(i);
     const std::string what = fmt::format("excitation run {} of {} ({:.0f} s, seed {})", i + 1, spec.excitation_runs, spec.excitation_s, seed);
     step(Stage::kExciting, percent_done(), what, out);
     auto run = axis_.excite({spec.excitation_s, seed, spec.amplitude_max_v}, abort_);
@@ -207,6 +216,8 @@ std::optional<IdentifiedModel> CommissionSequence::identify_cross_validated(doub
   step(Stage::kIdentifying, percent_done(), "identifying the Hammerstein model", out);
   std::vector<IdentifiedModel> candidates;
   std::string first_error;
+  lowest_estimation_fit_pct_ = 100.0;
+  a_split_failed_ = false;
   for (std::size_t held = out.experiment.size(); held-- > 0;) {
     std::vector<core::Run> estimation;
     for (std::size_t i = 0; i < out.experiment.size(); ++i)
@@ -217,9 +228,11 @@ std::optional<IdentifiedModel> CommissionSequence::identify_cross_validated(doub
     if (!candidate) {
       out.log.push_back("identification, " + which + candidate.error().message);
       if (first_error.empty()) first_error = which + candidate.error().message;
+      a_split_failed_ = true;
       continue;
     }
     candidate->held_out_run = held;
+    lowest_estimation_fit_pct_ = std::min(lowest_estimation_fit_pct_, candidate->estimation_fit_pct);
     out.log.push_back("identified, " + which + candidate->summary);
     if (log_) log_("commission: identified, " + which + candidate->summary);
     candidates.push_back(std::move(*candidate));
@@ -231,6 +244,27 @@ std::optional<IdentifiedModel> CommissionSequence::identify_cross_validated(doub
   out.log.push_back("identified: " + identified.summary);
   if (log_) log_("commission: identified: " + identified.summary);
   return identified;
+}
+
+// 2b. An experiment the models cannot follow (a split failed, or a split's model follows its own
+// estimation runs below kDescribedRunsFitPct) is set aside and run once more with the next seeds,
+// and the model is identified on the new runs alone: a disturbed run spoils every split it is in,
+// held out or estimating. The second experiment is kept whatever it gives; its model still has to
+// pass the simulated and the measured verification.
+std::optional<IdentifiedModel> CommissionSequence::identify_once_more_if_undescribed(const CommissionSpec& spec, double loop_period_s,
+                                                                                   IdentifiedModel identified, CommissionOutcome& out) {
+  if (!a_split_failed_ && lowest_estimation_fit_pct_ >= kDescribedRunsFitPct) return identified;
+  out.repeated_experiment =
+      a_split_failed_ ? "a split of the cross-validation could not be identified"
+                      : fmt::format("a split's model follows the runs it was estimated on at {:.1f} % (below {:.0f} %)",
+                                    lowest_estimation_fit_pct_, kDescribedRunsFitPct);
+  out.log.push_back("the experiment is run once more: " + out.repeated_experiment);
+  if (log_) log_("commission: the experiment is run once more: " + out.repeated_experiment);
+  total_s_ += spec.excitation_runs * spec.excitation_s;
+  out.experiment.clear();
+  const auto next_seed = spec.seed + static_cast<std::uint64_t>(spec.excitation_runs);
+  if (!excite_the_axis(spec, next_seed, out)) return std::nullopt;
+  return identify_cross_validated(loop_period_s, out);
 }
 
 // 3. Design: the previous set with the new law, dead zone and arrival; l_c and the valve limit
@@ -333,6 +367,7 @@ std::string format_commission_json(const CommissionOutcome& o) {
                       {"previous_set", o.previous_set},
                       {"new_set", o.new_set.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.new_set)},
                       {"spec", nlohmann::json::parse(format_commission_spec(o.spec))},
+                      {"repeated_experiment", o.repeated_experiment.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.repeated_experiment)},
                       {"log", o.log}};
   if (o.identified) {
     const auto& m = o.identified->model;

@@ -1,6 +1,7 @@
 #pragma once
 // The commissioning sequence: excite -> identify -> design -> verify in simulation ->
-// save -> use -> verify on the axis -> keep, or roll back to the previous set at once.
+// save -> use -> verify on the axis -> keep, or roll back to the previous set at once. An
+// experiment whose runs the identified model cannot follow is run once more before the design.
 //
 // Nothing is left half-done. The new set is stored but the store's active set changes only when the
 // axis verification passed (Axis::use_set persist), so a restart mid-way comes up on the previous
@@ -9,6 +10,7 @@
 // by the axis. Runs in the calling thread; abort() and progress() may be called from any other.
 #include <array>
 #include <atomic>
+#include <cstdint>
 #include <functional>
 #include <mutex>
 #include <optional>
@@ -69,6 +71,9 @@ struct CommissionOutcome {
   std::string previous_set, new_set;  // names; new_set empty when none was stored
   std::int64_t previous_set_id = 0, new_set_id = 0;
   std::vector<core::Run> experiment;  // the excitation runs (identified->held_out_run validated the model)
+  // Why the first experiment was set aside and run once more (empty: it was not); its runs are not
+  // in `experiment`.
+  std::string repeated_experiment;
   std::optional<IdentifiedModel> identified;
   std::optional<control::RstDesign> design;
   std::optional<SimulatedVerification> simulation;
@@ -90,8 +95,10 @@ class CommissionSequence {
   // run()'s phases, in order. Each that fails or is aborted finishes the outcome (finish()) and
   // returns false or nothing.
   const CommissionSpec& start(CommissionOutcome& out);  // the spec as run: named, and the progress reset
-  bool excite_the_axis(const CommissionSpec& spec, CommissionOutcome& out);
+  bool excite_the_axis(const CommissionSpec& spec, std::uint64_t first_seed, CommissionOutcome& out);
   std::optional<IdentifiedModel> identify_cross_validated(double loop_period_s, CommissionOutcome& out);
+  std::optional<IdentifiedModel> identify_once_more_if_undescribed(const CommissionSpec& spec, double loop_period_s,
+                                                                   IdentifiedModel identified, CommissionOutcome& out);
   std::optional<store::TuningSet> design_tuning_set(const IdentifiedModel& identified, const store::TuningSet& previous,
                                                     const CommissionSpec& spec, CommissionOutcome& out);
   bool verify_by_simulation(const store::TuningSet& set, const IdentifiedModel& identified, const CommissionSpec& spec,
@@ -112,6 +119,10 @@ class CommissionSequence {
   mutable std::mutex mutex_;
   Progress progress_;
   bool new_set_running_ = false;
+  // The lowest free-run fit of a split's Hammerstein model on its own estimation runs, and whether
+  // a split failed: what identify_once_more_if_undescribed judges the experiment by.
+  double lowest_estimation_fit_pct_ = 0.0;
+  bool a_split_failed_ = false;
   double total_s_ = 1.0, done_s_ = 0.0;  // the sequence's expected duration (identification weighed as seconds), and what is done
 };
 

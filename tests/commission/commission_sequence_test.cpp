@@ -136,6 +136,76 @@ TEST(CommissionSequence, EachRunIsHeldOutOnceAndTheBestHeldOutFitIsKept) {
   }
 }
 
+// Estimated on a run of one of `disturbed_seeds`, the stand-in's model follows that very run at
+// 37.5 % (as a run disturbed through its remote I/O gave on the physics rig); on any other, 85 %.
+Identify disturbed_when_estimated_on(std::vector<std::uint64_t> disturbed_seeds, std::vector<std::string>& estimated_on) {
+  return [disturbed_seeds, &estimated_on](const std::vector<core::Run>& estimation, const core::Run&) -> core::Result<IdentifiedModel> {
+    if (estimation.size() != 1) return core::invalid_argument("expected one estimation run");
+    const std::string seed = estimation.front().meta("excitation_seed");
+    estimated_on.push_back(seed);
+    for (const auto bad : disturbed_seeds)
+      if (seed == std::to_string(bad)) return IdentifiedModel{core::paper::model(), 37.5, 71.9, {}, "from a disturbed run"};
+    return IdentifiedModel{core::paper::model(), 85.0, 86.0, {}, "from a sound run"};
+  };
+}
+
+TEST(CommissionSequence, AnExperimentItsModelCannotFollowIsRunOnceMoreWithTheNextSeeds) {
+  const auto plant = core::paper::model();
+  testing::SimulatedAxis axis(plant, testing::paper_running_tuning());
+  std::vector<std::string> estimated_on;
+  CommissionSequence seq(axis, disturbed_when_estimated_on({1}, estimated_on));
+  const auto out = seq.run(short_spec());  // seeds 1 and 2, then 3 and 4
+  ASSERT_EQ(out.verdict, Verdict::kDeployed) << out.reason;
+  EXPECT_EQ(axis.excitations, 4);
+  EXPECT_EQ(estimated_on, (std::vector<std::string>{"1", "2", "3", "4"}));
+  ASSERT_EQ(out.experiment.size(), 2u) << "the model is identified on the new runs alone";
+  EXPECT_EQ(out.experiment[0].meta("excitation_seed"), "3");
+  EXPECT_EQ(out.experiment[1].meta("excitation_seed"), "4");
+  ASSERT_TRUE(out.identified);
+  EXPECT_EQ(out.identified->estimation_fit_pct, 85.0);
+  EXPECT_NE(out.repeated_experiment.find("37.5 %"), std::string::npos) << out.repeated_experiment;
+  const auto j = nlohmann::json::parse(format_commission_json(out));
+  EXPECT_EQ(j["repeated_experiment"], out.repeated_experiment);
+  EXPECT_EQ(seq.progress().percent, 100.0);
+}
+
+TEST(CommissionSequence, TheExperimentIsRunOnceMoreAtMostAndASoundOneNotAtAll) {
+  const auto plant = core::paper::model();
+  {
+    testing::SimulatedAxis axis(plant, testing::paper_running_tuning());
+    std::vector<std::string> estimated_on;
+    CommissionSequence seq(axis, disturbed_when_estimated_on({1, 4}, estimated_on));
+    const auto out = seq.run(short_spec());
+    EXPECT_EQ(axis.excitations, 4) << "the second experiment is kept whatever it gives";
+    ASSERT_TRUE(out.identified);
+    EXPECT_EQ(out.identified->estimation_fit_pct, 85.0) << "its better split";
+  }
+  {
+    testing::SimulatedAxis axis(plant, testing::paper_running_tuning());
+    std::vector<std::string> estimated_on;
+    CommissionSequence seq(axis, disturbed_when_estimated_on({}, estimated_on));
+    const auto out = seq.run(short_spec());
+    ASSERT_EQ(out.verdict, Verdict::kDeployed) << out.reason;
+    EXPECT_EQ(axis.excitations, 2);
+    EXPECT_TRUE(out.repeated_experiment.empty());
+    EXPECT_TRUE(nlohmann::json::parse(format_commission_json(out))["repeated_experiment"].is_null());
+  }
+}
+
+TEST(CommissionSequence, ASplitThatCannotBeIdentifiedRunsTheExperimentOnceMore) {
+  const auto plant = core::paper::model();
+  testing::SimulatedAxis axis(plant, testing::paper_running_tuning());
+  Identify identify = [&](const std::vector<core::Run>& estimation, const core::Run& validation) -> core::Result<IdentifiedModel> {
+    if (estimation.front().meta("excitation_seed") == "2") return core::invalid_argument("the right break point was not identified");
+    return returns(plant)(estimation, validation);
+  };
+  CommissionSequence seq(axis, identify);
+  const auto out = seq.run(short_spec());
+  ASSERT_EQ(out.verdict, Verdict::kDeployed) << out.reason;
+  EXPECT_EQ(axis.excitations, 4);
+  EXPECT_NE(out.repeated_experiment.find("could not be identified"), std::string::npos) << out.repeated_experiment;
+}
+
 // Per split (by the held-out run's seed), the Hammerstein and the stick-slip model's held-out fits,
 // and whether the split fitted a stick-slip model at all.
 struct SplitFits {
