@@ -246,8 +246,8 @@ std::optional<IdentifiedModel> CommissionSequence::identify_cross_validated(doub
   return identified;
 }
 
-// 2b. An experiment the models cannot follow (a split failed, or a split's model follows its own
-// estimation runs below kDescribedRunsFitPct) is set aside and run once more with the next seeds,
+// 2b. An experiment the models cannot follow (a split failed while another gave a model, or a
+// split's model follows its own estimation runs below kDescribedRunsFitPct) is set aside and run once more with the next seeds,
 // and the model is identified on the new runs alone: a disturbed run spoils every split it is in,
 // held out or estimating. The second experiment is kept whatever it gives; its model still has to
 // pass the simulated and the measured verification.
