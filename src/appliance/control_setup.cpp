@@ -73,7 +73,7 @@ core::Result<ControlSetup> prepare_control(config::ApplianceConfig& c, const std
   take_from_store(c, *store, setpoint_given);
 
   const control::ControllerConfig base =
-      runtime::with_travel_range(store::controller_config(store->set, store->model.model, c.runtime.safe_valve_v), c.runtime);
+      runtime::with_loop_limits(store::controller_config(store->set, store->model.model, c.runtime.safe_valve_v), c.runtime);
   auto tuning = runtime::make_tuning(base);
   if (!tuning) return tuning.error();  // cannot happen: load_active_tuning validated the set
   return ControlSetup{std::move(*plant_model), std::move(*store), base, *tuning};

@@ -74,6 +74,8 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   if (!(c.idz_ramp >= 0.0) || !std::isfinite(c.idz_ramp)) return field_error("idz_ramp", c.idz_ramp, ">= 0");
   if (!(c.creep_blend_s >= 0.0) || !std::isfinite(c.creep_blend_s)) return field_error("creep_blend_s", c.creep_blend_s, ">= 0 s");
   if (!(c.coast_s >= 0.0) || !std::isfinite(c.coast_s)) return field_error("coast_s", c.coast_s, ">= 0 s (0: off)");
+  if (!(c.in_position_window_v >= 0.0) || !std::isfinite(c.in_position_window_v))
+    return field_error("in_position_window", c.in_position_window_v, ">= 0 V (0: none)");
   if (c.coast_s > 0.0) {
     if (!(c.approach_speed_v_s > 0.0) || !std::isfinite(c.approach_speed_v_s))
       return field_error("approach_speed", c.approach_speed_v_s, "> 0");
@@ -143,6 +145,7 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   p.approach.travel_max_v = c.travel_max_v;
   p.fallback_approach = p.approach;
   p.fallback_approach.coast_s = kFallbackCoastS;
+  p.fallback_approach.retry_band_v = std::max(p.approach.retry_band_v, kFallbackRetryShareOfWindow * c.in_position_window_v);
   return p;
 }
 

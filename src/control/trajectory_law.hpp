@@ -73,8 +73,13 @@ struct TrajectoryConfig {
   double max_retries = 3.0;           // approaches again at most this often (a whole number 0..10)
   double approach_settle_s = 0.15;    // from the cut to judging the stop, s
   // Where its back-off legs may go, V: the sensor's span unless the appliance narrows it to the
-  // loop's setpoint range (runtime/tuning.hpp, with_travel_range). Not a tuning parameter.
+  // loop's setpoint range (runtime/tuning.hpp, with_loop_limits). Not a tuning parameter.
   double travel_min_v = 0.0, travel_max_v = 10.0;
+  // Where the loop calls the piston in position, V (0: nowhere). The fallback's arrival (below)
+  // accepts a stop within 3/4 of it: a law that guesses its coast would otherwise back off 50 mm
+  // and approach again, up to max_retries times, from stops the status already called in position.
+  // Set by the appliance like the travel range. Not a tuning parameter.
+  double in_position_window_v = 0.0;
 };
 
 // Validated parameters with everything precomputed for the loop.
@@ -93,13 +98,18 @@ struct TrajectoryParams {
   bool sliding_approach = false;  // coast_s > 0
   ApproachLimits approach;
   // The sliding arrival a law without it falls back to once it hunts (trajectory_fall_back_to_sliding),
-  // with a first guess of the coast that its stops then correct.
+  // with a first guess of the coast that its stops then correct, and its stops judged against the
+  // in-position window (kFallbackRetryShareOfWindow of it) when that is wider than retry_band_v.
   ApproachLimits fallback_approach;
 };
 
 // The coast a hunting axis's fallback starts from, s: the physics plant's is 23-24 ms at mid-stroke
 // (plant/stick_slip_model.hpp, coast_time_s); its first stops correct the guess.
 inline constexpr double kFallbackCoastS = 0.02;
+// The share of the in-position window within which the fallback accepts a stop: the margin is for
+// the sensor noise and the creep after the judgement (commissioning gives its sets 3/4 of the
+// e_ss limit for the same reason).
+inline constexpr double kFallbackRetryShareOfWindow = 0.75;
 
 struct TrajectoryState {
   MotionProfileState profile;

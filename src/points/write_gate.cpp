@@ -487,7 +487,7 @@ HealthReport WriteGate::health_report(bool with_trend) const {
 GateResult WriteGate::replace_tuning(const control::ControllerConfig& replacement, const Requester& who, const core::AuditEntry& entry) {
   if (!who.may_write) return refuse(Refusal::kForbidden, who.no_write_reason);
   if (!who.tuning_unlocked) return refuse(Refusal::kForbidden, "a tuning set is tuning: unlock the tuning first");
-  const control::ControllerConfig tuning = runtime::with_travel_range(replacement, loop_rules_);
+  const control::ControllerConfig tuning = runtime::with_loop_limits(replacement, loop_rules_);
   auto t = runtime::make_tuning(tuning);
   if (!t) return refuse(Refusal::kInvalidValue, "the tuning set would not validate: " + t.error().message);
   std::lock_guard lock(mutex_);

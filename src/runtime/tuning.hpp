@@ -42,12 +42,14 @@ inline core::Result<Tuning> make_tuning(control::ControllerConfig base) {
   return t;
 }
 
-// `config` with pp-traj's back-off legs kept within the loop's setpoint range (control/
-// sliding_approach.hpp): a position the loop accepts as a target is one it may pass through.
+// `config` with what pp-traj takes from the loop's rules: its back-off legs kept within the loop's
+// setpoint range (control/sliding_approach.hpp: a position the loop accepts as a target is one it
+// may pass through), and the in-position window its hunting fallback judges its stops against.
 // Every tuning the appliance gives the loop goes through here (the first and each replacement).
-inline control::ControllerConfig with_travel_range(control::ControllerConfig config, const RuntimeConfig& rules) {
+inline control::ControllerConfig with_loop_limits(control::ControllerConfig config, const RuntimeConfig& rules) {
   config.trajectory.travel_min_v = rules.setpoint_min_mm / rules.mm_per_volt;
   config.trajectory.travel_max_v = rules.setpoint_max_mm / rules.mm_per_volt;
+  config.trajectory.in_position_window_v = rules.in_position_window_mm / rules.mm_per_volt;
   return config;
 }
 

@@ -13,6 +13,7 @@
 #include "hal/sim_daq.hpp"
 #include "plant/plant_adapter.hpp"
 #include "runtime/recorder.hpp"
+#include "runtime/tuning.hpp"
 #include "sim/closed_loop.hpp"
 #include "../support/physics_identified_model.hpp"
 #include "../support/pp_traj_on_model.hpp"
@@ -345,6 +346,26 @@ TEST(ScanCycle, AHuntingPpTrajArrivesWhileSlidingInsteadAndEndsInPosition) {
   EXPECT_NEAR(end.position_mm, 100.0, config.in_position_window_mm);
   EXPECT_EQ(end.valve_v, 0.0);
   EXPECT_TRUE(end.axis.in_position);
+}
+
+// What pp-traj takes from the loop's rules: its back-off legs within the setpoint range, and the
+// in-position window its hunting fallback judges stops against (3/4 of it, when wider than the
+// set's own retry band); the set's own band still judges the arrival of a law with a coast.
+TEST(LoopLimits, PpTrajTakesTheSetpointRangeAndTheInPositionWindowFromTheLoop) {
+  RuntimeConfig rules;
+  rules.setpoint_min_mm = 20.0, rules.setpoint_max_mm = 480.0, rules.in_position_window_mm = 1.0;
+  const auto c = with_loop_limits(control::paper_controller_config(ControllerKind::kPpTraj), rules);
+  EXPECT_DOUBLE_EQ(c.trajectory.travel_min_v, 20.0 / rules.mm_per_volt);
+  EXPECT_DOUBLE_EQ(c.trajectory.travel_max_v, 480.0 / rules.mm_per_volt);
+  EXPECT_DOUBLE_EQ(c.trajectory.in_position_window_v, 1.0 / rules.mm_per_volt);
+  const auto p = control::ControllerParams::make(c);
+  ASSERT_TRUE(p.has_value()) << p.error().message;
+  EXPECT_DOUBLE_EQ(p->trajectory().fallback_approach.retry_band_v, 0.75 / rules.mm_per_volt);
+  EXPECT_DOUBLE_EQ(p->trajectory().approach.retry_band_v, c.trajectory.retry_band_v);
+  rules.in_position_window_mm = 0.2;  // narrower than the set's band (0.3 mm): the set's band
+  const auto narrow = control::ControllerParams::make(with_loop_limits(control::paper_controller_config(ControllerKind::kPpTraj), rules));
+  ASSERT_TRUE(narrow.has_value());
+  EXPECT_DOUBLE_EQ(narrow->trajectory().fallback_approach.retry_band_v, c.trajectory.retry_band_v);
 }
 
 // A position record's side of approach, on an axis whose model says stick-slip (pp-traj arrives

@@ -236,5 +236,47 @@ TEST(PpTrajSliding, TheSameLawWithoutTheCoastHuntsThenFallsBackToArrivingWhileSl
   }
 }
 
+
+// The shipped law (pp-traj on the paper's model, no stick-slip model) on a rig with stiction whose
+// valve is not the default's (the commissioning test's: orifices x0.8, overlap +0.2 V), commanded
+// like an HMI, one law over ten moves of 25-200 mm held 5 s each. It hunts on its first move and
+// falls back to arriving while sliding; from then on a stop within the in-position window is kept.
+// With the fallback judging its stops at the set's 0.3 mm instead, a stop 0.78 mm short backed off
+// 50 mm and approached again three times, and the HMI read a move 49.7 mm from its target at 5 s.
+TEST(PpTrajSliding, TheHuntingFallbackKeepsAStopWithinTheInPositionWindow) {
+  plant::PneumaticParams rig;
+  rig.orifice_area_mm2 = 3.2, rig.overlap_pos_v = 1.4, rig.overlap_neg_v = -1.5;
+  constexpr double kWindowMm = 1.0;
+  auto config = control::paper_controller_config(control::ControllerKind::kPpTraj);
+  config.trajectory.in_position_window_v = kWindowMm / 50.0;
+  const auto params = control::ControllerParams::make(config);
+  ASSERT_TRUE(params.has_value()) << params.error().message;
+  auto plant = plant::make_pneumatic_simulator(rig, {.initial_position_mm = 250.0});
+  ASSERT_TRUE(plant.has_value());
+  control::ControllerState state;
+  for (const double target_mm : {225.0, 275.0, 175.0, 275.0, 125.0, 325.0, 250.0, 50.0, 250.0, 450.0}) {
+    const bool fallen_back = state.trajectory.sliding_fallback;  // from the move's start
+    bool kept = false;  // the piston has stood within the window (10 samples alike)
+    double y_mm = 0.0, last_mm = NAN, worst_after_kept_mm = 0.0;
+    int still = 0;
+    for (int k = 0; k < 1000; ++k) {  // 5 s
+      y_mm = (*plant)->measured_v() * 50.0;
+      still = std::abs(y_mm - last_mm) < 0.05 ? still + 1 : 0;
+      last_mm = y_mm;
+      kept = kept || (still >= 10 && std::abs(y_mm - target_mm) <= kWindowMm);
+      if (kept) worst_after_kept_mm = std::max(worst_after_kept_mm, std::abs(y_mm - target_mm));
+      const auto out = control::controller_step(*params, state, target_mm / 50.0, (*plant)->measured_v());
+      ASSERT_FALSE(out.fault);
+      (*plant)->step(out.valve_v);
+    }
+    y_mm = (*plant)->measured_v() * 50.0;
+    EXPECT_LE(std::abs(y_mm - target_mm), kWindowMm) << "move to " << target_mm << " mm ends at " << y_mm << " mm";
+    if (fallen_back) {
+      EXPECT_LE(worst_after_kept_mm, kWindowMm) << "move to " << target_mm << " mm: left the window after standing in it";
+    }
+  }
+  EXPECT_TRUE(state.trajectory.sliding_fallback) << "it was expected to hunt on the first move and fall back";
+}
+
 }  // namespace
 }  // namespace epa::sim
