@@ -77,7 +77,7 @@ struct TrajectoryConfig {
   double travel_min_v = 0.0, travel_max_v = 10.0;
   // Where the loop calls the piston in position, V (0: nowhere). The fallback's arrival (below)
   // accepts a stop within 3/4 of it: a law that guesses its coast would otherwise back off 50 mm
-  // and approach again, up to max_retries times, from stops the status already called in position.
+  // and approach again, up to max_retries times, from stops already within the window.
   // Set by the appliance like the travel range. Not a tuning parameter.
   double in_position_window_v = 0.0;
 };
