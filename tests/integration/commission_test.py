@@ -10,7 +10,9 @@ Checks, each printed with its figures:
   * deployed: `epa commission` with pp-traj and the default limits (1 mm, 5 %) exits 0 with verdict
     "deployed", the new set is the running and the stored active set; then moves of 25-200 mm in
     both directions, commanded over HTTP like an HMI would, end within 1 mm with overshoot <= 5 %,
-    and closer to their targets on average than the paper's tuning did on the same rig before;
+    and with less overshoot than the paper's tuning (the shipped one, whose model knows no
+    stick-slip: its first move hunts before it falls back to arriving while sliding) on the same
+    rig before;
   * a verification limit the axis cannot meet (e_ss <= 0.02 mm with NG-IDZ), commissioned on a
     second rig and appliance alongside the first: exit 2, verdict "rolled-back" before the axis
     moves with it (the simulation on the identified stick-slip model already ends 0.5-1 mm off)
@@ -293,10 +295,12 @@ def run_once(epa, src):
                       f"(spec: {limits['ess_mm']} mm), overshoot {overshoot:.1f} % = {overshoot_mm:.2f} mm "
                       f"(spec: {limits['overshoot_pct']} % or {limits['overshoot_mm']} mm)")
             print(f"      after commissioning (rig-1): {summary(deployed_moves)}")
-            mean_error = lambda moves: sum(abs(final - target) for _, target, final, _ in moves) / len(moves)
-            check(mean_error(deployed_moves) < mean_error(paper_moves),
-                  f"closer than the paper's tuning on the same rig: mean |error| {mean_error(deployed_moves):.2f} mm "
-                  f"against {mean_error(paper_moves):.2f} mm")
+            # Both end within the window now (the shipped law's fallback keeps a stop inside it);
+            # what commissioning adds is the stick-slip model, so no move hunts.
+            most_overshoot = lambda moves: max(overshoot for _, _, _, overshoot in moves)
+            check(most_overshoot(deployed_moves) < most_overshoot(paper_moves),
+                  f"less overshoot than the paper's tuning on the same rig: up to {most_overshoot(deployed_moves):.1f} % "
+                  f"against {most_overshoot(paper_moves):.1f} %")
 
         roll_back_thread.join(timeout=700)
         if roll_back_error or not roll_back:
