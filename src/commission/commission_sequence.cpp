@@ -68,6 +68,17 @@ IdentifiedModel keep_cross_validated(std::vector<IdentifiedModel> candidates) {
   return kept;
 }
 
+// Why the cross-validation's splits say the runs are not one experiment on one axis (empty: they
+// are): a split failed while another gave a model, or a split's model follows its own estimation
+// runs below kDescribedRunsFitPct.
+std::string runs_not_described(bool a_split_failed, double lowest_estimation_fit_pct) {
+  if (a_split_failed) return "a split of the cross-validation could not be identified";
+  if (lowest_estimation_fit_pct < kDescribedRunsFitPct)
+    return fmt::format("a split's model follows the runs it was estimated on at {:.1f} % (below {:.0f} %)", lowest_estimation_fit_pct,
+                       kDescribedRunsFitPct);
+  return {};
+}
+
 // The identified models as a model file would hold them (epa identify's --out).
 core::ModelFile identified_model_file(const IdentifiedModel& identified) {
   return {.model = identified.model, .source = "identified by epa commission", .stick_slip = identified.stick_slip,
@@ -165,12 +176,15 @@ CommissionOutcome CommissionSequence::run(const CommissionSpec& spec_in) {
   if (!excite_the_axis(spec, spec.seed, out)) return out;
   auto identified = identify_cross_validated(previous->model.model.Ts, out);
   if (!identified) return out;
-  identified = identify_once_more_if_undescribed(spec, previous->model.model.Ts, std::move(*identified), out);
-  if (!identified) return out;
-  auto set = design_tuning_set(*identified, previous->set, spec, out);
+  if (!identified->runs_not_described.empty()) {
+    identified = identify_once_more(spec, previous->model.model.Ts, identified->runs_not_described, out);
+    if (!identified) return out;
+  }
+  const IdentifiedModel& model = identified->kept;
+  auto set = design_tuning_set(model, previous->set, spec, out);
   if (!set) return out;
-  if (!verify_by_simulation(*set, *identified, spec, out)) return out;
-  const auto set_id = save_and_run(*set, *identified, out);
+  if (!verify_by_simulation(*set, model, spec, out)) return out;
+  const auto set_id = save_and_run(*set, model, out);
   if (!set_id) return out;
   if (!verify_on_the_axis(spec, out)) return out;
   return keep(*set_id, set->name, out);
@@ -212,12 +226,13 @@ bool CommissionSequence::excite_the_axis(const CommissionSpec& spec, std::uint64
 // describes the axis). One short run can leave the search in a model that fits it and nothing
 // else (held-out fits of 24 % and 88 % were seen on the same rig); trying each split costs
 // seconds of computation, not another experiment.
-std::optional<IdentifiedModel> CommissionSequence::identify_cross_validated(double loop_period_s, CommissionOutcome& out) {
+std::optional<CommissionSequence::CrossValidated> CommissionSequence::identify_cross_validated(double loop_period_s,
+                                                                                            CommissionOutcome& out) {
   step(Stage::kIdentifying, percent_done(), "identifying the Hammerstein model", out);
   std::vector<IdentifiedModel> candidates;
   std::string first_error;
-  lowest_estimation_fit_pct_ = 100.0;
-  a_split_failed_ = false;
+  double lowest_estimation_fit_pct = 100.0;
+  bool a_split_failed = false;
   for (std::size_t held = out.experiment.size(); held-- > 0;) {
     std::vector<core::Run> estimation;
     for (std::size_t i = 0; i < out.experiment.size(); ++i)
@@ -228,11 +243,11 @@ std::optional<IdentifiedModel> CommissionSequence::identify_cross_validated(doub
     if (!candidate) {
       out.log.push_back("identification, " + which + candidate.error().message);
       if (first_error.empty()) first_error = which + candidate.error().message;
-      a_split_failed_ = true;
+      a_split_failed = true;
       continue;
     }
     candidate->held_out_run = held;
-    lowest_estimation_fit_pct_ = std::min(lowest_estimation_fit_pct_, candidate->estimation_fit_pct);
+    lowest_estimation_fit_pct = std::min(lowest_estimation_fit_pct, candidate->estimation_fit_pct);
     out.log.push_back("identified, " + which + candidate->summary);
     if (log_) log_("commission: identified, " + which + candidate->summary);
     candidates.push_back(std::move(*candidate));
@@ -243,23 +258,18 @@ std::optional<IdentifiedModel> CommissionSequence::identify_cross_validated(doub
   out.identified = identified;
   out.log.push_back("identified: " + identified.summary);
   if (log_) log_("commission: identified: " + identified.summary);
-  return identified;
+  return CrossValidated{std::move(identified), runs_not_described(a_split_failed, lowest_estimation_fit_pct)};
 }
 
-// 2b. An experiment the models cannot follow (a split failed while another gave a model, or a
-// split's model follows its own estimation runs below kDescribedRunsFitPct) is set aside and run once more with the next seeds,
-// and the model is identified on the new runs alone: a disturbed run spoils every split it is in,
-// held out or estimating. The second experiment is kept whatever it gives; its model still has to
-// pass the simulated and the measured verification.
-std::optional<IdentifiedModel> CommissionSequence::identify_once_more_if_undescribed(const CommissionSpec& spec, double loop_period_s,
-                                                                                   IdentifiedModel identified, CommissionOutcome& out) {
-  if (!a_split_failed_ && lowest_estimation_fit_pct_ >= kDescribedRunsFitPct) return identified;
-  out.repeated_experiment =
-      a_split_failed_ ? "a split of the cross-validation could not be identified"
-                      : fmt::format("a split's model follows the runs it was estimated on at {:.1f} % (below {:.0f} %)",
-                                    lowest_estimation_fit_pct_, kDescribedRunsFitPct);
-  out.log.push_back("the experiment is run once more: " + out.repeated_experiment);
-  if (log_) log_("commission: the experiment is run once more: " + out.repeated_experiment);
+// 2b. An experiment whose runs are not described (runs_not_described) is set aside and run once
+// more with the next seeds, and the model is identified on the new runs alone: a disturbed run
+// spoils every split it is in, held out or estimating. The second experiment is kept whatever it
+// gives; its model still has to pass the simulated and the measured verification.
+std::optional<CommissionSequence::CrossValidated> CommissionSequence::identify_once_more(const CommissionSpec& spec, double loop_period_s,
+                                                                                      std::string why, CommissionOutcome& out) {
+  out.repeated_experiment = why;
+  out.log.push_back("the experiment is run once more: " + why);
+  if (log_) log_("commission: the experiment is run once more: " + why);
   total_s_ += spec.excitation_runs * spec.excitation_s;
   out.experiment.clear();
   const auto next_seed = spec.seed + static_cast<std::uint64_t>(spec.excitation_runs);

@@ -96,9 +96,14 @@ class CommissionSequence {
   // returns false or nothing.
   const CommissionSpec& start(CommissionOutcome& out);  // the spec as run: named, and the progress reset
   bool excite_the_axis(const CommissionSpec& spec, std::uint64_t first_seed, CommissionOutcome& out);
-  std::optional<IdentifiedModel> identify_cross_validated(double loop_period_s, CommissionOutcome& out);
-  std::optional<IdentifiedModel> identify_once_more_if_undescribed(const CommissionSpec& spec, double loop_period_s,
-                                                                   IdentifiedModel identified, CommissionOutcome& out);
+  // The model kept, and why the runs are not one experiment on one axis (empty: they are).
+  struct CrossValidated {
+    IdentifiedModel kept;
+    std::string runs_not_described;
+  };
+  std::optional<CrossValidated> identify_cross_validated(double loop_period_s, CommissionOutcome& out);
+  std::optional<CrossValidated> identify_once_more(const CommissionSpec& spec, double loop_period_s, std::string why,
+                                                   CommissionOutcome& out);
   std::optional<store::TuningSet> design_tuning_set(const IdentifiedModel& identified, const store::TuningSet& previous,
                                                     const CommissionSpec& spec, CommissionOutcome& out);
   bool verify_by_simulation(const store::TuningSet& set, const IdentifiedModel& identified, const CommissionSpec& spec,
@@ -119,10 +124,6 @@ class CommissionSequence {
   mutable std::mutex mutex_;
   Progress progress_;
   bool new_set_running_ = false;
-  // The lowest free-run fit of a split's Hammerstein model on its own estimation runs, and whether
-  // a split failed: what identify_once_more_if_undescribed judges the experiment by.
-  double lowest_estimation_fit_pct_ = 0.0;
-  bool a_split_failed_ = false;
   double total_s_ = 1.0, done_s_ = 0.0;  // the sequence's expected duration (identification weighed as seconds), and what is done
 };
 
