@@ -172,12 +172,14 @@ void ModelHealth::fit_baseline() {
   // baseline's own windows, half a window apart. A later change is named only beyond
   // spread_margin times the widest of them (and beyond the floor).
   for (const EffectKind kind : kAxisChanges) tolerance_[index_of(kind)] = floor_of(config_, kind);
+  unchanged_gap_mm_ = verdict_.baseline_gap_mm;
   const std::deque<core::Run> all = moves_;
   for (std::size_t first = 0; first + config_.window_moves <= all.size(); first += std::max<std::size_t>(1, config_.window_moves / 2)) {
     moves_.assign(all.begin() + static_cast<std::ptrdiff_t>(first), all.begin() + static_cast<std::ptrdiff_t>(first + config_.window_moves));
     const core::Run window = joined(moves_);
     const auto window_runs = anchored(window, moves_.front().size());
     const ChangeFitData window_data{baseline_, Ts_, window_runs, window_runs, scope_};
+    unchanged_gap_mm_ = std::max(unchanged_gap_mm_, from_rest_gap_mm(baseline_, Ts_, window_runs, scope_));
     for (const EffectKind kind : kAxisChanges) {
       const ChangeFit fit = fit_change(window_data, {kind});
       fits_ += fit.evaluations;
@@ -238,7 +240,9 @@ void ModelHealth::judge() {
   // This judgement's reading, then whether enough judgements in a row agree on it.
   HealthState reading = HealthState::kOk;
   std::optional<EffectKind> effect;
-  if (best && best->reduction >= config_.min_reduction) {
+  // A window no wider than the unchanged axis's own is not a drift, however well a change fits it:
+  // on an unchanged axis a single term re-fitted to a window's moves shrank its gap by up to 65 %.
+  if (best && best->reduction >= config_.min_reduction && gap_mm > unchanged_gap_mm_) {
     reading = HealthState::kDrifting;
     effect = best->effect;
   } else if (gap_mm > config_.unexplained_gap_ratio * verdict_.baseline_gap_mm) {

@@ -11,13 +11,13 @@
 // deployment are fitted jointly (every continuous term) and that fit, the baseline model, is what
 // later windows are compared with; its gap on those moves is the level an unchanged axis keeps.
 // A drift is then a change of the baseline model that shrinks a later window's gap by more than
-// min_reduction of it, lies beyond the tolerance below, and is seen in confirm_windows windows in
-// a row. A window whose gap grew beyond unexplained_gap_ratio times the baseline's with no change
+// min_reduction of it, lies beyond the tolerance below, comes in a window whose gap is wider than
+// every window of the baseline's own, and is seen in confirm_windows windows in a row. A window whose gap grew beyond unexplained_gap_ratio times the baseline's with no change
 // that explains it is unexplained.
 //
 // Pure: no threads, no clock, so that it can run on a low-priority thread beside the scan cycle
 // (appliance/health_monitor.hpp runs it so). bench/health_drift.cpp measures it on the physics
-// plant; its false alarms are still above zero there (notes/model-health.md).
+// plant (notes/model-health.md).
 #include <array>
 #include <cstddef>
 #include <deque>
@@ -119,6 +119,7 @@ class ModelHealth {
   std::size_t onset_move_ = 0;  // moves_seen at the first judgement of the candidate, less the window
   std::size_t fits_ = 0;
   std::array<double, std::size(kAxisChanges)> tolerance_{};  // per effect, in the units of its size (model_health.cpp)
+  double unchanged_gap_mm_ = 0.0;  // the widest gap of the baseline's own windows against the baseline model
 };
 
 }  // namespace epa::diag
