@@ -74,7 +74,8 @@ Axis::Axis(const config::ApplianceConfig& config, const ControlSetup& control, p
   health_ = std::make_unique<HealthMonitor>(
       config_.health, [this] { return services_.store.running_set_id(); },
       [this](std::int64_t set_id) { return monitored_model(config_.store_path, set_id); }, &services_.audit,
-      [](bool warning, const std::string& line) { warning ? spdlog::warn("{}", line) : spdlog::info("{}", line); });
+      [](bool warning, const std::string& line) { warning ? spdlog::warn("{}", line) : spdlog::info("{}", line); },
+      [this](const std::string& text) { note_health_warning(text); });
   gate_.attach_health(health_.get());
 }
 
@@ -117,6 +118,22 @@ void Axis::stop() {
   if (recorder_) recorder_->stop();    // writes what is pending
   gate_.attach_health(nullptr);
   health_.reset();                     // moves still queued are not judged
+}
+
+// A model-health warning's start, change or end, in the fault history beside the faults (its code
+// says it is none): where the loop stood when the verdict changed, the valve and sensor unknown.
+void Axis::note_health_warning(const std::string& text) {
+  const runtime::Snapshot snap = channels_.snapshot.read();
+  runtime::FaultRecord f;
+  f.time_ms = core::unix_time_ms();
+  f.code = runtime::FaultCode::kModelHealth;
+  f.mode = snap.mode;
+  f.position_mm = snap.position_mm;
+  f.setpoint_mm = snap.setpoint_mm;
+  f.name = std::string(runtime::to_string(f.code));
+  f.text = text;
+  services_.store.record_fault(f);
+  channels_.fault_history.add(std::move(f));
 }
 
 // From the loop's events, never from the snapshot (a reset in the next cycle has cleared the

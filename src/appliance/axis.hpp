@@ -57,6 +57,8 @@ class Axis {
 
   // Each fault the loop latched, logged, added to the history and handed to the store.
   void take_fault_events();
+  // A model-health warning's start, change or end (HealthMonitor's history note), in the history and the store.
+  void note_health_warning(const std::string& text);
 
   runtime::LoopChannels& channels() { return channels_; }
   points::WriteGate& gate() { return gate_; }

@@ -80,8 +80,14 @@ points::HealthEffectCode health_effect_code(plant::EffectKind effect) {
   }
 }
 
-HealthMonitor::HealthMonitor(config::HealthSettings config, RunningSetId running_set, ModelOf model_of, core::AuditSink* audit, Log log)
-    : config_(std::move(config)), running_set_(std::move(running_set)), model_of_(std::move(model_of)), audit_(audit), log_(std::move(log)) {
+HealthMonitor::HealthMonitor(config::HealthSettings config, RunningSetId running_set, ModelOf model_of, core::AuditSink* audit, Log log,
+                             HistoryNote history)
+    : config_(std::move(config)),
+      running_set_(std::move(running_set)),
+      model_of_(std::move(model_of)),
+      audit_(audit),
+      log_(std::move(log)),
+      history_(std::move(history)) {
   if (!config_.enabled) {
     current_.reason = "the model-health monitor is switched off ([health] enabled = false)";
     put(current_);
@@ -216,6 +222,7 @@ void HealthMonitor::set_off(const std::string& reason, const std::string& source
   current_.reason = reason;
   put(current_);
   if (!same_reason) log_(false, "model health: off: " + reason);
+  if (history_ && points::health_warns(before)) history_("model health: " + std::string(points::to_string(before)) + " -> off: " + reason);
   if (audit_ && before != HealthStateCode::kOff)
     audit_->record({{core::unix_time_ms(), source, std::string(points::name(points::PointId::kHealthState)), double(static_cast<int>(before)),
                      double(static_cast<int>(HealthStateCode::kOff))}});
@@ -256,9 +263,11 @@ void HealthMonitor::publish(const std::string& source, bool always_audit) {
   const points::HealthReport& now = current_;
   if (before == now.view.state && effect_before == now.view.effect && !always_audit) return;
   const bool warns = points::health_warns(now.view.state);
-  log_(warns, "model health: " + std::string(points::to_string(before)) + " -> " + std::string(points::to_string(now.view.state)) +
-                  (now.size.empty() ? "" : " (" + now.size + ", " + std::to_string(now.view.moves_since_onset) + " moves since its onset)") +
-                  " after " + std::to_string(now.view.moves_seen) + " moves");
+  const std::string line = "model health: " + std::string(points::to_string(before)) + " -> " + std::string(points::to_string(now.view.state)) +
+                           (now.size.empty() ? "" : " (" + now.size + ", " + std::to_string(now.view.moves_since_onset) + " moves since its onset)") +
+                           " after " + std::to_string(now.view.moves_seen) + " moves";
+  log_(warns, line);
+  if (history_ && (warns || points::health_warns(before))) history_(line);
   if (audit_)
     audit_->record({{core::unix_time_ms(), source + (now.size.empty() ? "" : ": " + now.size),
                      std::string(points::name(points::PointId::kHealthState)), double(static_cast<int>(before)),

@@ -3,7 +3,8 @@
 // its own at the lowest priority (nice 19: the loop, the interfaces and the store come first),
 // against the running tuning set's stick-slip model by diag::ModelHealth. Its verdict is what the
 // health points, /api/status, /metrics and the page show; each change of state goes to the audit
-// trail and the log. It never commands the axis: a drift warns, it does not fault.
+// trail and the log, and each warning's start, change and end to the fault history. It never
+// commands the axis: a drift warns, it does not fault.
 //
 // The model follows the running set: when another set runs (commissioning deployed one, or rolled
 // back), the monitor starts learning again on that set's model. A set whose model has no
@@ -42,13 +43,16 @@ struct MonitoredModel {
 class HealthMonitor final : public points::HealthControl {
  public:
   using Log = std::function<void(bool warning, const std::string& line)>;
+  // An entry for the fault history: a warning began, changed or ended (never a fault: the axis runs on).
+  using HistoryNote = std::function<void(const std::string& text)>;
   // The running set's id (cheap: asked for every move) and its model (read when the id changes).
   // Both are called on the monitor's thread.
   using RunningSetId = std::function<std::int64_t()>;
   using ModelOf = std::function<core::Result<MonitoredModel>(std::int64_t set_id)>;
 
-  // `audit` may be null. Starts its thread (unless disabled).
-  HealthMonitor(config::HealthSettings config, RunningSetId running_set, ModelOf model_of, core::AuditSink* audit, Log log);
+  // `audit` and `history` may be null. Starts its thread (unless disabled).
+  HealthMonitor(config::HealthSettings config, RunningSetId running_set, ModelOf model_of, core::AuditSink* audit, Log log,
+                HistoryNote history = nullptr);
   ~HealthMonitor() override;  // stops the thread; moves still queued are not judged
   HealthMonitor(const HealthMonitor&) = delete;
   HealthMonitor& operator=(const HealthMonitor&) = delete;
@@ -87,6 +91,7 @@ class HealthMonitor final : public points::HealthControl {
   ModelOf model_of_;
   core::AuditSink* audit_;
   Log log_;
+  HistoryNote history_;
 
   // Hands the report over: readers copy a pointer, never wait for a judgement.
   void put(points::HealthReport report);

@@ -132,7 +132,8 @@ std::vector<PointDef> build() {
                              "(3 fault: read only; leave it with reset)", A::kWrite, 0, 4, true, true,
        [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.mode)); }},
       {P::kFaultCode, "fault_code", "", "latched fault: 0 none, 1 sensor not finite, 2 sensor out of range, 3 soft limit, 4 I/O errors, "
-                                        "5 overruns, 6 following error, 7 heartbeat lost, 8 controller fault, 9 store damaged, 10 sensor frozen",
+                                        "5 overruns, 6 following error, 7 heartbeat lost, 8 controller fault, 9 store damaged, 10 sensor frozen "
+                                        "(11 model health: in the fault history only, a warning's start, change or end)",
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(static_cast<int>(c.snapshot.fault)); }},
       {P::kFaultActive, "fault_active", "", "1 while a fault is latched", A::kRead, 0, 0, true, true,
        [](const Ctx& c, int) { return b(c.snapshot.mode == runtime::Mode::kFault); }},

@@ -28,6 +28,7 @@ std::string_view to_string(FaultCode code) {
     case FaultCode::kControllerFault: return "controller-fault";
     case FaultCode::kStoreDamaged: return "store-damaged";
     case FaultCode::kSensorFrozen: return "sensor-frozen";
+    case FaultCode::kModelHealth: return "model-health";
   }
   return "?";
 }
@@ -45,6 +46,8 @@ std::string_view describe(FaultCode code) {
     case FaultCode::kControllerFault: return "the control law produced a non-finite command";
     case FaultCode::kSensorFrozen:
       return "the position reading stopped changing while the valve was driving the piston: a frozen sensor or a stuck input";
+    case FaultCode::kModelHealth:
+      return "the model-health monitor's warning began, changed or ended; a warning, not a fault: the axis ran on";
     case FaultCode::kStoreDamaged:
       return "the tuning database was damaged: it was moved aside and the appliance started from the seeded defaults; check the tuning, then reset";
   }

@@ -28,6 +28,7 @@ enum class FaultCode : std::uint8_t {
   kControllerFault = 8,   // the control law reported a non-finite result
   kStoreDamaged = 9,      // the tuning database was damaged: moved aside, started from defaults
   kSensorFrozen = 10,     // the reading stopped changing while the valve drove the piston
+  kModelHealth = 11,      // not a fault: a model-health warning began, changed or ended (the fault history only; never latched)
 };
 
 std::string_view to_string(Mode mode);

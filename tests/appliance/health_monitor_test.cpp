@@ -59,7 +59,11 @@ struct Rig {
               ++model_reads;
               return MonitoredModel{"set " + std::to_string(id), with_stick_slip ? model.stick_slip : std::nullopt, model.model.Ts};
             },
-            &audit, [](bool, const std::string&) {}) {}
+            &audit, [](bool, const std::string&) {},
+            [this](const std::string& text) {
+              std::lock_guard lock(history_mutex);
+              history.push_back(text);
+            }) {}
 
   // `n` moves of the axis, each judged before the next is added.
   void moves(testing::StickSlipAxis& axis, int n) {
@@ -76,7 +80,14 @@ struct Rig {
     return out;
   }
 
+  std::vector<std::string> history_notes() const {
+    std::lock_guard lock(history_mutex);
+    return history;
+  }
+
   core::ModelFile model;
+  mutable std::mutex history_mutex;
+  std::vector<std::string> history;  // what the monitor gave the fault history
   std::atomic<std::int64_t> set_id{1};
   std::atomic<int> model_reads{0};
   RecordingAudit audit;
@@ -175,6 +186,17 @@ TEST(HealthMonitor, FrictionDoubledIsPublishedAuditedAndWarns) {
   EXPECT_EQ(changes[1], std::make_pair(int(HealthStateCode::kLearning), int(HealthStateCode::kOk)));
   EXPECT_EQ(changes.back(), std::make_pair(int(HealthStateCode::kOk), int(HealthStateCode::kDrifting)));
   EXPECT_NE(rig.audit.entries().back().source.find("friction"), std::string::npos) << rig.audit.entries().back().source;
+
+  // The fault history gets the warning, not the learning before it; and its end.
+  auto notes = rig.history_notes();
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("ok -> drifting"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[0].find("friction"), std::string::npos) << notes[0];
+  rig.monitor.retake_baseline("web 127.0.0.1:4000");
+  ASSERT_TRUE(rig.monitor.wait_idle(5000));
+  notes = rig.history_notes();
+  ASSERT_EQ(notes.size(), 2u);
+  EXPECT_NE(notes[1].find("drifting -> learning"), std::string::npos) << notes[1];
 }
 
 TEST(HealthMonitor, ARetakenBaselineAndAnotherRunningSetStartLearningAgain) {
