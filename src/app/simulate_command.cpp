@@ -22,6 +22,7 @@
 #include "report/response_plot.hpp"
 #include "report/simulation_case.hpp"
 #include "report/table1_report.hpp"
+#include "runtime/tuning.hpp"
 #include "store/trajectory_settings.hpp"
 #include "store/tuning_set.hpp"
 #include "sim/model_perturbation.hpp"
@@ -119,14 +120,18 @@ core::Result<PlantMaker> plant_maker(const SimulateOptions& o, const core::Model
 }
 
 // The controller of `kind` with the polynomials, the model's dead zone and --lc, as a tuning set
-// would make it.
+// would make it, and with what the appliance's loop gives it under the default [motion] settings
+// (pp-traj: its back-offs within the setpoint range 0-500 mm, its stops judged against the 1 mm
+// in-position window), so that a simulated move ends as the appliance's would.
 core::Result<control::ControllerParams> controller_params(control::ControllerKind kind, const SimulateOptions& o,
                                                           const appliance::ControllerPolynomials& polynomials,
                                                           const store::TrajectorySettings& trajectory, const core::HammersteinModel& model) {
   store::TuningSet set;
   set.controller = kind, set.F = polynomials.F, set.G = polynomials.G, set.H = polynomials.H;
   set.dead_zone = model.dead_zone, set.lc_mm = o.lc_mm, set.valve_limit_v = core::paper::kValveLimitV, set.trajectory = trajectory;
-  return control::ControllerParams::make(store::controller_config(set, model, 0.0));
+  runtime::RuntimeConfig loop;
+  loop.mm_per_volt = model.mm_per_volt;
+  return control::ControllerParams::make(runtime::with_loop_limits(store::controller_config(set, model, 0.0), loop));
 }
 
 // Every controller on every step, each on a fresh plant.

@@ -50,6 +50,7 @@ void start_leg(const ApproachLimits& l, ApproachState& s, double target_v, doubl
   s.leg_coast_s = std::max(0.0, coast_at_s(l, target_v) + s.learned_offset_s[direction_index(s.final_direction)]);
   const double sliding = direction * reading_slope(s, l.Ts);
   s.path_speed_v_s = sliding >= 0.5 * l.speed_v_s ? sliding : 0.0;
+  s.whole_approach = final_leg && (direction * (target_v - from_v) >= l.length_v - l.retry_band_v || s.path_speed_v_s > 0.0);
   s.samples_in_phase = 0;
 }
 
@@ -149,7 +150,8 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
     }
     if (!s.final_leg) {
       start_leg(l, s, s.planned_r_v, s.final_direction, true, y_mean);
-    } else if (std::abs(error) <= l.retry_band_v || s.retries >= l.max_retries) {
+    } else if (std::abs(error) <= (s.whole_approach ? l.retry_band_v : std::max(l.retry_band_v, l.short_approach_band_v)) ||
+               s.retries >= l.max_retries) {
       hold(s, y_mean);
     } else {
       ++s.retries;

@@ -16,7 +16,9 @@
 //            before, the drive is scaled to the share of the sample still to go, so the stop is
 //            not quantised to the v Ts the piston covers per sample (+-0.3 mm at 120 mm/s)
 //   judge    settle_samples later, the mean of the last 4 readings against the target: within
-//            retry_band_v, hold; else back off length_v and approach again (at most max_retries)
+//            retry_band_v, hold; else back off length_v and approach again (at most max_retries).
+//            A short approach (see short) is judged within short_approach_band_v when that is
+//            wider: its retry would be as short, and no surer
 //   where    the coast depends on where along the stroke the piston stops: the air spring that
 //            brakes it stiffens near an end (coast_at_s below)
 //   learn    every stop after a steady slide corrects the coast of its direction by its error /
@@ -51,6 +53,10 @@ struct ApproachLimits {
   double top_speed_pos_v_s = 10.0, top_speed_neg_v_s = 10.0;  // the leg's cruise speed each way
   double accel_v_s2 = 100.0;     // speeding up
   double retry_band_v = 0.006;   // judged within this, V
+  // A stop after a short approach (less than length_v of steady slide: from rest near a travel end)
+  // is judged within this when it is wider than retry_band_v, V: the next approach would be as short,
+  // and scatters as much (0: no such allowance).
+  double short_approach_band_v = 0.0;
   int max_retries = 3;
   std::size_t settle_samples = 30;  // from the cut to the judgement
   double Ts = 0.005;
@@ -67,6 +73,7 @@ struct ApproachState {
   double final_direction = 1.0;  // the move's approach direction
   double next_direction = 0.0;   // +1 / -1: the next plan approaches this way (a move's side kept), 0: from where the piston is
   bool final_leg = false;
+  bool whole_approach = false;  // this final leg slides steadily for length_v (or began sliding towards the target)
   int retries = 0;
   double path_v = 0.0, path_speed_v_s = 0.0;  // the leg's reference and its speed (>= 0, along leg_direction)
   double leg_coast_s = 0.0;       // the coast this leg's cut assumes: at its target, plus the move's direction's offset

@@ -143,9 +143,10 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   p.approach.Ts = Ts;
   p.approach.travel_min_v = c.travel_min_v;
   p.approach.travel_max_v = c.travel_max_v;
+  p.approach.short_approach_band_v = kStopShareOfWindow * c.in_position_window_v;
   p.fallback_approach = p.approach;
   p.fallback_approach.coast_s = kFallbackCoastS;
-  p.fallback_approach.retry_band_v = std::max(p.approach.retry_band_v, kFallbackRetryShareOfWindow * c.in_position_window_v);
+  p.fallback_approach.retry_band_v = std::max(p.approach.retry_band_v, kStopShareOfWindow * c.in_position_window_v);
   return p;
 }
 

@@ -77,7 +77,8 @@ struct TrajectoryConfig {
   double travel_min_v = 0.0, travel_max_v = 10.0;
   // Where the loop calls the piston in position, V (0: nowhere). The fallback's arrival (below)
   // accepts a stop within 3/4 of it: a law that guesses its coast would otherwise back off 50 mm
-  // and approach again, up to max_retries times, from stops already within the window.
+  // and approach again, up to max_retries times, from stops already within the window. So does
+  // every arrival after a short approach (near a travel end), whose retry would be as short.
   // Set by the appliance like the travel range. Not a tuning parameter.
   double in_position_window_v = 0.0;
 };
@@ -99,17 +100,17 @@ struct TrajectoryParams {
   ApproachLimits approach;
   // The sliding arrival a law without it falls back to once it hunts (trajectory_fall_back_to_sliding),
   // with a first guess of the coast that its stops then correct, and its stops judged against the
-  // in-position window (kFallbackRetryShareOfWindow of it) when that is wider than retry_band_v.
+  // in-position window (kStopShareOfWindow of it) when that is wider than retry_band_v.
   ApproachLimits fallback_approach;
 };
 
 // The coast a hunting axis's fallback starts from, s: the physics plant's is 23-24 ms at mid-stroke
 // (plant/stick_slip_model.hpp, coast_time_s); its first stops correct the guess.
 inline constexpr double kFallbackCoastS = 0.02;
-// The share of the in-position window within which the fallback accepts a stop: the margin is for
-// the sensor noise and the creep after the judgement (commissioning gives its sets 3/4 of the
-// e_ss limit for the same reason).
-inline constexpr double kFallbackRetryShareOfWindow = 0.75;
+// The share of the in-position window within which the fallback accepts every stop, and a sliding
+// arrival a stop after a short approach: the margin is for the sensor noise and the creep after the
+// judgement (commissioning gives its sets 3/4 of the e_ss limit for the same reason).
+inline constexpr double kStopShareOfWindow = 0.75;
 
 struct TrajectoryState {
   MotionProfileState profile;

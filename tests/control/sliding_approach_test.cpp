@@ -108,6 +108,26 @@ TEST(SlidingApproach, APistonBetweenTheTargetAndTheEndGoesStraightIn) {
   EXPECT_NEAR(t.y.back(), 0.4, l.retry_band_v);
 }
 
+TEST(SlidingApproach, AStopAfterAShortApproachIsJudgedAgainstTheShortApproachBand) {
+  auto l = limits();
+  l.dead_length_v = 1e6;
+  l.short_approach_band_v = 0.015;  // 3/4 of a 1 mm window
+  // The piston coasts 15 % further than the law thinks: each stop lands past the target by more
+  // than the band and less than the short approach's band.
+  ApproachState short_move;
+  const Trace t = run(l, short_move, 0.0, 0.4, 5.0, 1.15);  // 20 mm from the end: a short approach
+  const double off_v = std::abs(t.y.back() - 0.4);
+  ASSERT_GT(off_v, l.retry_band_v) << "the case does not test the band";
+  EXPECT_LE(off_v, l.short_approach_band_v);
+  EXPECT_EQ(short_move.retries, 0) << "a retry would be as short: the stop is kept";
+  EXPECT_EQ(short_move.phase, ApproachPhase::kHolding);
+
+  // A whole approach with the same error is approached again: its retry can do better.
+  ApproachState long_move;
+  run(l, long_move, 0.0, 4.0, 8.0, 1.15);
+  EXPECT_GE(long_move.retries, 1);
+}
+
 TEST(SlidingApproach, ASideAskedForIsTheSideTheNextPlanApproachesFrom) {
   const auto l = limits();
   ApproachState s;

@@ -350,7 +350,8 @@ TEST(ScanCycle, AHuntingPpTrajArrivesWhileSlidingInsteadAndEndsInPosition) {
 
 // What pp-traj takes from the loop's rules: its back-off legs within the setpoint range, and the
 // in-position window its hunting fallback judges stops against (3/4 of it, when wider than the
-// set's own retry band); the set's own band still judges the arrival of a law with a coast.
+// set's own retry band); the set's own band still judges the arrival of a law with a coast, but
+// after a short approach (near a travel end), where 3/4 of the window applies too.
 TEST(LoopLimits, PpTrajTakesTheSetpointRangeAndTheInPositionWindowFromTheLoop) {
   RuntimeConfig rules;
   rules.setpoint_min_mm = 20.0, rules.setpoint_max_mm = 480.0, rules.in_position_window_mm = 1.0;
@@ -362,6 +363,7 @@ TEST(LoopLimits, PpTrajTakesTheSetpointRangeAndTheInPositionWindowFromTheLoop) {
   ASSERT_TRUE(p.has_value()) << p.error().message;
   EXPECT_DOUBLE_EQ(p->trajectory().fallback_approach.retry_band_v, 0.75 / rules.mm_per_volt);
   EXPECT_DOUBLE_EQ(p->trajectory().approach.retry_band_v, c.trajectory.retry_band_v);
+  EXPECT_DOUBLE_EQ(p->trajectory().approach.short_approach_band_v, 0.75 / rules.mm_per_volt);
   rules.in_position_window_mm = 0.2;  // narrower than the set's band (0.3 mm): the set's band
   const auto narrow = control::ControllerParams::make(with_loop_limits(control::paper_controller_config(ControllerKind::kPpTraj), rules));
   ASSERT_TRUE(narrow.has_value());
