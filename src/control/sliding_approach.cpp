@@ -39,6 +39,17 @@ constexpr double kSensorSpanV = core::mm_to_sensor_v(core::kStrokeMm);  // the s
 // 2-10 retries in all and no move with 3, against 1-16 and 5 moves with 3 at a gain of 1.
 constexpr int kLearningMemory = 4;
 
+// Where an approach starts: one approach length before the target, or as far as the travel
+// allows when the target lies nearer than that to its end (the approach is then shorter).
+double back_off_point_v(const ApproachLimits& l, const ApproachState& s) noexcept {
+  return std::clamp(s.planned_r_v - s.final_direction * l.length_v, l.travel_min_v, l.travel_max_v);
+}
+
+// The target lies nearer than one approach length to the end of the travel it is approached from.
+bool travel_cuts_the_approach(const ApproachLimits& l, const ApproachState& s) noexcept {
+  return back_off_point_v(l, s) != s.planned_r_v - s.final_direction * l.length_v;
+}
+
 // A leg from the piston at from_v; the path starts at the piston's speed along it when the piston
 // slides that way (a setpoint changed mid-move does not first stop the piston), else from rest.
 void start_leg(const ApproachLimits& l, ApproachState& s, double target_v, double direction, bool final_leg, double from_v) noexcept {
@@ -50,14 +61,8 @@ void start_leg(const ApproachLimits& l, ApproachState& s, double target_v, doubl
   s.leg_coast_s = std::max(0.0, coast_at_s(l, target_v) + s.learned_offset_s[direction_index(s.final_direction)]);
   const double sliding = direction * reading_slope(s, l.Ts);
   s.path_speed_v_s = sliding >= 0.5 * l.speed_v_s ? sliding : 0.0;
-  s.whole_approach = final_leg && (direction * (target_v - from_v) >= l.length_v - l.retry_band_v || s.path_speed_v_s > 0.0);
+  s.short_approach = final_leg && s.path_speed_v_s == 0.0 && travel_cuts_the_approach(l, s);
   s.samples_in_phase = 0;
-}
-
-// Where an approach starts: one approach length before the target, or as far as the travel
-// allows when the target lies nearer than that to its end (the approach is then shorter).
-double back_off_point_v(const ApproachLimits& l, const ApproachState& s) noexcept {
-  return std::clamp(s.planned_r_v - s.final_direction * l.length_v, l.travel_min_v, l.travel_max_v);
 }
 
 // The back-off before an approach, from where the piston is.
@@ -150,7 +155,7 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
     }
     if (!s.final_leg) {
       start_leg(l, s, s.planned_r_v, s.final_direction, true, y_mean);
-    } else if (std::abs(error) <= (s.whole_approach ? l.retry_band_v : std::max(l.retry_band_v, l.short_approach_band_v)) ||
+    } else if (std::abs(error) <= (s.short_approach ? std::max(l.retry_band_v, l.short_approach_band_v) : l.retry_band_v) ||
                s.retries >= l.max_retries) {
       hold(s, y_mean);
     } else {

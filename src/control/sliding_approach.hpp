@@ -73,7 +73,7 @@ struct ApproachState {
   double final_direction = 1.0;  // the move's approach direction
   double next_direction = 0.0;   // +1 / -1: the next plan approaches this way (a move's side kept), 0: from where the piston is
   bool final_leg = false;
-  bool whole_approach = false;  // this final leg slides steadily for length_v (or began sliding towards the target)
+  bool short_approach = false;  // this final leg starts from rest with less than length_v to go: the travel cuts it
   int retries = 0;
   double path_v = 0.0, path_speed_v_s = 0.0;  // the leg's reference and its speed (>= 0, along leg_direction)
   double leg_coast_s = 0.0;       // the coast this leg's cut assumes: at its target, plus the move's direction's offset
