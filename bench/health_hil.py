@@ -86,6 +86,10 @@ def run_case(epa, model, points, name, moves, change_at, law, seed):
         right_way = named_after is not None and (ratio - 1.0) * direction > 0
         final = (read_point(app.client, points, "health_state"), EFFECTS.get(read_point(app.client, points, "health_effect"), ""),
                  read_point(app.client, points, "health_ratio"))
+        with urllib.request.urlopen(f"http://127.0.0.1:{app.web_port}/api/faults", timeout=5) as r:
+            history = json.load(r)
+        noted = sum(1 for f in history.get("faults", []) if f.get("name") == "model-health")
+        final = final + (noted,)
         if os.environ.get("EPA_HEALTH_TRACE"):
             with urllib.request.urlopen(f"http://127.0.0.1:{app.web_port}/api/health", timeout=5) as r:
                 health = json.load(r)
@@ -127,9 +131,10 @@ def main(argv):
                 named.append(after)
         verdict = ("not named" if after is None else f"named {CASES[name][1]} {after} moves after the change (ratio {ratio:.2f})") \
             if CASES[name][0] else "no change"
-        state, effect, final_ratio = final
+        state, effect, final_ratio, noted = final
         print(f"case {name} ({law}): {verdict}; {alarms} false alarm(s) before the change; {seen} moves judged; at the end: "
-              f"health_state {state} {effect} ratio {final_ratio:.2f}; {time.monotonic() - start:.0f} s")
+              f"health_state {state} {effect} ratio {final_ratio:.2f}; {noted} model-health entries in the fault history; "
+              f"{time.monotonic() - start:.0f} s")
     median = f"{statistics.median(named):.0f}" if named else "-"
     latest = f"{max(named)}" if named else "-"
     print(f"health hil: {len(named)} of {changes} changes named, median {median} moves after the change, latest {latest}; "

@@ -309,7 +309,7 @@ std::vector<PointDef> build() {
   const auto after_select = std::find_if(p.begin(), p.end(), [](const PointDef& d) { return d.id == P::kRecordSelect; }) + 1;
   p.insert(after_select, positioning.begin(), positioning.end());
 
-  p.push_back({P::kFaultHistoryCount, "fault_history_count", "", "faults recorded since the tuning store was created (the history keeps the newest 64)",
+  p.push_back({P::kFaultHistoryCount, "fault_history_count", "", "faults (and model-health warnings, code 11) recorded since the tuning store was created (the history keeps the newest 64)",
                A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(c.status.fault_history_count); }});
   const auto& fault_texts = fault_history_texts();
   for (std::size_t k = 0; k < fault_texts.size(); ++k) {
