@@ -12,8 +12,9 @@
 // later windows are compared with; its gap on those moves is the level an unchanged axis keeps.
 // A drift is then a change of the baseline model that shrinks a later window's gap by more than
 // min_reduction of it, lies beyond the tolerance below, comes in a window whose gap is wider than
-// every window of the baseline's own, and is seen in confirm_windows windows in a row. A window whose gap grew beyond unexplained_gap_ratio times the baseline's with no change
-// that explains it is unexplained.
+// every window of the baseline's own, and is seen in confirm_windows windows in a row. A window
+// whose gap grew beyond unexplained_gap_ratio times the baseline's with no change that explains
+// it is unexplained.
 //
 // Pure: no threads, no clock, so that it can run on a low-priority thread beside the scan cycle
 // (appliance/health_monitor.hpp runs it so). bench/health_drift.cpp measures it on the physics
