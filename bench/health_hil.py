@@ -94,6 +94,8 @@ def run_case(epa, model, points, name, moves, change_at, law, seed):
             with urllib.request.urlopen(f"http://127.0.0.1:{app.web_port}/api/health", timeout=5) as r:
                 health = json.load(r)
             print(f"  gaps: window {health['window_gap_mm']} mm, baseline {health['baseline_gap_mm']} mm; {health['reason']}")
+            for f in reversed([f for f in history.get("faults", []) if f.get("name") == "model-health"]):
+                print(f"  fault history: {f['text']}")
             for j in health["trend"][-6:]:
                 print(f"  move {j['move']}: " + ", ".join(f"{e['effect']} x{e['ratio']:.2f} ({100 * e['reduction']:.0f} %)"
                                                        for e in j["estimates"]))
