@@ -88,13 +88,13 @@ def run_case(epa, model, points, name, moves, change_at, law, seed):
                  read_point(app.client, points, "health_ratio"))
         with urllib.request.urlopen(f"http://127.0.0.1:{app.web_port}/api/faults", timeout=5) as r:
             history = json.load(r)
-        noted = sum(1 for f in history.get("faults", []) if f.get("name") == "model-health")
-        final = final + (noted,)
+        noted = [f for f in history.get("faults", []) if f.get("name") == "model-health"]  # newest first
+        final = final + (len(noted),)
         if os.environ.get("EPA_HEALTH_TRACE"):
             with urllib.request.urlopen(f"http://127.0.0.1:{app.web_port}/api/health", timeout=5) as r:
                 health = json.load(r)
             print(f"  gaps: window {health['window_gap_mm']} mm, baseline {health['baseline_gap_mm']} mm; {health['reason']}")
-            for f in reversed([f for f in history.get("faults", []) if f.get("name") == "model-health"]):
+            for f in reversed(noted):
                 print(f"  fault history: {f['text']}")
             for j in health["trend"][-6:]:
                 print(f"  move {j['move']}: " + ", ".join(f"{e['effect']} x{e['ratio']:.2f} ({100 * e['reduction']:.0f} %)"

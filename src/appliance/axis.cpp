@@ -132,8 +132,12 @@ void Axis::note_health_warning(const std::string& text) {
   f.setpoint_mm = snap.setpoint_mm;
   f.name = std::string(runtime::to_string(f.code));
   f.text = text;
-  services_.store.record_fault(f);
-  channels_.fault_history.add(std::move(f));
+  keep_in_history(std::move(f));
+}
+
+void Axis::keep_in_history(runtime::FaultRecord record) {
+  services_.store.record_fault(record);
+  channels_.fault_history.add(std::move(record));
 }
 
 // From the loop's events, never from the snapshot (a reset in the next cycle has cleared the
@@ -152,8 +156,7 @@ void Axis::take_fault_events() {
     runtime::FaultRecord f = runtime::fault_record(event, runtime::fault_time_ms(event, loop_now_s, now_ms));
     spdlog::error("FAULT {}: {} (in {}, position {:.2f} mm, setpoint {:.2f} mm, valve {:.3f} V, sensor {:.3f} V)", f.name, f.text,
                   runtime::to_string(f.mode), f.position_mm, f.setpoint_mm, f.valve_v, f.sensor_v);
-    services_.store.record_fault(f);
-    channels_.fault_history.add(std::move(f));
+    keep_in_history(std::move(f));
   }
 }
 

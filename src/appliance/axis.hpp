@@ -57,8 +57,6 @@ class Axis {
 
   // Each fault the loop latched, logged, added to the history and handed to the store.
   void take_fault_events();
-  // A model-health warning's start, change or end (HealthMonitor's history note), in the history and the store.
-  void note_health_warning(const std::string& text);
 
   runtime::LoopChannels& channels() { return channels_; }
   points::WriteGate& gate() { return gate_; }
@@ -67,6 +65,10 @@ class Axis {
 
  private:
   void stop_loop();
+  // A model-health warning's start, change or end (HealthMonitor's history note), in the history.
+  void note_health_warning(const std::string& text);
+  // An entry of the history, handed to the store and added to what the interfaces read.
+  void keep_in_history(runtime::FaultRecord record);
 
   const config::ApplianceConfig& config_;
   AxisServices services_;

@@ -146,7 +146,7 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   p.approach.short_approach_band_v = kStopShareOfWindow * c.in_position_window_v;
   p.fallback_approach = p.approach;
   p.fallback_approach.coast_s = kFallbackCoastS;
-  p.fallback_approach.retry_band_v = std::max(p.approach.retry_band_v, kStopShareOfWindow * c.in_position_window_v);
+  p.fallback_approach.retry_band_v = std::max(p.approach.retry_band_v, p.approach.short_approach_band_v);
   return p;
 }
 
