@@ -141,7 +141,7 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
   } else if (s.phase == ApproachPhase::kCoasting && s.samples_in_phase >= l.settle_samples) {
     const double y_mean = mean_reading(s);
     const double error = s.planned_r_v - y_mean;
-    if (s.final_leg && s.cut_speed_v_s >= 0.5 * l.speed_v_s && s.cut_speed_v_s <= 1.5 * l.speed_v_s) {
+    if (s.final_leg && !s.short_approach && s.cut_speed_v_s >= 0.5 * l.speed_v_s && s.cut_speed_v_s <= 1.5 * l.speed_v_s) {
       // A stop off by e after a steady slide at v asks for a coast longer by e / v, by at most the
       // model's coast per stop (a cut in a breakaway, or a loop that stalled, must not teach it a
       // coast it then keeps); the offset follows at kLearningMemory's gain, within -3/4 to 3 times it.

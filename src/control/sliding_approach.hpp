@@ -27,7 +27,8 @@
 //            through a slower I/O path it was 1-3 mm long); the correction is kept as an offset,
 //            the same at every position, as a delay the model did not see would be, and the
 //            offset is the running mean of what the stops asked for (over about the last 4), so
-//            that a retry does not chase one stop's scatter
+//            that a retry does not chase one stop's scatter. A short approach (below) teaches
+//            nothing: cut before its slide is steady, its stop says little of a steady slide's coast
 //   short    a move shorter than length_v backs off first (unless the piston already slides
 //            towards the target), so that every final approach is a steady slide, not the
 //            breakaway jump of a start from rest; near an end of [travel_min_v, travel_max_v]

@@ -128,6 +128,24 @@ TEST(SlidingApproach, AStopAfterAShortApproachIsJudgedAgainstTheShortApproachBan
   EXPECT_GE(long_move.retries, 1);
 }
 
+TEST(SlidingApproach, AStopAfterAShortApproachTeachesTheCoastNothing) {
+  auto l = limits();
+  l.dead_length_v = 1e6;
+  // From rest at the end, the slide is cut before it is steady: its stop says little of the coast
+  // of a steady slide, and learning from it set the next whole approach off by as much.
+  ApproachState s;
+  run(l, s, 0.0, 0.4, 5.0, 1.6);  // 20 mm from the end, the piston coasting 60 % further
+  ASSERT_GE(s.retries, 1) << "the case does not stop off the target";
+  EXPECT_EQ(s.learned_stops[0], 0);
+  EXPECT_EQ(s.learned_offset_s[0], 0.0);
+
+  // A whole approach with the same piston does learn.
+  ApproachState whole;
+  run(l, whole, 0.0, 4.0, 8.0, 1.6);
+  EXPECT_GE(whole.learned_stops[0], 1);
+  EXPECT_GT(whole.learned_offset_s[0], 0.0);
+}
+
 TEST(SlidingApproach, ASideAskedForIsTheSideTheNextPlanApproachesFrom) {
   const auto l = limits();
   ApproachState s;
