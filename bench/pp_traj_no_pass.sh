@@ -6,31 +6,40 @@
 # where it moved), and how far from it it ended. Prints one line per move that passed by more than
 # the in-position window (1 mm) or ended outside it, then the summary line.
 #
-#   bench/pp_traj_no_pass.sh [BUILD_DIR=build/release] [fast]
+#   bench/pp_traj_no_pass.sh [BUILD_DIR=build/release] [full|fast|ends] [FIRST_SEED=1] [NOISE_MM=0]
 #
-# fast (CI's smoke step): 10, 20 and 100 mm only.
+# fast (CI's smoke step): 10, 20 and 100 mm only. ends: 10-60 mm from 0 and 500 mm only, where a
+# move has no room for a whole approach. FIRST_SEED: the commissioning's excitation seeds (another
+# identified model of the same plant); NOISE_MM: the moves' sensor noise (its seed FIRST_SEED).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build/release}
 mode=${2:-full}
+first_seed=${3:-1}
+noise_mm=${4:-0}
 epa="$build/src/app/epa"
 [ -x "$epa" ] || { echo "pp_traj_no_pass: $epa is not built" >&2; exit 1; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 source bench/physics_axis.sh
-commission_physics_axis "$epa" "$work" pp_traj_no_pass
+commission_physics_axis "$epa" "$work" pp_traj_no_pass "$first_seed"
 
-if [ "$mode" = fast ]; then sizes="10 20 100"; else sizes=$(seq 10 5 200); fi
+case $mode in
+  fast) sizes="10 20 100" ;;
+  ends) sizes=$(seq 10 5 60) ;;
+  full) sizes=$(seq 10 5 200) ;;
+  *) echo "pp_traj_no_pass: mode must be full, fast or ends, got $mode" >&2; exit 2 ;;
+esac
 up=$(for s in $sizes; do printf '%s,' "$s"; done)
 down=$(for s in $sizes; do printf '%s,' "-$s"; done)
 moves() {  # moves START STEPS: one epa simulate run per step, run files into $work/START
   mkdir -p "$work/from$1"
   "$epa" simulate --plant physics --model "$work/physics-model.toml" --controller pp-traj --start "$1" --steps "${2%,}" --duration 8 \
-    --out-dir "$work/from$1" >"$work/from$1.log" 2>&1 || { echo "pp_traj_no_pass: epa simulate failed:" >&2; cat "$work/from$1.log" >&2; exit 1; }
+    --noise "$noise_mm" --seed "$first_seed" --out-dir "$work/from$1" >"$work/from$1.log" 2>&1 || { echo "pp_traj_no_pass: epa simulate failed:" >&2; cat "$work/from$1.log" >&2; exit 1; }
 }
 moves 0 "$up"
-moves 250 "$up$down"
+[ "$mode" = ends ] || moves 250 "$up$down"
 moves 500 "$down"
 
 python3 - "$work" <<'PY'

@@ -199,7 +199,8 @@ ApproachOutput approach_step(const ApproachLimits& l, ApproachState& s, double r
       left_v < -l.length_v ? 0.0
                            : std::min(std::max(top, l.speed_v_s),
                                       std::sqrt(l.speed_v_s * l.speed_v_s + 2.0 * l.decel_v_s2 * std::max(0.0, left_v - l.length_v)));
-  s.path_speed_v_s = scheduled > s.path_speed_v_s ? std::min(scheduled, s.path_speed_v_s + l.accel_v_s2 * l.Ts)
+  const double accel = s.short_approach && l.short_approach_accel_v_s2 > 0.0 ? l.short_approach_accel_v_s2 : l.accel_v_s2;
+  s.path_speed_v_s = scheduled > s.path_speed_v_s ? std::min(scheduled, s.path_speed_v_s + accel * l.Ts)
                                                   : std::max(scheduled, s.path_speed_v_s - l.decel_v_s2 * l.Ts);
   s.path_v += dir * s.path_speed_v_s * l.Ts;
   out.w_v = s.path_v;

@@ -33,8 +33,9 @@
 //            towards the target), so that every final approach is a steady slide, not the
 //            breakaway jump of a start from rest; near an end of [travel_min_v, travel_max_v]
 //            (the loop's setpoint range) it backs off only as far as that end, or goes straight
-//            in when the piston stands between the target and that end. An approach never comes
-//            from the target's far side: a gripper or a part may stand there
+//            in when the piston stands between the target and that end. Such a short approach
+//            speeds up at short_approach_accel_v_s2. An approach never comes from the target's
+//            far side: a gripper or a part may stand there
 //   hold     the valve stays centred until the setpoint changes or the piston is pushed more than
 //            4 retry bands from where it stopped
 //
@@ -53,6 +54,9 @@ struct ApproachLimits {
   double decel_v_s2 = 6.0;       // braking to the approach speed, V/s^2
   double top_speed_pos_v_s = 10.0, top_speed_neg_v_s = 10.0;  // the leg's cruise speed each way
   double accel_v_s2 = 100.0;     // speeding up
+  // Speeding up on a short approach (see short), V/s^2 (0: accel_v_s2): slower, so that the chambers
+  // build the breakaway's force gently and the piston does not leave the end in a burst.
+  double short_approach_accel_v_s2 = 0.0;
   double retry_band_v = 0.006;   // judged within this, V
   // A stop after a short approach (less than length_v of steady slide: from rest near a travel end)
   // is judged within this when it is wider than retry_band_v, V: the next approach would be as short,

@@ -146,6 +146,27 @@ TEST(SlidingApproach, AStopAfterAShortApproachTeachesTheCoastNothing) {
   EXPECT_GT(whole.learned_offset_s[0], 0.0);
 }
 
+// The fastest the reference runs in the first `samples` of a move from rest at y0 to r.
+double early_reference_speed(const ApproachLimits& l, double y0, double r, int samples) {
+  ApproachState s;
+  double fastest = 0.0;
+  for (int k = 0; k < samples; ++k) fastest = std::max(fastest, std::abs(approach_step(l, s, r, y0).speed_v_s));
+  return fastest;
+}
+
+TEST(SlidingApproach, AShortApproachSpeedsUpAtItsOwnGentlerRate) {
+  auto l = limits();
+  l.dead_length_v = 1e6;
+  l.short_approach_accel_v_s2 = 14.4;  // the approach speed over 0.2 V
+  const int samples = 20;              // 0.1 s: the leg's rate would reach the approach speed in 12 ms
+  // From rest at the end, 20 mm to go: a short approach.
+  EXPECT_LE(early_reference_speed(l, 0.0, 0.4, samples), l.short_approach_accel_v_s2 * samples * kTs + 1e-9);
+  // A whole approach from mid-stroke, and the same short one without the gentler rate, speed up at the leg's.
+  EXPECT_NEAR(early_reference_speed(l, 1.0, 9.0, samples), l.top_speed_pos_v_s, 1e-9);
+  l.short_approach_accel_v_s2 = 0.0;
+  EXPECT_NEAR(early_reference_speed(l, 0.0, 0.4, samples), l.speed_v_s, 1e-9);
+}
+
 TEST(SlidingApproach, ASideAskedForIsTheSideTheNextPlanApproachesFrom) {
   const auto l = limits();
   ApproachState s;

@@ -119,6 +119,26 @@ TEST(PpTrajSliding, OnThePhysicsPlantEveryMoveSettlesWithinASecondWithinAThirdOf
     }
 }
 
+// Moves from an end stop to targets nearer than one approach length: the approach is as short as
+// the target is near, and starts from rest at the end. A gripper or a part may stand past the
+// target, so none passes it by more than the in-position window (1 mm); each ends within it.
+TEST(PpTrajSliding, AShortMoveFromAnEndStopDoesNotPassItsTarget) {
+  auto config = epa::testing::pp_traj_config_on(identified());
+  config.trajectory.in_position_window_v = 1.0 / 50.0;
+  auto params = control::ControllerParams::make(config);
+  ASSERT_TRUE(params.has_value()) << params.error().message;
+  for (double from : {0.0, 500.0})
+    for (double size : {10.0, 15.0, 20.0, 25.0}) {
+      const double step = from == 0.0 ? size : -size, target = from + step;
+      SCOPED_TRACE("from " + std::to_string(from) + " mm, step " + std::to_string(step) + " mm");
+      const StepRun r = physics_move(*params, from, step);
+      double passed_mm = 0.0;
+      for (const double y : r.run.y_mm) passed_mm = std::max(passed_mm, (y - target) * (step > 0 ? 1.0 : -1.0));
+      EXPECT_LE(passed_mm, 1.0);
+      EXPECT_LE(std::abs(r.run.y_mm.back() - target), 1.0);
+    }
+}
+
 TEST(PpTrajSliding, WithTwoSamplesOfDelayTheModelDoesNotKnowItStillEndsWithinTheBand) {
   const auto params = pp_traj_for(identified());
   for (double from : {100.0, 400.0})
