@@ -61,7 +61,8 @@ void start_leg(const ApproachLimits& l, ApproachState& s, double target_v, doubl
   s.leg_coast_s = std::max(0.0, coast_at_s(l, target_v) + s.learned_offset_s[direction_index(s.final_direction)]);
   const double sliding = direction * reading_slope(s, l.Ts);
   s.path_speed_v_s = sliding >= 0.5 * l.speed_v_s ? sliding : 0.0;
-  s.short_approach = final_leg && s.path_speed_v_s == 0.0 && travel_cuts_the_approach(l, s);
+  s.short_approach = final_leg && s.path_speed_v_s == 0.0 && travel_cuts_the_approach(l, s) &&
+                     direction * (target_v - from_v) < l.length_v;
   s.samples_in_phase = 0;
 }
 
@@ -76,6 +77,7 @@ void back_off(const ApproachLimits& l, ApproachState& s, double y_v) noexcept {
 void plan(const ApproachLimits& l, ApproachState& s, double r_v, double y_v) noexcept {
   s.planned_r_v = r_v;
   s.retries = 0;
+  s.short_approach = false;
   const double move = r_v - y_v;
   if (std::abs(move) <= l.retry_band_v) {
     hold(s, y_v);
@@ -126,6 +128,7 @@ void approach_after_moving_reference(const ApproachLimits& l, ApproachState& s, 
   s.final_direction = direction;
   s.next_direction = 0.0;  // a moving reference's arrival is where it stands, from where the piston is
   s.final_leg = true;
+  s.short_approach = false;
   s.retries = l.max_retries;  // judged after the coast: held wherever it stopped
   s.cut_speed_v_s = 0.0;      // and nothing learned from it
   s.phase = ApproachPhase::kCoasting;

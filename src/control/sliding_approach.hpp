@@ -28,14 +28,16 @@
 //            the same at every position, as a delay the model did not see would be, and the
 //            offset is the running mean of what the stops asked for (over about the last 4), so
 //            that a retry does not chase one stop's scatter. A short approach (below) teaches
-//            nothing: cut before its slide is steady, its stop says little of a steady slide's coast
+//            nothing: it starts with a breakaway from rest at the end, and its stop says little
+//            of a steady slide's coast
 //   short    a move shorter than length_v backs off first (unless the piston already slides
 //            towards the target), so that every final approach is a steady slide, not the
 //            breakaway jump of a start from rest; near an end of [travel_min_v, travel_max_v]
 //            (the loop's setpoint range) it backs off only as far as that end, or goes straight
-//            in when the piston stands between the target and that end. Such a short approach
-//            speeds up at short_approach_accel_v_s2. An approach never comes from the target's
-//            far side: a gripper or a part may stand there
+//            in when the piston already stands there. Such a short approach (a final leg from
+//            rest with less than length_v to go because the travel cuts it) speeds up at
+//            short_approach_accel_v_s2. An approach never comes from the target's far side: a
+//            gripper or a part may stand there
 //   hold     the valve stays centred until the setpoint changes or the piston is pushed more than
 //            4 retry bands from where it stopped
 //
@@ -78,7 +80,7 @@ struct ApproachState {
   double final_direction = 1.0;  // the move's approach direction
   double next_direction = 0.0;   // +1 / -1: the next plan approaches this way (a move's side kept), 0: from where the piston is
   bool final_leg = false;
-  bool short_approach = false;  // this final leg starts from rest with less than length_v to go: the travel cuts it
+  bool short_approach = false;  // this final leg starts from rest with less than length_v to go, because the travel cuts it
   int retries = 0;
   double path_v = 0.0, path_speed_v_s = 0.0;  // the leg's reference and its speed (>= 0, along leg_direction)
   double leg_coast_s = 0.0;       // the coast this leg's cut assumes: at its target, plus the move's direction's offset

@@ -144,8 +144,9 @@ core::Result<TrajectoryParams> make_trajectory_params(const TrajectoryConfig& c,
   p.approach.travel_min_v = c.travel_min_v;
   p.approach.travel_max_v = c.travel_max_v;
   p.approach.short_approach_band_v = kStopShareOfWindow * c.in_position_window_v;
+  p.approach.short_approach_accel_v_s2 =
+      std::min(c.approach_speed_v_s * c.approach_speed_v_s / (2.0 * kShortApproachRunUpV), p.approach.accel_v_s2);
   p.fallback_approach = p.approach;
-  p.approach.short_approach_accel_v_s2 = c.approach_speed_v_s * c.approach_speed_v_s / (2.0 * kShortApproachSpeedUpV);
   p.fallback_approach.coast_s = kFallbackCoastS;
   p.fallback_approach.retry_band_v = std::max(p.approach.retry_band_v, p.approach.short_approach_band_v);
   return p;

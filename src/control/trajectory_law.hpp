@@ -111,13 +111,12 @@ inline constexpr double kFallbackCoastS = 0.02;
 // arrival a stop after a short approach: the margin is for the sensor noise and the creep after the
 // judgement (commissioning gives its sets 3/4 of the e_ss limit for the same reason).
 inline constexpr double kStopShareOfWindow = 0.75;
-// A short approach of the law's own sliding arrival (from rest near a travel end) reaches its
-// approach speed over this much travel, V (10 mm at 50 mm/V), not in the 1-2 mm the leg's rate
-// takes. On the commissioned physics plant the leg's rate threw the piston off the end stop in a
-// burst that passed 10-25 mm targets by up to 2.8 mm. Measured, not derived: rates of 6-24 V/s^2
-// were tried (notes/pp-traj-development.md). The fallback keeps the leg's rate: with its guessed
-// coast a gentle start landed short and used its retries.
-inline constexpr double kShortApproachSpeedUpV = 0.2;
+// A short approach (from rest near a travel end, sliding_approach.hpp) reaches its approach speed
+// over this much travel, V (10 mm at 50 mm/V), not in the 1-2 mm the leg's rate takes (and never
+// faster than that rate). On the commissioned physics plant the leg's rate threw the piston off
+// the end stop in a burst that passed 10-25 mm targets by up to 3 mm. Measured, not derived: rates
+// of 6-24 V/s^2 were tried (notes/pp-traj-development.md). The hunting fallback takes it too.
+inline constexpr double kShortApproachRunUpV = 0.2;
 
 struct TrajectoryState {
   MotionProfileState profile;

@@ -161,3 +161,28 @@ TEST(ControllerKind, NamesRoundTripAndUnknownNameIsRefusedWithTheChoices) {
 
 }  // namespace
 }  // namespace epa::control
+
+namespace epa::control {
+namespace {
+
+// pp-traj's short approach (near a travel end) runs up to its approach speed over
+// kShortApproachRunUpV, in its own sliding arrival and in the hunting fallback's alike, and never
+// faster than the leg's own rate.
+TEST(PpTrajParams, AShortApproachRunsUpOverItsOwnDistanceNeverFasterThanTheLeg) {
+  auto c = paper_controller_config(ControllerKind::kPpTraj);
+  const double v = c.trajectory.approach_speed_v_s;
+  const auto p = ControllerParams::make(c);
+  ASSERT_TRUE(p.has_value()) << p.error().message;
+  const double run_up = v * v / (2.0 * kShortApproachRunUpV);
+  ASSERT_LT(run_up, p->trajectory().approach.accel_v_s2) << "the case does not test the run-up";
+  EXPECT_DOUBLE_EQ(p->trajectory().approach.short_approach_accel_v_s2, run_up);
+  EXPECT_DOUBLE_EQ(p->trajectory().fallback_approach.short_approach_accel_v_s2, run_up);
+
+  c.trajectory.accel_v_s2 = 0.5 * run_up;  // a leg slower than the run-up
+  const auto slow = ControllerParams::make(c);
+  ASSERT_TRUE(slow.has_value()) << slow.error().message;
+  EXPECT_DOUBLE_EQ(slow->trajectory().approach.short_approach_accel_v_s2, 0.5 * run_up);
+}
+
+}  // namespace
+}  // namespace epa::control

@@ -159,8 +159,14 @@ TEST(SlidingApproach, AShortApproachSpeedsUpAtItsOwnGentlerRate) {
   l.dead_length_v = 1e6;
   l.short_approach_accel_v_s2 = 14.4;  // the approach speed over 0.2 V
   const int samples = 20;              // 0.1 s: the leg's rate would reach the approach speed in 12 ms
-  // From rest at the end, 20 mm to go: a short approach.
-  EXPECT_LE(early_reference_speed(l, 0.0, 0.4, samples), l.short_approach_accel_v_s2 * samples * kTs + 1e-9);
+  // From rest at the end, 20 mm to go: a short approach, speeding up at its own rate.
+  const double short_speed = early_reference_speed(l, 0.0, 0.4, samples);
+  EXPECT_LE(short_speed, l.short_approach_accel_v_s2 * samples * kTs + 1e-9);
+  EXPECT_GE(short_speed, l.short_approach_accel_v_s2 * (samples - 2) * kTs);
+  // A travel that starts 20 mm up still leaves the piston at 0 mm a whole approach to 60 mm: not short.
+  auto raised = l;
+  raised.travel_min_v = 0.4;
+  EXPECT_GE(early_reference_speed(raised, 0.0, 1.2, samples), l.speed_v_s);
   // A whole approach from mid-stroke, and the same short one without the gentler rate, speed up at the leg's.
   EXPECT_NEAR(early_reference_speed(l, 1.0, 9.0, samples), l.top_speed_pos_v_s, 1e-9);
   l.short_approach_accel_v_s2 = 0.0;
