@@ -8,9 +8,10 @@
 #
 #   bench/pp_traj_no_pass.sh [BUILD_DIR=build/release] [full|fast|ends] [FIRST_SEED=1] [NOISE_MM=0]
 #
-# fast (CI's smoke step): 10, 20 and 100 mm only. ends: 10-60 mm from 0 and 500 mm only, where a
-# move has no room for a whole approach. FIRST_SEED: the commissioning's excitation seeds (another
-# identified model of the same plant); NOISE_MM: the moves' sensor noise (its seed FIRST_SEED).
+# fast (CI's smoke step): 10, 20 and 100 mm only. ends: 10-60 mm from 0 and 500 mm only, the moves
+# nearest the ends (up to 45 mm their final approach is short). FIRST_SEED: the first of the
+# commissioning's three excitation seeds (another identified model of the same plant); NOISE_MM:
+# the moves' sensor noise (one seed, FIRST_SEED, for all of them).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build/release}
@@ -19,18 +20,19 @@ first_seed=${3:-1}
 noise_mm=${4:-0}
 epa="$build/src/app/epa"
 [ -x "$epa" ] || { echo "pp_traj_no_pass: $epa is not built" >&2; exit 1; }
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-
-source bench/physics_axis.sh
-commission_physics_axis "$epa" "$work" pp_traj_no_pass "$first_seed"
-
 case $mode in
   fast) sizes="10 20 100" ;;
   ends) sizes=$(seq 10 5 60) ;;
   full) sizes=$(seq 10 5 200) ;;
   *) echo "pp_traj_no_pass: mode must be full, fast or ends, got $mode" >&2; exit 2 ;;
 esac
+[[ $first_seed =~ ^[1-9][0-9]*$ ]] || { echo "pp_traj_no_pass: FIRST_SEED must be a whole number >= 1, got $first_seed" >&2; exit 2; }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+source bench/physics_axis.sh
+commission_physics_axis "$epa" "$work" pp_traj_no_pass "$first_seed"
+
 up=$(for s in $sizes; do printf '%s,' "$s"; done)
 down=$(for s in $sizes; do printf '%s,' "-$s"; done)
 moves() {  # moves START STEPS: one epa simulate run per step, run files into $work/START
