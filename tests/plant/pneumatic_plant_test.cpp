@@ -630,3 +630,50 @@ TEST(PneumaticPlant, PaperFfidzControllerStaysStableOverTheTableSteps) {
 
 }  // namespace
 }  // namespace epa::plant
+
+namespace epa::plant {
+namespace {
+
+// What a reduced model of the axis has to hold (docs/diagnosis.md, "The drift benchmark"): beyond
+// the overlap, the steady speed is linear in the command (the meter-out side sets it), but a move
+// from rest starts far faster than it goes on, while the chamber that fills still holds its rest
+// pressure.
+struct ConstantCommand {
+  double steady_mm_s = 0.0;      // over the last 40 samples before it nears the end
+  double first_peak_mm_s = 0.0;  // the fastest 20 ms of its first 0.2 s
+};
+
+ConstantCommand run_at(double valve_v) {
+  PneumaticPlant plant = make_plant({}, {.initial_position_mm = valve_v > 0.0 ? 50.0 : 450.0});
+  for (int k = 0; k < 400; ++k) plant.step(0.0);  // 2 s centred: the chambers settle
+  std::vector<double> y{plant.position_mm()};
+  while (y.size() < 2000 && std::abs(y.back() - 250.0) < 230.0) {
+    plant.step(valve_v);
+    y.push_back(plant.position_mm());
+  }
+  ConstantCommand c;
+  const std::size_t n = y.size() - 1;
+  c.steady_mm_s = std::abs(y[n] - y[n - 40]) / (40 * 0.005);
+  for (std::size_t k = 4; k <= 40 && k <= n; ++k) c.first_peak_mm_s = std::max(c.first_peak_mm_s, std::abs(y[k] - y[k - 4]) / 0.02);
+  return c;
+}
+
+TEST(PneumaticPlant, SteadySpeedIsLinearBeyondTheOverlapButAMoveFromRestStartsFaster) {
+  const PneumaticParams p;
+  for (const double sign : {1.0, -1.0}) {
+    const double overlap_v = sign > 0.0 ? p.overlap_pos_v : p.overlap_neg_v;
+    std::vector<double> per_volt;
+    for (const double u : {2.5, 3.5, 5.0}) {
+      const double command = sign * u;
+      per_volt.push_back(run_at(command).steady_mm_s / std::abs(command - overlap_v));
+    }
+    const auto [lo, hi] = std::minmax_element(per_volt.begin(), per_volt.end());
+    EXPECT_LE(*hi / *lo, 1.03) << "steady speed per volt beyond the overlap, direction " << sign;
+    const ConstantCommand full = run_at(sign * 5.0);
+    EXPECT_GE(full.first_peak_mm_s, 1.5 * full.steady_mm_s) << "direction " << sign;
+    RecordProperty(sign > 0 ? "start_over_steady_speed_pos" : "start_over_steady_speed_neg", figure(full.first_peak_mm_s / full.steady_mm_s));
+  }
+}
+
+}  // namespace
+}  // namespace epa::plant
