@@ -131,8 +131,8 @@ TEST(SlidingApproach, AStopAfterAShortApproachIsJudgedAgainstTheShortApproachBan
 TEST(SlidingApproach, AStopAfterAShortApproachTeachesTheCoastNothing) {
   auto l = limits();
   l.dead_length_v = 1e6;
-  // From rest at the end, the slide is cut before it is steady: its stop says little of the coast
-  // of a steady slide, and learning from it set the next whole approach off by as much.
+  // From rest at the end, the approach starts with a breakaway: its stop says little of the coast
+  // of a steady slide, and learning from it would set the next retry off by as much.
   ApproachState s;
   run(l, s, 0.0, 0.4, 5.0, 1.6);  // 20 mm from the end, the piston coasting 60 % further
   ASSERT_GE(s.retries, 1) << "the case does not stop off the target";

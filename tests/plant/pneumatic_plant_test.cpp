@@ -628,11 +628,6 @@ TEST(PneumaticPlant, PaperFfidzControllerStaysStableOverTheTableSteps) {
   }
 }
 
-}  // namespace
-}  // namespace epa::plant
-
-namespace epa::plant {
-namespace {
 
 // What a reduced model of the axis has to hold (docs/diagnosis.md, "The drift benchmark"): beyond
 // the overlap, the steady speed is linear in the command (the meter-out side sets it), but a move
