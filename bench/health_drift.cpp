@@ -17,11 +17,11 @@
 #include "control/controller.hpp"
 #include "control/paper_controller.hpp"
 #include "core/model_file.hpp"
-#include "core/random.hpp"
 #include "diag/model_health.hpp"
 #include "plant/plant_adapter.hpp"
 #include "plant/pneumatic_params.hpp"
 #include "plant/stick_slip_model.hpp"
+#include "sim/random_moves.hpp"
 
 namespace {
 
@@ -109,10 +109,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "health_drift: %s\n", !plant ? plant.error().message.c_str() : health.error().message.c_str());
         return 1;
       }
-      control::ControllerState state;
-      control::controller_start(params, state, (*plant)->measured_v(), 0.0);
-      core::Random rng(static_cast<std::uint64_t>(seed) * 7919 + 13);
-      double target_mm = 250.0;
+      sim::RandomMoves sequence(**plant, params, {.move_s = move_s, .seed = static_cast<std::uint64_t>(seed)});
       int named_after = -1, alarms = 0;
       std::string named_size;
       double named_ratio = 1.0;
@@ -122,24 +119,7 @@ int main(int argc, char** argv) {
           for (const auto& [key, value] : change.keys) (void)plant::set_pneumatic_key(p, key, value);
           (void)(*plant)->set_physics_params(p);
         }
-        const double size = rng.uniform() < 0.4 ? 10.0 + 30.0 * rng.uniform() : 40.0 + 160.0 * rng.uniform();
-        const double dir = target_mm > 400 ? -1.0 : target_mm < 100 ? 1.0 : (rng.uniform() < 0.5 ? -1.0 : 1.0);
-        target_mm = std::clamp(target_mm + dir * size, 20.0, 480.0);
-        control::controller_new_move(state);
-        core::Run run;
-        run.Ts = Ts;
-        bool hunted = false;
-        for (int k = 0; k < static_cast<int>(move_s / Ts); ++k) {
-          const double y_v = (*plant)->measured_v();
-          const auto out = control::controller_step(params, state, target_mm / 50.0, y_v);
-          hunted = hunted || out.hunting || out.sliding_fallback_started;
-          run.t_s.push_back(k * Ts);
-          run.r_mm.push_back(target_mm);
-          run.y_mm.push_back(y_v * 50.0);
-          run.u_V.push_back(out.valve_v);
-          run.uc_V.push_back(out.controller_v);
-          (*plant)->step(out.valve_v);
-        }
+        auto [run, hunted] = sequence.next();
         const bool changed = health->add_move(std::move(run), hunted);
         const auto& v = health->verdict();
         if (changed || verbose) {

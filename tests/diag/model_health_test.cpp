@@ -10,6 +10,8 @@
 #include "../support/physics_identified_model.hpp"
 #include "../support/stick_slip_axis.hpp"
 #include "core/model_file.hpp"
+#include "plant/plant_adapter.hpp"
+#include "sim/random_moves.hpp"
 
 namespace epa::diag {
 namespace {
@@ -85,6 +87,44 @@ TEST(ModelHealth, AFlowGainDownOnTheModelsOwnFormIsNamedDown) {
   const HealthRun r = run_moves(*health, p, changed, 28, 60, plant::EffectKind::kGainChange, 3);
   ASSERT_GE(r.named_after, 0) << "a flow gain x0.7 was never named";
   EXPECT_LT(r.ratio_named, 0.9);
+}
+
+// On the physics plant (another structure than the model: chambers, orifices, Stribeck friction)
+// under pp-traj designed on its identified model, friction doubled after move 32 is named within 20
+// moves and stays named to the end, at about its size. The gap of a sticking model is jagged in
+// its friction: fitted from "no change" alone, some windows of these seeds read x0.9, and the
+// warning went back to ok (seed 3) or to unexplained (seed 2).
+TEST(ModelHealthOnThePhysicsPlant, FrictionDoubledIsNamedAndStaysNamed) {
+  const auto file = health_model_file();
+  const auto law = control::ControllerParams::make(testing::pp_traj_config_on(file));
+  ASSERT_TRUE(law.has_value()) << law.error().message;
+  for (const std::uint64_t seed : {2u, 3u}) {
+    auto plant = plant::make_pneumatic_simulator({}, {.initial_position_mm = 250.0, .noise_std_mm = 0.1, .seed = seed});
+    auto health = ModelHealth::make(*file.stick_slip, kHealthTs, 500.0, {});
+    ASSERT_TRUE(plant.has_value() && health.has_value());
+    sim::RandomMoves moves(**plant, *law, {.seed = seed});
+    int named_after = -1;
+    for (int m = 0; m < 70; ++m) {
+      if (m == 32) {
+        auto p = *(*plant)->physics_params();
+        p.static_friction_n *= 2.0, p.coulomb_friction_n *= 2.0;
+        ASSERT_TRUE(static_cast<bool>((*plant)->set_physics_params(p)));
+      }
+      auto [run, hunted] = moves.next();
+      health->add_move(std::move(run), hunted);
+      const auto& v = health->verdict();
+      if (m < 32) {
+        EXPECT_NE(v.state, HealthState::kDrifting) << "seed " << seed << " move " << m + 1;
+      }
+      if (m >= 32 && named_after < 0 && v.state == HealthState::kDrifting && v.effect == plant::EffectKind::kStaticFriction) named_after = m + 1 - 32;
+    }
+    EXPECT_GE(named_after, 1) << "seed " << seed << ": friction x2 was never named";
+    EXPECT_LE(named_after, 20) << "seed " << seed;
+    const auto& end = health->verdict();
+    EXPECT_EQ(end.state, HealthState::kDrifting) << "seed " << seed << " ends " << to_string(end.state);
+    EXPECT_EQ(end.effect, plant::EffectKind::kStaticFriction) << "seed " << seed;
+    EXPECT_NEAR(end.ratio, 2.0, 0.6) << "seed " << seed;
+  }
 }
 
 TEST(ModelHealth, ABadConfigurationIsRefusedNamingTheField) {
