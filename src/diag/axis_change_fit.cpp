@@ -48,13 +48,11 @@ struct Problem {
 void start_from_best_of_scan(Problem& problem, std::vector<double>& x) {
   problem.put(x.data());
   double best = problem.train_gap();
-  const double x0 = x[0];
   for (int i = 0; i < kScanPoints; ++i) {
-    double xi = (i + 0.5) / kScanPoints;
+    const double xi = (i + 0.5) / kScanPoints;
     problem.put(&xi);
     if (const double gap = problem.train_gap(); gap < best) best = gap, x[0] = xi;
   }
-  if (x[0] == x0) problem.put(x.data());
 }
 
 // Minimises the training gap over the continuous values from x (unit box); returns the gap.

@@ -5,7 +5,7 @@
 // caller's, so that it can change the plant's parameters between moves (wear, a supply drop).
 //
 // Targets: 40 % of the moves 10-40 mm long, the rest 40-200 mm, each way at random but towards
-// the middle once the target lies beyond 100 mm of an end, within [20, 480] mm.
+// the middle while the last target lies within 100 mm of an end; every target within [20, 480] mm.
 #include <cstdint>
 
 #include "control/controller.hpp"
@@ -35,7 +35,6 @@ class RandomMoves {
   // The law starts at the plant's reading. plant and law must outlive this object.
   RandomMoves(plant::PlantSimulator& plant, const control::ControllerParams& law, const RandomMovesOptions& options);
   RecordedMove next();
-  double target_mm() const { return target_mm_; }
 
  private:
   plant::PlantSimulator& plant_;
