@@ -11,7 +11,7 @@ using plant::EffectKind;
 
 std::vector<ChangeParam> change_params(EffectKind kind, const core::StickSlipParams& c) {
   switch (kind) {
-    case EffectKind::kStaticFriction: return {{"friction_ratio", 1.0, 0.2, 6.0, true}};
+    case EffectKind::kStaticFriction: return {{"friction_ratio", 1.0, 0.2, 6.0, true, true}};
     case EffectKind::kGainChange: return {{"flow_gain_ratio", 1.0, 0.3, 2.0, true}};
     case EffectKind::kDeadzoneShift: return {{"shift_r_V", 0.0, -1.0, 1.0, false}, {"shift_l_V", 0.0, -1.0, 1.0, false}};
     case EffectKind::kValveLag: return {{"spool_lag_s", c.spool_lag_s, 0.0, 0.15, false}};

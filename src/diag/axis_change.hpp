@@ -24,6 +24,9 @@ struct ChangeParam {
   double neutral;    // no change (spool_lag_s: the commissioned lag)
   double lo, hi;
   bool log_scale;
+  // The gap is jagged in it (a sticking model's friction: a breakaway a sample earlier or later),
+  // so a fit of it alone scans its range before the local search (axis_change_fit.cpp).
+  bool jagged = false;
 };
 
 // The continuous parameters of `kind` (input_delay has none: its dead time is searched whole).

@@ -13,7 +13,7 @@ using plant::EffectKind;
 
 constexpr unsigned kEvaluationsPerDimension = 120;
 constexpr double kInitialStep = 0.15;  // of the unit box
-constexpr int kScanPoints = 12;         // a friction fit's coarse scan over its range, before the local search
+constexpr int kScanPoints = 12;         // a jagged parameter's coarse scan over its range, before the local search
 
 double to_unit(const ChangeParam& p, double v) {
   v = std::clamp(v, p.lo, p.hi);
@@ -42,11 +42,11 @@ struct Problem {
   }
 };
 
-// Where a friction fit's local search starts: the best of x0 and a coarse scan over the unit range.
-// A sticking model's gap is jagged in its friction (a breakaway comes a sample earlier or later):
-// searched from the neutral point alone, a window whose friction had doubled fitted it as x0.9.
-// Only friction: scanned, the spool lag found far basins at the range's end on 15 s parts of an
-// unchanged axis's runs (100 ms against 12), which would have widened its tolerance eight-fold.
+// Where a one-term fit of a jagged parameter (ChangeParam::jagged: friction) starts its local
+// search: the best of x0 and a coarse scan over the unit range. Searched from the neutral point
+// alone, a window whose friction had doubled fitted it as x0.9. Only such parameters: scanned, the
+// spool lag found far basins at the range's end on 15 s parts of an unchanged axis's runs (100 ms
+// against 12), which would have widened its tolerance eight-fold.
 void start_from_best_of_scan(Problem& problem, std::vector<double>& x) {
   problem.put(x.data());
   double best = problem.train_gap();
@@ -61,8 +61,7 @@ void start_from_best_of_scan(Problem& problem, std::vector<double>& x) {
 double minimise(Problem& problem, std::vector<double>& x) {
   const std::size_t n = x.size();
   if (n == 0) return problem.train_gap();
-  if (n == 1 && problem.change.kinds.size() == 1 && problem.change.kinds.front() == EffectKind::kStaticFriction)
-    start_from_best_of_scan(problem, x);
+  if (problem.change.kinds.size() == 1 && n == 1 && problem.slots.front().second.jagged) start_from_best_of_scan(problem, x);
   nlopt::opt opt(nlopt::LN_SBPLX, static_cast<unsigned>(n));
   opt.set_lower_bounds(std::vector<double>(n, 0.0));
   opt.set_upper_bounds(std::vector<double>(n, 1.0));

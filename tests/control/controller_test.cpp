@@ -159,7 +159,6 @@ TEST(ControllerKind, NamesRoundTripAndUnknownNameIsRefusedWithTheChoices) {
   EXPECT_NE(bad.error().message.find("pp-ffidz"), std::string::npos);
 }
 
-
 // pp-traj's short approach (near a travel end) runs up to its approach speed over
 // kShortApproachRunUpV, in its own sliding arrival and in the hunting fallback's alike, and never
 // faster than the leg's own rate.

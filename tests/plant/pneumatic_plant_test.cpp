@@ -628,7 +628,6 @@ TEST(PneumaticPlant, PaperFfidzControllerStaysStableOverTheTableSteps) {
   }
 }
 
-
 // What a reduced model of the axis has to hold (docs/diagnosis.md, "The drift benchmark"): beyond
 // the overlap, the steady speed is linear in the command (the meter-out side sets it), but a move
 // from rest starts far faster than it goes on, while the chamber that fills still holds its rest
