@@ -7,7 +7,7 @@
 //
 //   case friction-x2 seed 1: named static_friction after 6 moves (friction up 92 %, ratio 1.92), ...
 //
-//   health_drift MODEL.toml [--case NAME] [--seeds N] [--moves N] [--change-at N] [--law pp-traj|pp-ffidz]
+//   health_drift MODEL.toml [--case NAME] [--seeds N] [--first-seed S] [--moves N] [--change-at N] [--law pp-traj|pp-ffidz]
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -67,11 +67,12 @@ control::ControllerParams law_for(const core::ModelFile& f, control::ControllerK
 int main(int argc, char** argv) {
   CLI::App app{"The model-health monitor on the physics plant, one change at a time"};
   std::string model_path, only, law = "pp-traj";
-  int seeds = 1, moves = 70, change_at = 32;
+  int seeds = 1, first_seed = 1, moves = 70, change_at = 32;
   double move_s = 2.5, noise_mm = 0.1;
   app.add_option("model", model_path, "epa-model/1 file with [stick_slip] (epa identify)")->required();
   app.add_option("--case", only, "one case by name");
   app.add_option("--seeds", seeds, "seeds per case");
+  app.add_option("--first-seed", first_seed, "the first seed (seeds run from it on)");
   app.add_option("--moves", moves, "moves per run");
   app.add_option("--change-at", change_at, "the change comes after this many moves");
   app.add_option("--move-s", move_s, "each move's length, s");
@@ -101,7 +102,7 @@ int main(int argc, char** argv) {
 
   for (const Change& change : cases()) {
     if (!only.empty() && change.name != only) continue;
-    for (int seed = 1; seed <= seeds; ++seed) {
+    for (int seed = first_seed; seed < first_seed + seeds; ++seed) {
       ++runs;
       auto plant = plant::make_pneumatic_simulator({}, {.initial_position_mm = 250.0, .noise_std_mm = noise_mm, .seed = static_cast<std::uint64_t>(seed)});
       auto health = diag::ModelHealth::make(*file->stick_slip, Ts, 500.0, hc, scoped ? file->identified_drive_v : std::nullopt);
