@@ -75,7 +75,7 @@ void judge_whole_moves(diag::GapReport& report, const core::ModelFile& file, con
   const auto& d = report.diagnosis;
   if (std::find(d.effects.begin(), d.effects.end(), plant::EffectKind::kSensorQuantization) != d.effects.end())
     report.changes->sensor_step_mm = d.final_model.effects.param(plant::EffectKind::kSensorQuantization, 0);
-  progress(fmt::format("since commissioning: {} change(s) named, held-out gap {:.3f} -> {:.3f} mm", report.changes->accepted.kinds.size(),
+  progress(fmt::format("since commissioning: {} change(s) named, held-out gap {:.3f} -> {:.3f} mm", report.changes->accepted.terms.size(),
                        report.changes->commissioned_heldout_mm, report.changes->heldout_after_mm));
 }
 

@@ -9,8 +9,6 @@ namespace epa::diag {
 
 namespace {
 
-using plant::EffectKind;
-
 constexpr unsigned kEvaluationsPerDimension = 120;
 constexpr double kInitialStep = 0.15;  // of the unit box
 constexpr int kScanPoints = 12;         // a jagged parameter's coarse scan over its range, before the local search
@@ -27,8 +25,8 @@ double from_unit(const ChangeParam& p, double x) {
 
 struct Problem {
   const ChangeFitData* data;
-  AxisChange change;                              // the kinds, their values written by put()
-  std::vector<std::pair<std::size_t, ChangeParam>> slots;  // (kind index, parameter) per dimension
+  AxisChange change;                              // the terms, their values written by put()
+  std::vector<std::pair<std::size_t, ChangeParam>> slots;  // (term index, parameter) per dimension
   std::size_t evaluations = 0;
 
   void put(const double* x) {
@@ -42,7 +40,7 @@ struct Problem {
   }
 };
 
-// Where a one-term fit of a jagged parameter (ChangeParam::jagged: friction) starts its local
+// Where a one-term fit of a jagged parameter (ChangeParam::jagged: friction, supply) starts its local
 // search: the best of x0 and a coarse scan over the unit range. Searched from the neutral point
 // alone, a window whose friction had doubled fitted it as x0.9. Only such parameters: scanned, the
 // spool lag found far basins at the range's end on 15 s parts of an unchanged axis's runs (100 ms
@@ -61,7 +59,7 @@ void start_from_best_of_scan(Problem& problem, std::vector<double>& x) {
 double minimise(Problem& problem, std::vector<double>& x) {
   const std::size_t n = x.size();
   if (n == 0) return problem.train_gap();
-  if (problem.change.kinds.size() == 1 && n == 1 && problem.slots.front().second.jagged) start_from_best_of_scan(problem, x);
+  if (problem.change.terms.size() == 1 && n == 1 && problem.slots.front().second.jagged) start_from_best_of_scan(problem, x);
   nlopt::opt opt(nlopt::LN_SBPLX, static_cast<unsigned>(n));
   opt.set_lower_bounds(std::vector<double>(n, 0.0));
   opt.set_upper_bounds(std::vector<double>(n, 1.0));
@@ -87,20 +85,20 @@ double minimise(Problem& problem, std::vector<double>& x) {
 
 }  // namespace
 
-ChangeFit fit_change(const ChangeFitData& data, const std::vector<EffectKind>& kinds, const AxisChange& start) {
+ChangeFit fit_change(const ChangeFitData& data, const std::vector<ChangeTerm>& terms, const AxisChange& start) {
   Problem problem{&data, {}, {}, 0};
-  problem.change.kinds = kinds;
-  problem.change.values.resize(kinds.size());
+  problem.change.terms = terms;
+  problem.change.values.resize(terms.size());
   std::vector<double> x0;
-  for (std::size_t i = 0; i < kinds.size(); ++i) {
-    const auto params = change_params(kinds[i], data.commissioned);
-    const auto* given = start.values_of(kinds[i]);
+  for (std::size_t i = 0; i < terms.size(); ++i) {
+    const auto params = change_params(terms[i], data.commissioned);
+    const auto* given = start.values_of(terms[i]);
     for (std::size_t j = 0; j < params.size(); ++j) {
       problem.slots.emplace_back(i, params[j]);
       x0.push_back(to_unit(params[j], given && j < given->size() ? (*given)[j] : params[j].neutral));
     }
   }
-  const bool delay = std::find(kinds.begin(), kinds.end(), EffectKind::kInputDelay) != kinds.end();
+  const bool delay = std::find(terms.begin(), terms.end(), ChangeTerm::kDeadTime) != terms.end();
   ChangeFit best;
   best.train_gap_mm = std::numeric_limits<double>::infinity();
   const int lo = delay ? 0 : data.commissioned.delay_samples, hi = delay ? core::StickSlipParams::kMaxDelay : lo;

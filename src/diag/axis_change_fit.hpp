@@ -25,9 +25,9 @@ struct ChangeFitData {
   JudgedScope scope;
 };
 
-// The changes of `kinds` fitted together, each continuous value started from `start` where it
-// holds that kind, else from no change; the dead time, when among them, searched whole over
+// The changes of `terms` fitted together, each continuous value started from `start` where it
+// holds that term, else from no change; the dead time, when among them, searched whole over
 // 0..StickSlipParams::kMaxDelay with the rest fitted at each.
-ChangeFit fit_change(const ChangeFitData& data, const std::vector<plant::EffectKind>& kinds, const AxisChange& start = {});
+ChangeFit fit_change(const ChangeFitData& data, const std::vector<ChangeTerm>& terms, const AxisChange& start = {});
 
 }  // namespace epa::diag

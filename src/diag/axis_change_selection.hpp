@@ -17,7 +17,7 @@ inline constexpr double kChangeThresholdPct = 10.0;
 inline constexpr std::size_t kMaxChanges = 2;
 
 struct ChangeCandidate {
-  plant::EffectKind effect;
+  ChangeTerm term;
   ChangeFit fit;               // the change alone (round 1)
   double reduction_pct = 0.0;  // of the commissioned model's held-out gap
   bool beyond_tolerance = false;

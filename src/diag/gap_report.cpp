@@ -94,9 +94,9 @@ ordered_json whole_move_json(const WholeMoveGap& w) {
   return j;
 }
 
-ordered_json change_params_json(plant::EffectKind k, const AxisChange& c) {
+ordered_json change_params_json(ChangeTerm k, const AxisChange& c) {
   ordered_json p = ordered_json::object();
-  if (k == plant::EffectKind::kInputDelay) return {{"delay_samples", c.delay_samples}};
+  if (k == ChangeTerm::kDeadTime) return {{"delay_samples", c.delay_samples}};
   const auto* v = c.values_of(k);
   const auto specs = change_params(k, {});
   for (std::size_t i = 0; v && i < v->size() && i < specs.size(); ++i) p[specs[i].name] = round_to((*v)[i], 4);
@@ -106,8 +106,8 @@ ordered_json change_params_json(plant::EffectKind k, const AxisChange& c) {
 ordered_json changes_json(const AxisChanges& c, const core::StickSlipParams& commissioned) {
   ordered_json candidates = ordered_json::array();
   for (const auto& k : c.candidates)
-    candidates.push_back({{"effect", std::string(plant::to_string(k.effect))}, {"change", describe_change(k.effect, k.fit.change, commissioned)},
-                          {"params", change_params_json(k.effect, k.fit.change)}, {"heldout_gap_mm", round_to(k.fit.heldout_gap_mm, 4)},
+    candidates.push_back({{"effect", std::string(plant::to_string(effect_of(k.term)))}, {"change", describe_change(k.term, k.fit.change, commissioned)},
+                          {"params", change_params_json(k.term, k.fit.change)}, {"heldout_gap_mm", round_to(k.fit.heldout_gap_mm, 4)},
                           {"reduction_pct", round_to(k.reduction_pct, 2)}, {"beyond_tolerance", k.beyond_tolerance}});
   return {{"commissioned_heldout_gap_mm", round_to(c.commissioned_heldout_mm, 4)},
           {"commissioned_train_gap_mm", round_to(c.commissioned_train_mm, 4)},
@@ -139,9 +139,9 @@ void changes_verdict(ordered_json& verdict, const GapReport& r) {
   const AxisChanges& c = *r.changes;
   std::vector<std::string> names;
   ordered_json detail = ordered_json::array();
-  for (auto k : c.accepted.kinds) {
-    names.emplace_back(plant::to_string(k));
-    detail.push_back({{"effect", std::string(plant::to_string(k))}, {"change", describe_change(k, c.accepted, r.whole_move->stick_slip)},
+  for (auto k : c.accepted.terms) {
+    names.emplace_back(plant::to_string(effect_of(k)));
+    detail.push_back({{"effect", std::string(plant::to_string(effect_of(k)))}, {"change", describe_change(k, c.accepted, r.whole_move->stick_slip)},
                       {"params", change_params_json(k, c.accepted)}});
   }
   if (c.sensor_step_mm) {
@@ -354,14 +354,14 @@ std::string changes_text(const GapReport& r) {
     s += "not judged: the model file does not say how far its stick-slip model's own terms spread (epa identify with --validate "
          "writes [stick_slip_spread])";
     if (c.unexplained) s += "; the readings move while the valve rests (a leak, a load or a drifting sensor)";
-  } else if (c.accepted.kinds.empty()) {
+  } else if (c.accepted.terms.empty()) {
     s += c.unexplained ? "unexplained: the readings move while the valve rests (a leak, a load or a drifting sensor), which no change of "
                          "the model's terms does"
                        : "no change beyond the commissioned model's tolerance";
   } else {
-    for (std::size_t i = 0; i < c.accepted.kinds.size(); ++i)
-      s += (i ? "; " : "") + std::string(plant::to_string(c.accepted.kinds[i])) + ": " +
-           describe_change(c.accepted.kinds[i], c.accepted, r.whole_move->stick_slip);
+    for (std::size_t i = 0; i < c.accepted.terms.size(); ++i)
+      s += (i ? "; " : "") + std::string(plant::to_string(effect_of(c.accepted.terms[i]))) + ": " +
+           describe_change(c.accepted.terms[i], c.accepted, r.whole_move->stick_slip);
     if (c.unexplained) s += "; and the readings move while the valve rests, which none of these does";
   }
   if (c.sensor_step_mm) s += fmt::format("; the sensor reads coarser: its readings lie on a grid of {:.4f} mm", *c.sensor_step_mm);

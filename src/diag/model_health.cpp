@@ -12,10 +12,15 @@ namespace {
 
 using plant::EffectKind;
 
-// The baseline is fitted on every continuous term at once; the dead time stays the commissioned
-// one (searching it whole would multiply the fit's cost by kMaxDelay + 1).
-const std::vector<EffectKind> kBaselineTerms = {EffectKind::kStaticFriction, EffectKind::kGainChange, EffectKind::kDeadzoneShift,
-                                                EffectKind::kValveLag};
+// The baseline is fitted on the continuous terms at once; the dead time stays the commissioned
+// one (searching it whole would multiply the fit's cost by kMaxDelay + 1), and the supply out of
+// it (fitted beside the flow gain on an unchanged axis it moved the spring x1.6-2.3).
+const std::vector<ChangeTerm> kBaselineTerms = {ChangeTerm::kFriction, ChangeTerm::kFlowGain, ChangeTerm::kDeadBand,
+                                                ChangeTerm::kSpoolLag};
+
+// Every term a window is re-fitted in, one at a time.
+constexpr ChangeTerm kMonitoredTerms[] = {ChangeTerm::kFriction, ChangeTerm::kFlowGain, ChangeTerm::kSupply,
+                                          ChangeTerm::kDeadBand, ChangeTerm::kSpoolLag, ChangeTerm::kDeadTime};
 
 // The moves one after the other as one run, so that the model carries what a move leaves in it
 // (the air spring's wind-up above all, which sets when the next breakaway comes) into the next,
@@ -45,6 +50,13 @@ std::vector<AnchoredRun> anchored(const core::Run& run, std::size_t warm_up) {
   return out;
 }
 
+// Adds a term's estimate as its effect's, or in place of the effect's other term when it explains more.
+void add_estimate(std::vector<EffectEstimate>& estimates, const EffectEstimate& e) {
+  const auto same = std::find_if(estimates.begin(), estimates.end(), [&](const EffectEstimate& o) { return o.effect == e.effect; });
+  if (same == estimates.end()) estimates.push_back(e);
+  else if (e.reduction > same->reduction) *same = e;
+}
+
 std::size_t judged_segments(const core::StickSlipParams& model, double Ts, const std::vector<AnchoredRun>& runs, const JudgedScope& scope) {
   std::size_t n = 0;
   for (const auto& r : runs) n += from_rest_sse(model, Ts, r, scope).windows;
@@ -56,31 +68,31 @@ struct Term {
   double value;
   const char* unit;
 };
-Term term_of(EffectKind kind, const core::StickSlipParams& p) {
-  switch (kind) {
-    case EffectKind::kStaticFriction: return {p.static_mm, "mm"};
-    case EffectKind::kGainChange: return {p.speed_right_mm_s_per_v, "mm/s/V"};
-    case EffectKind::kDeadzoneShift: return {p.break_right_v, "V"};
-    case EffectKind::kValveLag: return {p.spool_lag_s, "s"};
-    case EffectKind::kInputDelay: return {static_cast<double>(p.delay_samples), "samples"};
-    default: return {0.0, ""};
+Term term_of(ChangeTerm term, const core::StickSlipParams& p) {
+  switch (term) {
+    case ChangeTerm::kFriction: return {p.static_mm, "mm"};
+    case ChangeTerm::kFlowGain: return {p.speed_right_mm_s_per_v, "mm/s/V"};
+    case ChangeTerm::kSupply: return {p.spring_rad_s, "rad/s"};
+    case ChangeTerm::kDeadBand: return {p.break_right_v, "V"};
+    case ChangeTerm::kSpoolLag: return {p.spool_lag_s, "s"};
+    case ChangeTerm::kDeadTime: return {static_cast<double>(p.delay_samples), "samples"};
   }
+  return {0.0, ""};
 }
 
-// The smallest change of `kind` ever named, in change_size's units (axis_change.hpp).
-double floor_of(const HealthConfig& c, EffectKind kind) {
-  switch (kind) {
-    case EffectKind::kStaticFriction: return std::log1p(c.friction_ratio_tolerance);
-    case EffectKind::kGainChange: return std::log1p(c.gain_ratio_tolerance);
-    case EffectKind::kDeadzoneShift: return c.break_tolerance_v;
-    case EffectKind::kValveLag: return c.lag_tolerance_s;
-    case EffectKind::kInputDelay: return 1.0;
-    default: return 0.0;
+// The smallest change of `term` ever named, in change_size's units (axis_change.hpp). The supply
+// is held to friction's: it scales the wind-ups as friction does, and with the flow gain's floor
+// it named windows of an unchanged axis whose friction scattered.
+double floor_of(const HealthConfig& c, ChangeTerm term) {
+  switch (term) {
+    case ChangeTerm::kFriction:
+    case ChangeTerm::kSupply: return std::log1p(c.friction_ratio_tolerance);
+    case ChangeTerm::kFlowGain: return std::log1p(c.gain_ratio_tolerance);
+    case ChangeTerm::kDeadBand: return c.break_tolerance_v;
+    case ChangeTerm::kSpoolLag: return c.lag_tolerance_s;
+    case ChangeTerm::kDeadTime: return 1.0;
   }
-}
-
-std::size_t index_of(EffectKind kind) {
-  return static_cast<std::size_t>(std::find(std::begin(kAxisChanges), std::end(kAxisChanges), kind) - std::begin(kAxisChanges));
+  return 0.0;
 }
 
 }  // namespace
@@ -171,7 +183,7 @@ void ModelHealth::fit_baseline() {
   // How far windows of the unchanged axis scatter about the baseline: each effect fitted on the
   // baseline's own windows, half a window apart. A later change is named only beyond
   // spread_margin times the widest of them (and beyond the floor).
-  for (const EffectKind kind : kAxisChanges) tolerance_[index_of(kind)] = floor_of(config_, kind);
+  for (const ChangeTerm term : kMonitoredTerms) tolerance_[index(term)] = floor_of(config_, term);
   unchanged_gap_mm_ = verdict_.baseline_gap_mm;
   const std::deque<core::Run> all = moves_;
   for (std::size_t first = 0; first + config_.window_moves <= all.size(); first += std::max<std::size_t>(1, config_.window_moves / 2)) {
@@ -180,11 +192,11 @@ void ModelHealth::fit_baseline() {
     const auto window_runs = anchored(window, moves_.front().size());
     const ChangeFitData window_data{baseline_, Ts_, window_runs, window_runs, scope_};
     unchanged_gap_mm_ = std::max(unchanged_gap_mm_, from_rest_gap_mm(baseline_, Ts_, window_runs, scope_));
-    for (const EffectKind kind : kAxisChanges) {
-      const ChangeFit fit = fit_change(window_data, {kind});
+    for (const ChangeTerm term : kMonitoredTerms) {
+      const ChangeFit fit = fit_change(window_data, {term});
       fits_ += fit.evaluations;
-      double& t = tolerance_[index_of(kind)];
-      t = std::max(t, config_.spread_margin * change_size(kind, fit.change, baseline_));
+      double& t = tolerance_[index(term)];
+      t = std::max(t, config_.spread_margin * change_size(term, fit.change, baseline_));
     }
   }
   moves_ = all;
@@ -220,21 +232,24 @@ void ModelHealth::judge() {
   const ChangeFitData data{baseline_, Ts_, runs, runs, scope_};
 
   verdict_.estimates.clear();
-  std::optional<EffectEstimate> best;
+  std::optional<EffectEstimate> best;        // the change beyond tolerance that explains most
+  double best_within_tolerance = 0.0;        // the most any change within it explains
   core::StickSlipParams best_model = baseline_;
-  for (const EffectKind kind : kAxisChanges) {
-    const ChangeFit fit = fit_change(data, {kind});
+  for (const ChangeTerm term : kMonitoredTerms) {
+    const ChangeFit fit = fit_change(data, {term});
     fits_ += fit.evaluations;
     const core::StickSlipParams changed = apply_change(baseline_, fit.change);
     EffectEstimate e;
-    e.effect = kind;
-    e.value = term_of(kind, changed).value;
-    e.commissioned = term_of(kind, commissioned_).value;
+    e.effect = effect_of(term);
+    e.term = term;
+    e.value = term_of(term, changed).value;
+    e.commissioned = term_of(term, commissioned_).value;
     e.ratio = e.commissioned != 0.0 ? e.value / e.commissioned : 1.0;
     e.reduction = gap_mm > 0.0 ? std::max(0.0, (gap_mm - fit.train_gap_mm) / gap_mm) : 0.0;
-    e.beyond_tolerance = change_size(kind, fit.change, baseline_) > tolerance_[index_of(kind)];
-    verdict_.estimates.push_back(e);
-    if (e.beyond_tolerance && (!best || e.reduction > best->reduction)) best = e, best_model = changed;
+    e.beyond_tolerance = change_size(term, fit.change, baseline_) > tolerance_[index(term)];
+    add_estimate(verdict_.estimates, e);
+    if (!e.beyond_tolerance) best_within_tolerance = std::max(best_within_tolerance, e.reduction);
+    else if (!best || e.reduction > best->reduction) best = e, best_model = changed;
   }
 
   // This judgement's reading, then whether enough judgements in a row agree on it.
@@ -242,7 +257,10 @@ void ModelHealth::judge() {
   std::optional<EffectKind> effect;
   // A window no wider than the unchanged axis's own is not a drift, however well a change fits it:
   // on an unchanged axis a single term re-fitted to a window's moves shrank its gap by up to 65 %.
-  if (best && best->reduction >= config_.min_reduction && gap_mm > unchanged_gap_mm_) {
+  // Nor is one that a change within the unchanged axis's scatter explains better: with the supply
+  // among the terms, windows of an unchanged axis were named for a term that explained a third of
+  // their gap while friction within its tolerance explained two thirds.
+  if (best && best->reduction >= config_.min_reduction && best->reduction >= best_within_tolerance && gap_mm > unchanged_gap_mm_) {
     reading = HealthState::kDrifting;
     effect = best->effect;
   } else if (gap_mm > config_.unexplained_gap_ratio * verdict_.baseline_gap_mm) {
@@ -265,12 +283,12 @@ void ModelHealth::judge() {
   verdict_.effect = effect;
   verdict_.moves_since_onset = reading == HealthState::kOk ? 0 : verdict_.moves_seen - onset_move_ + 1;
   if (effect) {
-    const Term t = term_of(*effect, best_model);
+    const Term t = term_of(best->term, best_model);
     verdict_.value = t.value;
     verdict_.unit = t.unit;
-    verdict_.commissioned = term_of(*effect, commissioned_).value;
+    verdict_.commissioned = term_of(best->term, commissioned_).value;
     verdict_.ratio = verdict_.commissioned != 0.0 ? verdict_.value / verdict_.commissioned : 1.0;
-    verdict_.size = describe_change(*effect, change_between(*effect, commissioned_, best_model), commissioned_);  // as the diagnosis words it
+    verdict_.size = describe_change(best->term, change_between(best->term, commissioned_, best_model), commissioned_);  // as the diagnosis words it
   } else {
     verdict_.value = verdict_.commissioned = 0.0;
     verdict_.ratio = 1.0;

@@ -1,9 +1,9 @@
 #pragma once
 // The running comparison of an axis with its commissioned stick-slip model: every move the
 // appliance makes is added; over a sliding window of recent moves the model is re-fitted one
-// effect at a time (axis_change.hpp's vocabulary: friction, flow gain, dead band, spool lag, dead
-// time), on the gap over whole moves from rest (from_rest_gap.hpp), and the best change that
-// explains the window is named with its size.
+// term at a time (axis_change.hpp's vocabulary: friction, flow gain, supply, dead band, spool lag,
+// dead time), on the gap over whole moves from rest (from_rest_gap.hpp), and the best change that
+// explains the window is named by its effect with its size.
 //
 // Why a baseline. A model identified on an excitation fits the deployed law's moves less well
 // (other speeds, other drives): judged against the commissioned model itself, an unchanged axis
@@ -11,8 +11,9 @@
 // deployment are fitted jointly (every continuous term) and that fit, the baseline model, is what
 // later windows are compared with; its gap on those moves is the level an unchanged axis keeps.
 // A drift is then a change of the baseline model that shrinks a later window's gap by more than
-// min_reduction of it, lies beyond the tolerance below, comes in a window whose gap is wider than
-// every window of the baseline's own, and is seen in confirm_windows windows in a row. A window
+// min_reduction of it, lies beyond the tolerance below, explains the window better than any change
+// within it, comes in a window whose gap is wider than every window of the baseline's own, and is
+// seen in confirm_windows windows in a row. A window
 // whose gap grew beyond unexplained_gap_ratio times the baseline's with no change that explains
 // it is unexplained.
 //
@@ -57,12 +58,20 @@ struct HealthConfig {
   std::string problem() const;
 };
 
+// The effects the monitor estimates, each by the terms of axis_change.hpp that belong to it.
+inline constexpr plant::EffectKind kMonitoredEffects[] = {plant::EffectKind::kStaticFriction, plant::EffectKind::kGainChange,
+                                                          plant::EffectKind::kDeadzoneShift, plant::EffectKind::kValveLag,
+                                                          plant::EffectKind::kInputDelay};
+
 // One effect's estimate in the latest judgement: the fitted model's term against the baseline
-// model's and the commissioned model's.
+// model's and the commissioned model's. An effect of two terms (the gain: flow or supply) shows
+// the one that explains more of the window.
 struct EffectEstimate {
   plant::EffectKind effect = plant::EffectKind::kStaticFriction;
-  double value = 0.0;         // the term in its unit (friction: breakaway wind-up mm; gain: mm/s per V right;
-                              // dead band: the right break point V; lag: s; dead time: samples)
+  ChangeTerm term = ChangeTerm::kFriction;
+  double value = 0.0;         // the term in its unit (friction: breakaway wind-up mm; flow gain: mm/s per V right;
+                              // supply: the air spring's frequency rad/s; dead band: the right break point V;
+                              // lag: s; dead time: samples)
   double commissioned = 0.0;  // the same term of the commissioned model
   double ratio = 1.0;         // value / commissioned
   double reduction = 0.0;     // of the window's gap against the baseline model, 0..1: how much of it this explains
@@ -119,7 +128,7 @@ class ModelHealth {
   int agreeing_ = 0;
   std::size_t onset_move_ = 0;  // moves_seen at the first judgement of the candidate, less the window
   std::size_t fits_ = 0;
-  std::array<double, std::size(kAxisChanges)> tolerance_{};  // per effect, in the units of its size (model_health.cpp)
+  std::array<double, kChangeTermCount> tolerance_{};  // per term, in the units of its size (model_health.cpp)
   double unchanged_gap_mm_ = 0.0;  // the widest gap of the baseline's own windows against the baseline model
 };
 

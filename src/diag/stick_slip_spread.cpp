@@ -40,16 +40,16 @@ core::StickSlipSpread stick_slip_spread(const core::StickSlipParams& params, dou
   for (const auto& part : parts(runs)) {
     const std::vector<AnchoredRun> one{{&part, rest_anchors(part)}};
     const ChangeFitData data{params, Ts, one, one, scope};
-    for (const auto kind : kAxisChanges) {
-      const ChangeFit fit = fit_change(data, {kind});
-      const double size = change_size(kind, fit.change, params);
-      switch (kind) {
-        case plant::EffectKind::kStaticFriction: spread.friction_log_ratio = std::max(spread.friction_log_ratio, size); break;
-        case plant::EffectKind::kGainChange: spread.flow_gain_log_ratio = std::max(spread.flow_gain_log_ratio, size); break;
-        case plant::EffectKind::kDeadzoneShift: spread.break_v = std::max(spread.break_v, size); break;
-        case plant::EffectKind::kValveLag: spread.spool_lag_s = std::max(spread.spool_lag_s, size); break;
-        case plant::EffectKind::kInputDelay: spread.delay_samples = std::max(spread.delay_samples, size); break;
-        default: break;
+    for (const auto term : kAxisChanges) {
+      const ChangeFit fit = fit_change(data, {term});
+      const double size = change_size(term, fit.change, params);
+      switch (term) {
+        case ChangeTerm::kFriction: spread.friction_log_ratio = std::max(spread.friction_log_ratio, size); break;
+        case ChangeTerm::kFlowGain: spread.flow_gain_log_ratio = std::max(spread.flow_gain_log_ratio, size); break;
+        case ChangeTerm::kDeadBand: spread.break_v = std::max(spread.break_v, size); break;
+        case ChangeTerm::kSpoolLag: spread.spool_lag_s = std::max(spread.spool_lag_s, size); break;
+        case ChangeTerm::kDeadTime: spread.delay_samples = std::max(spread.delay_samples, size); break;
+        case ChangeTerm::kSupply: break;  // held to friction's spread (axis_change.hpp)
       }
     }
   }

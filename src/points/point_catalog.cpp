@@ -223,7 +223,7 @@ std::vector<PointDef> build() {
                                               "2 gain_change (supply, valve gain), 3 deadzone_shift (valve overlap), 4 valve_lag (spool), 5 input_delay",
        A::kRead, 0, 0, true, true, [](const Ctx& c, int) { return double(static_cast<int>(c.status.health.effect)); }},
       {P::kHealthValue, "health_value", "", "model health, drifting: the effect's model term now (static_friction: breakaway wind-up mm; "
-                                            "gain_change: mm/s per V; deadzone_shift: right break point V; valve_lag: s; input_delay: samples); NaN otherwise",
+                                            "gain_change: mm/s per V, or as a supply the air spring's frequency rad/s; deadzone_shift: right break point V; valve_lag: s; input_delay: samples); NaN otherwise",
        A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.status.health.value; }},
       {P::kHealthCommissioned, "health_commissioned", "", "model health, drifting: the same term of the commissioned model; NaN otherwise",
        A::kRead, 0, 0, false, true, [](const Ctx& c, int) { return c.status.health.commissioned; }},

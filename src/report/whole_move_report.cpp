@@ -49,9 +49,9 @@ std::string changes_table(const diag::AxisChanges& c, const core::StickSlipParam
                               c.commissioned_heldout_mm, c.judged ? "" : "; changes not judged: the model file holds no spread");
   h += "<table><tr><th>change</th><th>fitted alone</th><th>held-out gap mm</th><th>reduction %</th><th>beyond the spread</th></tr>\n";
   for (const auto& k : c.candidates) {
-    const bool named = c.accepted.has(k.effect);
-    h += std::string("<tr") + (named ? " class=\"yes\"" : "") + "><td>" + std::string(plant::to_string(k.effect)) + "</td><td>" +
-         escape_html(diag::describe_change(k.effect, k.fit.change, commissioned)) + "</td><td>" + fmt::format("{:.3f}", k.fit.heldout_gap_mm) +
+    const bool named = c.accepted.has(k.term);
+    h += std::string("<tr") + (named ? " class=\"yes\"" : "") + "><td>" + std::string(plant::to_string(diag::effect_of(k.term))) + "</td><td>" +
+         escape_html(diag::describe_change(k.term, k.fit.change, commissioned)) + "</td><td>" + fmt::format("{:.3f}", k.fit.heldout_gap_mm) +
          "</td><td>" + fmt::format("{:.1f}", k.reduction_pct) + "</td><td>" + (k.beyond_tolerance ? "yes" : "") + "</td></tr>\n";
   }
   return h + "</table>\n";

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include "../support/physics_identified_model.hpp"
 #include "../support/stick_slip_axis.hpp"
@@ -30,6 +31,7 @@ core::ModelFile health_model_file() {
 struct HealthRun {
   int named_after = -1;
   double ratio_named = 1.0;
+  std::string unit_named;  // of the term named
   int alarms_before_change = 0;
 };
 HealthRun run_moves(ModelHealth& health, const core::StickSlipParams& plant_params, const core::StickSlipParams& changed, int change_at,
@@ -45,6 +47,7 @@ HealthRun run_moves(ModelHealth& health, const core::StickSlipParams& plant_para
     if (m >= change_at && out.named_after < 0 && v.state == HealthState::kDrifting && v.effect == expected) {
       out.named_after = m + 1 - change_at;
       out.ratio_named = v.ratio;
+      out.unit_named = v.unit;
     }
   }
   return out;
@@ -59,7 +62,7 @@ TEST(ModelHealth, ItLearnsABaselineFirstThenJudgesAnUnchangedAxisOk) {
   EXPECT_EQ(r.alarms_before_change, 0);
   EXPECT_EQ(health->verdict().state, HealthState::kOk);
   EXPECT_EQ(health->verdict().moves_seen, 40u);
-  EXPECT_EQ(health->verdict().estimates.size(), std::size(kAxisChanges));
+  EXPECT_EQ(health->verdict().estimates.size(), std::size(kMonitoredEffects));
   health->retake_baseline();
   EXPECT_EQ(health->verdict().state, HealthState::kLearning);
   EXPECT_EQ(health->verdict().moves_seen, 0u);
@@ -87,6 +90,22 @@ TEST(ModelHealth, AFlowGainDownOnTheModelsOwnFormIsNamedDown) {
   const HealthRun r = run_moves(*health, p, changed, 28, 60, plant::EffectKind::kGainChange, 3);
   ASSERT_GE(r.named_after, 0) << "a flow gain x0.7 was never named";
   EXPECT_LT(r.ratio_named, 0.9);
+}
+
+// A lower supply on the model's own form (its air spring softer, the wind-ups longer) is named as
+// the gain effect, told as the spring's frequency, down.
+TEST(ModelHealth, ASofterAirSpringOnTheModelsOwnFormIsNamedAsTheSupplyDown) {
+  const auto p = *health_model_file().stick_slip;
+  AxisChange supply;
+  supply.terms = {ChangeTerm::kSupply};
+  supply.values = {{0.7}};
+  const auto changed = apply_change(p, supply);
+  auto health = ModelHealth::make(p, kHealthTs, 500.0, {});
+  ASSERT_TRUE(health.has_value());
+  const HealthRun r = run_moves(*health, p, changed, 28, 60, plant::EffectKind::kGainChange, 4);
+  ASSERT_GE(r.named_after, 0) << "an air spring at 0.7 of its frequency was never named";
+  EXPECT_EQ(r.unit_named, "rad/s");
+  EXPECT_LT(r.ratio_named, 0.85);
 }
 
 // On the physics plant (another structure than the model: chambers, orifices, Stribeck friction)

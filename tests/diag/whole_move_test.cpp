@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/format.hpp"
 #include "core/paper_reference.hpp"
 #include "core/random.hpp"
 #include "diag/axis_change_selection.hpp"
@@ -181,7 +182,7 @@ TEST(WholeMove, TheStickSlipMechanicsExplainTheLawModelsGapAndNameFrictionOnlyWh
 TEST(AxisChange, ApplyingAChangeScalesOrShiftsOnlyItsTerms) {
   const auto c = commissioned();
   AxisChange change;
-  change.kinds = {plant::EffectKind::kStaticFriction, plant::EffectKind::kDeadzoneShift, plant::EffectKind::kInputDelay};
+  change.terms = {ChangeTerm::kFriction, ChangeTerm::kDeadBand, ChangeTerm::kDeadTime};
   change.values = {{2.0}, {0.1, -0.2}, {}};
   change.delay_samples = 3;
   const auto p = apply_change(c, change);
@@ -191,14 +192,40 @@ TEST(AxisChange, ApplyingAChangeScalesOrShiftsOnlyItsTerms) {
   EXPECT_DOUBLE_EQ(p.break_left_v, c.break_left_v - 0.2);
   EXPECT_EQ(p.delay_samples, 3);
   EXPECT_EQ(p.speed_right_mm_s_per_v, c.speed_right_mm_s_per_v);
-  EXPECT_EQ(describe_change(plant::EffectKind::kStaticFriction, change, c), "friction up 100 %");
-  EXPECT_EQ(describe_change(plant::EffectKind::kInputDelay, change, c), "line longer: dead time 0 -> 3 samples");
+  EXPECT_EQ(describe_change(ChangeTerm::kFriction, change, c), "friction up 100 %");
+  EXPECT_EQ(describe_change(ChangeTerm::kDeadTime, change, c), "line longer: dead time 0 -> 3 samples");
   // Within the spread (twice it) a change is not beyond tolerance; beyond, it is.
   core::StickSlipSpread spread;
   spread.friction_log_ratio = 0.4;
-  EXPECT_FALSE(beyond_tolerance(plant::EffectKind::kStaticFriction, change, c, spread));  // ln 2 = 0.69 < 0.8
+  EXPECT_FALSE(beyond_tolerance(ChangeTerm::kFriction, change, c, spread));  // ln 2 = 0.69 < 0.8
   spread.friction_log_ratio = 0.3;
-  EXPECT_TRUE(beyond_tolerance(plant::EffectKind::kStaticFriction, change, c, spread));
+  EXPECT_TRUE(beyond_tolerance(ChangeTerm::kFriction, change, c, spread));
+}
+
+// A lower supply as the model holds it: a softer air spring that the friction winds further, the
+// speeds kept; named as the gain effect, told in the spring's frequency, and held to friction's
+// tolerance.
+TEST(AxisChange, TheSupplySoftensTheSpringAndWindsItFurther) {
+  const auto c = commissioned();
+  AxisChange change;
+  change.terms = {ChangeTerm::kSupply};
+  change.values = {{0.5}};
+  const auto p = apply_change(c, change);
+  EXPECT_DOUBLE_EQ(p.spring_rad_s, 0.5 * c.spring_rad_s);
+  EXPECT_DOUBLE_EQ(p.static_mm, 2.0 * c.static_mm);
+  EXPECT_DOUBLE_EQ(p.coulomb_mm, 2.0 * c.coulomb_mm);
+  EXPECT_EQ(p.speed_right_mm_s_per_v, c.speed_right_mm_s_per_v);
+  EXPECT_EQ(effect_of(ChangeTerm::kSupply), plant::EffectKind::kGainChange);
+  EXPECT_NEAR((*change_between(ChangeTerm::kSupply, c, p).values_of(ChangeTerm::kSupply))[0], 0.5, 1e-12);
+  EXPECT_EQ(describe_change(ChangeTerm::kSupply, change, c),
+            "air spring softer: " + core::format_number(std::round(c.spring_rad_s)) + " -> " +
+                core::format_number(std::round(0.5 * c.spring_rad_s)) + " rad/s (supply pressure down)");
+  core::StickSlipSpread spread;
+  spread.flow_gain_log_ratio = 2.0;  // the flow gain's spread does not hold it
+  spread.friction_log_ratio = 0.3;   // ln 2 = 0.69 > 0.6
+  EXPECT_TRUE(beyond_tolerance(ChangeTerm::kSupply, change, c, spread));
+  spread.friction_log_ratio = 0.4;
+  EXPECT_FALSE(beyond_tolerance(ChangeTerm::kSupply, change, c, spread));
 }
 
 // Runs of the commissioned model itself name no change; the same with its friction doubled name
@@ -217,15 +244,15 @@ TEST(AxisChange, AFrictionChangeOfTheModelIsNamedAndNoneWhereThereIsNone) {
     const AxisChanges found = select_axis_changes(data, spread, 0.1, false);
     EXPECT_TRUE(found.judged);
     if (!changed) {
-      EXPECT_TRUE(found.accepted.kinds.empty());
+      EXPECT_TRUE(found.accepted.terms.empty());
       continue;
     }
-    ASSERT_FALSE(found.accepted.kinds.empty());
-    EXPECT_EQ(found.accepted.kinds.front(), plant::EffectKind::kStaticFriction);
-    EXPECT_NEAR((*found.accepted.values_of(plant::EffectKind::kStaticFriction))[0], 2.0, 0.3);
+    ASSERT_FALSE(found.accepted.terms.empty());
+    EXPECT_EQ(found.accepted.terms.front(), ChangeTerm::kFriction);
+    EXPECT_NEAR((*found.accepted.values_of(ChangeTerm::kFriction))[0], 2.0, 0.3);
     EXPECT_GT(found.reduction_pct, 50.0);
     EXPECT_FALSE(select_axis_changes(data, std::nullopt, 0.1, false).judged);
-    EXPECT_TRUE(select_axis_changes(data, std::nullopt, 0.1, false).accepted.kinds.empty());
+    EXPECT_TRUE(select_axis_changes(data, std::nullopt, 0.1, false).accepted.terms.empty());
   }
 }
 
