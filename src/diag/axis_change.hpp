@@ -1,7 +1,7 @@
 #pragma once
 // A change of a commissioned axis, as a change of its stick-slip model (core/stick_slip_params.hpp):
 // friction up or down (both friction levels scaled), the flow gain (both speeds per volt scaled),
-// the supply (the air spring's stiffness scaled, its wind-ups the other way), the dead band moved
+// the supply (the air spring's frequency scaled, its wind-ups the other way), the dead band moved
 // (each break point shifted), the spool slower or faster (its lag), the line longer (the dead
 // time). Each term is named by the effect it is in the diagnosis's vocabulary (plant/effects.hpp),
 // with its parameters in the model's own units.
@@ -32,7 +32,7 @@ inline constexpr ChangeTerm kAxisChanges[] = {ChangeTerm::kFriction, ChangeTerm:
 
 // One continuous parameter of a change, in its natural unit, with the search range.
 struct ChangeParam {
-  const char* name;  // as the report shows it: friction_ratio, flow_gain_ratio, spring_stiffness_ratio, shift_r_V, shift_l_V, spool_lag_s
+  const char* name;  // as the report shows it: friction_ratio, flow_gain_ratio, spring_frequency_ratio, shift_r_V, shift_l_V, spool_lag_s
   double neutral;    // no change (spool_lag_s: the commissioned lag)
   double lo, hi;
   bool log_scale;
@@ -74,7 +74,7 @@ inline constexpr double kLagToleranceS = 0.004;
 bool beyond_tolerance(ChangeTerm term, const AxisChange& change, const core::StickSlipParams& commissioned,
                       const core::StickSlipSpread& spread);
 // How far the change of `term` lies from none, in the units the spread gives (the supply: the
-// log of its stiffness ratio, as friction's).
+// log of its frequency ratio, as friction's).
 double change_size(ChangeTerm term, const AxisChange& change, const core::StickSlipParams& commissioned);
 
 // The change in words: "friction up 140 %", "flow gain down 22 % (supply or valve)",
