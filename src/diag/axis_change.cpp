@@ -94,13 +94,13 @@ double change_size(ChangeTerm term, const AxisChange& change, const core::StickS
 
 bool beyond_tolerance(ChangeTerm term, const AxisChange& change, const core::StickSlipParams& c, const core::StickSlipSpread& spread) {
   const double size = change_size(term, change, c), m = kSpreadMargin;
-  switch (term) {
-    case ChangeTerm::kFriction:
-    case ChangeTerm::kSupply: return size > std::max(std::log1p(kFrictionRatioTolerance), m * spread.friction_log_ratio);
+  switch (tolerance_term(term)) {
+    case ChangeTerm::kFriction: return size > std::max(std::log1p(kFrictionRatioTolerance), m * spread.friction_log_ratio);
     case ChangeTerm::kFlowGain: return size > std::max(std::log1p(kGainRatioTolerance), m * spread.flow_gain_log_ratio);
     case ChangeTerm::kDeadBand: return size > std::max(kBreakToleranceV, m * spread.break_v);
     case ChangeTerm::kSpoolLag: return size > std::max(kLagToleranceS, m * spread.spool_lag_s);
     case ChangeTerm::kDeadTime: return size > m * spread.delay_samples;
+    case ChangeTerm::kSupply: break;  // held to friction's
   }
   return false;
 }

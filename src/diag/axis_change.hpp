@@ -24,6 +24,9 @@ enum class ChangeTerm { kFriction, kFlowGain, kSupply, kDeadBand, kSpoolLag, kDe
 inline constexpr std::size_t kChangeTermCount = 6;
 inline std::size_t index(ChangeTerm term) { return static_cast<std::size_t>(term); }
 plant::EffectKind effect_of(ChangeTerm term);
+// The term whose tolerance (floor and spread) `term` is held to: the supply to friction's, since it
+// scales the wind-ups as friction does; every other term to its own.
+inline ChangeTerm tolerance_term(ChangeTerm term) { return term == ChangeTerm::kSupply ? ChangeTerm::kFriction : term; }
 
 // The terms the diagnosis selects changes among: one per effect, those the commissioned model's
 // spread (epa identify) covers.
@@ -63,8 +66,7 @@ AxisChange change_between(ChangeTerm term, const core::StickSlipParams& from, co
 // Whether the change of `term` lies beyond what the commissioned model's own uncertainty allows:
 // beyond kSpreadMargin times the spread of its terms over parts of its identification runs, and
 // beyond these floors (friction or gain ratio, a break point, the lag; the dead time by more than
-// a sample). The supply is held to friction's: it scales the wind-ups as friction does. The spread
-// is the largest of a handful of parts' fits: new runs of the same axis land beyond it about one
+// a sample); the supply to friction's (tolerance_term). The spread is the largest of a handful of parts' fits: new runs of the same axis land beyond it about one
 // time in (parts + 1) each way, beyond twice it rarely.
 inline constexpr double kSpreadMargin = 2.0;
 inline constexpr double kFrictionRatioTolerance = 0.2;

@@ -81,16 +81,16 @@ Term term_of(ChangeTerm term, const core::StickSlipParams& p) {
 }
 
 // The smallest change of `term` ever named, in change_size's units (axis_change.hpp). The supply
-// is held to friction's: it scales the wind-ups as friction does, and with the flow gain's floor
-// it named windows of an unchanged axis whose friction scattered.
+// takes friction's (tolerance_term): with the flow gain's floor it named windows of an unchanged
+// axis whose friction scattered.
 double floor_of(const HealthConfig& c, ChangeTerm term) {
-  switch (term) {
-    case ChangeTerm::kFriction:
-    case ChangeTerm::kSupply: return std::log1p(c.friction_ratio_tolerance);
+  switch (tolerance_term(term)) {
+    case ChangeTerm::kFriction: return std::log1p(c.friction_ratio_tolerance);
     case ChangeTerm::kFlowGain: return std::log1p(c.gain_ratio_tolerance);
     case ChangeTerm::kDeadBand: return c.break_tolerance_v;
     case ChangeTerm::kSpoolLag: return c.lag_tolerance_s;
     case ChangeTerm::kDeadTime: return 1.0;
+    case ChangeTerm::kSupply: break;  // held to friction's
   }
   return 0.0;
 }

@@ -49,7 +49,7 @@ core::StickSlipSpread stick_slip_spread(const core::StickSlipParams& params, dou
         case ChangeTerm::kDeadBand: spread.break_v = std::max(spread.break_v, size); break;
         case ChangeTerm::kSpoolLag: spread.spool_lag_s = std::max(spread.spool_lag_s, size); break;
         case ChangeTerm::kDeadTime: spread.delay_samples = std::max(spread.delay_samples, size); break;
-        case ChangeTerm::kSupply: break;  // held to friction's spread (axis_change.hpp)
+        case ChangeTerm::kSupply: break;  // held to friction's spread (tolerance_term)
       }
     }
   }
