@@ -152,6 +152,27 @@ void ModelHealth::retake_baseline() {
   verdict_.state = HealthState::kLearning;
 }
 
+WindowReading read_window(const std::vector<EffectEstimate>& per_term, double gap_mm, double unchanged_gap_mm, double baseline_gap_mm,
+                          const HealthConfig& config) {
+  std::optional<std::size_t> best;     // the change beyond tolerance that explains most
+  double best_within_tolerance = 0.0;  // the most any change within it explains
+  for (std::size_t i = 0; i < per_term.size(); ++i) {
+    const EffectEstimate& e = per_term[i];
+    if (!e.beyond_tolerance) best_within_tolerance = std::max(best_within_tolerance, e.reduction);
+    else if (!best || e.reduction > per_term[*best].reduction) best = i;
+  }
+  // A window no wider than the unchanged axis's own is not a drift, however well a change fits it:
+  // on an unchanged axis a single term re-fitted to a window's moves shrank its gap by up to 65 %.
+  // Nor is one that a change within the unchanged axis's scatter explains better: with the supply
+  // among the terms, windows of an unchanged axis were named for a term that explained a third of
+  // their gap while friction within its tolerance explained two thirds.
+  if (best && per_term[*best].reduction >= config.min_reduction && per_term[*best].reduction >= best_within_tolerance &&
+      gap_mm > unchanged_gap_mm)
+    return {HealthState::kDrifting, best};
+  if (gap_mm > config.unexplained_gap_ratio * baseline_gap_mm) return {HealthState::kUnexplained, std::nullopt};
+  return {};
+}
+
 bool ModelHealth::add_move(core::Run run, bool hunted) {
   const HealthState state_before = verdict_.state;
   const auto effect_before = verdict_.effect;
@@ -232,9 +253,8 @@ void ModelHealth::judge() {
   const ChangeFitData data{baseline_, Ts_, runs, runs, scope_};
 
   verdict_.estimates.clear();
-  std::optional<EffectEstimate> best;        // the change beyond tolerance that explains most
-  double best_within_tolerance = 0.0;        // the most any change within it explains
-  core::StickSlipParams best_model = baseline_;
+  std::vector<EffectEstimate> per_term;
+  std::vector<core::StickSlipParams> changed_models;
   for (const ChangeTerm term : kMonitoredTerms) {
     const ChangeFit fit = fit_change(data, {term});
     fits_ += fit.evaluations;
@@ -248,24 +268,16 @@ void ModelHealth::judge() {
     e.reduction = gap_mm > 0.0 ? std::max(0.0, (gap_mm - fit.train_gap_mm) / gap_mm) : 0.0;
     e.beyond_tolerance = change_size(term, fit.change, baseline_) > tolerance_[index(term)];
     add_estimate(verdict_.estimates, e);
-    if (!e.beyond_tolerance) best_within_tolerance = std::max(best_within_tolerance, e.reduction);
-    else if (!best || e.reduction > best->reduction) best = e, best_model = changed;
+    per_term.push_back(e);
+    changed_models.push_back(changed);
   }
 
   // This judgement's reading, then whether enough judgements in a row agree on it.
-  HealthState reading = HealthState::kOk;
-  std::optional<EffectKind> effect;
-  // A window no wider than the unchanged axis's own is not a drift, however well a change fits it:
-  // on an unchanged axis a single term re-fitted to a window's moves shrank its gap by up to 65 %.
-  // Nor is one that a change within the unchanged axis's scatter explains better: with the supply
-  // among the terms, windows of an unchanged axis were named for a term that explained a third of
-  // their gap while friction within its tolerance explained two thirds.
-  if (best && best->reduction >= config_.min_reduction && best->reduction >= best_within_tolerance && gap_mm > unchanged_gap_mm_) {
-    reading = HealthState::kDrifting;
-    effect = best->effect;
-  } else if (gap_mm > config_.unexplained_gap_ratio * verdict_.baseline_gap_mm) {
-    reading = HealthState::kUnexplained;
-  }
+  const WindowReading window = read_window(per_term, gap_mm, unchanged_gap_mm_, verdict_.baseline_gap_mm, config_);
+  const HealthState reading = window.state;
+  const std::optional<EffectEstimate> best = window.named ? std::optional(per_term[*window.named]) : std::nullopt;
+  const core::StickSlipParams& best_model = window.named ? changed_models[*window.named] : baseline_;
+  const std::optional<EffectKind> effect = best ? std::optional(best->effect) : std::nullopt;
   if (reading == candidate_state_ && effect == candidate_) {
     ++agreeing_;
   } else {

@@ -92,6 +92,19 @@ struct HealthVerdict {
   std::string reason;                       // off: why
 };
 
+// What one judgement reads from its window, before confirm_windows agree on it.
+struct WindowReading {
+  HealthState state = HealthState::kOk;            // kOk, kDrifting or kUnexplained
+  std::optional<std::size_t> named;                // drifting: the index of the estimate it names
+};
+// The rules of a judgement, from every term's estimate on the window (one per term, not merged by
+// effect): drifting on the estimate beyond its tolerance that explains most, when it explains at
+// least min_reduction of the window's gap, at least as much as every estimate within tolerance, and
+// the window's gap is wider than unchanged_gap_mm (the widest of the baseline's own windows); else
+// unexplained when the gap exceeds unexplained_gap_ratio times baseline_gap_mm; else ok.
+WindowReading read_window(const std::vector<EffectEstimate>& per_term, double gap_mm, double unchanged_gap_mm, double baseline_gap_mm,
+                          const HealthConfig& config);
+
 class ModelHealth {
  public:
   // drive_range_v: the valve commands the model was identified on (the model file's

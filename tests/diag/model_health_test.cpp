@@ -146,6 +146,54 @@ TEST(ModelHealthOnThePhysicsPlant, FrictionDoubledIsNamedAndStaysNamed) {
   }
 }
 
+// The judgement's rules, each on estimates made up to sit on one side of it.
+EffectEstimate estimate(ChangeTerm term, double reduction, bool beyond_tolerance) {
+  EffectEstimate e;
+  e.effect = effect_of(term);
+  e.term = term;
+  e.reduction = reduction;
+  e.beyond_tolerance = beyond_tolerance;
+  return e;
+}
+
+TEST(ModelHealthReading, TheChangeBeyondToleranceThatExplainsMostIsNamed) {
+  const std::vector<EffectEstimate> per_term = {estimate(ChangeTerm::kFriction, 0.3, true), estimate(ChangeTerm::kSpoolLag, 0.5, true),
+                                                estimate(ChangeTerm::kDeadBand, 0.1, false)};
+  const WindowReading r = read_window(per_term, 4.0, 3.0, 2.0, {});
+  EXPECT_EQ(r.state, HealthState::kDrifting);
+  ASSERT_TRUE(r.named.has_value());
+  EXPECT_EQ(*r.named, 1u);
+}
+
+// An unchanged axis's window read "spool faster" for a lag that explained a third of its gap while
+// friction within its tolerance explained 60 %: the scatter explains it better, so no drift.
+TEST(ModelHealthReading, AChangeThatAScatterWithinToleranceExplainsBetterIsNoDrift) {
+  const std::vector<EffectEstimate> per_term = {estimate(ChangeTerm::kFriction, 0.6, false), estimate(ChangeTerm::kSpoolLag, 0.33, true)};
+  EXPECT_EQ(read_window(per_term, 4.0, 3.0, 2.0, {}).state, HealthState::kOk);
+  // The same window with the scatter explaining less than the lag: a drift of the spool.
+  const std::vector<EffectEstimate> weaker_scatter = {estimate(ChangeTerm::kFriction, 0.2, false),
+                                                      estimate(ChangeTerm::kSpoolLag, 0.33, true)};
+  const WindowReading r = read_window(weaker_scatter, 4.0, 3.0, 2.0, {});
+  EXPECT_EQ(r.state, HealthState::kDrifting);
+  ASSERT_TRUE(r.named.has_value());
+  EXPECT_EQ(per_term[*r.named].term, ChangeTerm::kSpoolLag);
+}
+
+TEST(ModelHealthReading, AWindowNoWiderThanTheUnchangedAxissOwnIsNoDrift) {
+  const std::vector<EffectEstimate> per_term = {estimate(ChangeTerm::kFriction, 0.65, true)};
+  EXPECT_EQ(read_window(per_term, 3.0, 3.0, 2.0, {}).state, HealthState::kOk);
+  EXPECT_EQ(read_window(per_term, 3.1, 3.0, 2.0, {}).state, HealthState::kDrifting);
+}
+
+TEST(ModelHealthReading, AChangeThatExplainsTooLittleLeavesAWideGapUnexplained) {
+  HealthConfig c;
+  const std::vector<EffectEstimate> per_term = {estimate(ChangeTerm::kFriction, c.min_reduction * 0.9, true)};
+  EXPECT_EQ(read_window(per_term, 3.9, 3.0, 2.0, c).state, HealthState::kOk);  // within twice the baseline's gap
+  const WindowReading wide = read_window(per_term, 4.1, 3.0, 2.0, c);
+  EXPECT_EQ(wide.state, HealthState::kUnexplained);
+  EXPECT_FALSE(wide.named.has_value());
+}
+
 TEST(ModelHealth, ABadConfigurationIsRefusedNamingTheField) {
   const auto p = *health_model_file().stick_slip;
   HealthConfig c;
