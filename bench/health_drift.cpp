@@ -121,12 +121,13 @@ int main(int argc, char** argv) {
           (void)(*plant)->set_physics_params(p);
         }
         auto [run, hunted] = sequence.next();
+        const double from_mm = run.y_mm.front(), to_mm = run.r_mm.back();
         const bool changed = health->add_move(std::move(run), hunted);
         const auto& v = health->verdict();
         if (changed || verbose) {
-          std::printf("  %s seed %d move %d: %s %s %s (since onset %zu; gap %.2f mm, baseline %.2f mm)\n", change.name.c_str(), seed, m + 1,
-                      diag::to_string(v.state), v.effect ? plant::to_string(*v.effect).data() : "", v.size.c_str(), v.moves_since_onset,
-                      v.window_gap_mm, v.baseline_gap_mm);
+          std::printf("  %s seed %d move %d (%.0f -> %.0f mm): %s %s %s (since onset %zu; gap %.2f mm, baseline %.2f mm)\n", change.name.c_str(),
+                      seed, m + 1, from_mm, to_mm, diag::to_string(v.state), v.effect ? plant::to_string(*v.effect).data() : "", v.size.c_str(),
+                      v.moves_since_onset, v.window_gap_mm, v.baseline_gap_mm);
           if (verbose)
             for (const auto& e : v.estimates)
               std::printf("      %-16s ratio %6.3f reduction %5.1f %% %s\n", plant::to_string(e.effect).data(), e.ratio, 100 * e.reduction,
