@@ -179,7 +179,7 @@ TEST(ModelHealthReading, AChangeThatAScatterWithinToleranceExplainsBetterIsNoDri
   EXPECT_EQ(per_term[*r.named].term, ChangeTerm::kSpoolLag);
 }
 
-TEST(ModelHealthReading, AWindowNoWiderThanTheUnchangedAxissOwnIsNoDrift) {
+TEST(ModelHealthReading, AWindowNoWiderThanTheUnchangedAxisWindowsIsNoDrift) {
   const std::vector<EffectEstimate> per_term = {estimate(ChangeTerm::kFriction, 0.65, true)};
   EXPECT_EQ(read_window(per_term, 3.0, 3.0, 2.0, {}).state, HealthState::kOk);
   EXPECT_EQ(read_window(per_term, 3.1, 3.0, 2.0, {}).state, HealthState::kDrifting);
