@@ -5,7 +5,7 @@
 // (plant/pneumatic_params.hpp keys, as `epa plant-server`'s `physics` lines), and every move is
 // handed to the monitor. Prints each state change, then one line per case:
 //
-//   case friction-x2 seed 1: named static_friction after 6 moves (friction up 92 %, ratio 1.92), ...
+//   case friction-x2 seed 1: named static_friction after 6 moves (friction up 92 % since the baseline (...), ratio 1.92), ...
 //
 //   health_drift MODEL.toml [--case NAME] [--seeds N] [--first-seed S] [--moves N] [--change-at N] [--law pp-traj|pp-ffidz]
 #include <CLI/CLI.hpp>

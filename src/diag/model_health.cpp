@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "core/format.hpp"
 #include "diag/axis_change_fit.hpp"
@@ -80,6 +81,20 @@ Term term_of(ChangeTerm term, const core::StickSlipParams& p) {
   return {0.0, ""};
 }
 
+// The term's quantity in words, with its value: "breakaway wind-up 5.77 mm".
+std::string term_words(ChangeTerm term, const core::StickSlipParams& p) {
+  char text[64];
+  switch (term) {
+    case ChangeTerm::kFriction: std::snprintf(text, sizeof text, "breakaway wind-up %.3g mm", p.static_mm); break;
+    case ChangeTerm::kFlowGain: std::snprintf(text, sizeof text, "speed %.3g mm/s per V", p.speed_right_mm_s_per_v); break;
+    case ChangeTerm::kSupply: std::snprintf(text, sizeof text, "air spring %.3g rad/s", p.spring_rad_s); break;
+    case ChangeTerm::kDeadBand: std::snprintf(text, sizeof text, "right break point %.3g V", p.break_right_v); break;
+    case ChangeTerm::kSpoolLag: std::snprintf(text, sizeof text, "lag %.3g ms", p.spool_lag_s * 1e3); break;
+    case ChangeTerm::kDeadTime: std::snprintf(text, sizeof text, "dead time %d samples", p.delay_samples); break;
+  }
+  return text;
+}
+
 // The smallest change of `term` ever named, in change_size's units (axis_change.hpp). The supply
 // takes friction's (tolerance_term): with the flow gain's floor it named windows of an unchanged
 // axis whose friction scattered.
@@ -150,6 +165,12 @@ void ModelHealth::retake_baseline() {
   agreeing_ = 0;
   verdict_ = HealthVerdict{};
   verdict_.state = HealthState::kLearning;
+}
+
+std::string drift_words(ChangeTerm term, const core::StickSlipParams& baseline, const core::StickSlipParams& now,
+                        const core::StickSlipParams& commissioned) {
+  return describe_change(term, change_between(term, baseline, now), baseline) + " since the baseline (" + term_words(term, now) +
+         " now, " + term_words(term, commissioned) + " as commissioned)";
 }
 
 WindowReading read_window(const std::vector<EffectEstimate>& per_term, double gap_mm, double unchanged_gap_mm, double baseline_gap_mm,
@@ -300,7 +321,7 @@ void ModelHealth::judge() {
     verdict_.unit = t.unit;
     verdict_.commissioned = term_of(best->term, commissioned_).value;
     verdict_.ratio = verdict_.commissioned != 0.0 ? verdict_.value / verdict_.commissioned : 1.0;
-    verdict_.size = describe_change(best->term, change_between(best->term, commissioned_, best_model), commissioned_);  // as the diagnosis words it
+    verdict_.size = drift_words(best->term, baseline_, best_model, commissioned_);
   } else {
     verdict_.value = verdict_.commissioned = 0.0;
     verdict_.ratio = 1.0;

@@ -81,7 +81,7 @@ struct EffectEstimate {
 struct HealthVerdict {
   HealthState state = HealthState::kOff;
   std::optional<plant::EffectKind> effect;  // drifting: the effect named
-  std::string size;                         // drifting: in words ("friction up 80 %"); else ""
+  std::string size;                         // drifting: in words (drift_words: "friction up 80 % since the baseline (...)"); else ""
   double value = 0.0, commissioned = 0.0, ratio = 1.0;  // drifting: the effect's term (EffectEstimate's units)
   std::string unit;                         // of value
   std::size_t moves_seen = 0;               // moves added since the model was set or the baseline retaken
@@ -91,6 +91,14 @@ struct HealthVerdict {
   std::vector<EffectEstimate> estimates;    // the latest judgement, one per effect
   std::string reason;                       // off: why
 };
+
+// A drift in words: what the monitor found (the change from the baseline model to the window's, as
+// the diagnosis words a change), then where the term stands now and as commissioned. A drift is
+// judged against the baseline, which can stand off the commissioned model: told against the
+// commissioned model alone, a lag that grew from a baseline below it read "spool faster".
+// e.g. "spool slower: lag 10.2 -> 12.8 ms since the baseline (lag 12.8 ms now, lag 13.7 ms as commissioned)".
+std::string drift_words(ChangeTerm term, const core::StickSlipParams& baseline, const core::StickSlipParams& now,
+                        const core::StickSlipParams& commissioned);
 
 // What one judgement reads from its window, before confirm_windows agree on it.
 struct WindowReading {

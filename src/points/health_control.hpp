@@ -54,7 +54,7 @@ struct HealthJudgement {
 // The verdict in words, for JSON.
 struct HealthReport {
   HealthView view;
-  std::string size;    // drifting: in the diagnosis's words ("friction up 80 %"); else ""
+  std::string size;    // drifting: in words (diag::drift_words: "friction up 80 % since the baseline (...)"); else ""
   std::string unit;    // of value and commissioned
   std::string reason;  // off: why; else what the state means now
   double window_gap_mm = std::numeric_limits<double>::quiet_NaN();    // the latest window against the baseline model

@@ -194,6 +194,23 @@ TEST(ModelHealthReading, AChangeThatExplainsTooLittleLeavesAWideGapUnexplained) 
   EXPECT_FALSE(wide.named.has_value());
 }
 
+// A drift is judged against the baseline: a lag that grew from a baseline below the commissioned
+// one is a slower spool, though it still stands below the commissioned lag.
+TEST(ModelHealthWords, ADriftIsToldAsFoundAgainstTheBaselineAndPlacedAgainstTheCommissioned) {
+  core::StickSlipParams commissioned;
+  commissioned.spool_lag_s = 0.0137;
+  auto baseline = commissioned;
+  baseline.spool_lag_s = 0.0102;
+  auto now = commissioned;
+  now.spool_lag_s = 0.0128;
+  EXPECT_EQ(drift_words(ChangeTerm::kSpoolLag, baseline, now, commissioned),
+            "spool slower: lag 10.2 -> 12.8 ms since the baseline (lag 12.8 ms now, lag 13.7 ms as commissioned)");
+  now = baseline;
+  now.static_mm = baseline.static_mm * 1.8;
+  EXPECT_EQ(drift_words(ChangeTerm::kFriction, baseline, now, commissioned),
+            "friction up 80 % since the baseline (breakaway wind-up 14.4 mm now, breakaway wind-up 8 mm as commissioned)");
+}
+
 TEST(ModelHealth, ABadConfigurationIsRefusedNamingTheField) {
   const auto p = *health_model_file().stick_slip;
   HealthConfig c;
