@@ -176,7 +176,7 @@ TEST(ModelHealthReading, AChangeThatAScatterWithinToleranceExplainsBetterIsNoDri
   const WindowReading r = read_window(weaker_scatter, 4.0, 3.0, 2.0, {});
   EXPECT_EQ(r.state, HealthState::kDrifting);
   ASSERT_TRUE(r.named.has_value());
-  EXPECT_EQ(per_term[*r.named].term, ChangeTerm::kSpoolLag);
+  EXPECT_EQ(weaker_scatter[*r.named].term, ChangeTerm::kSpoolLag);
 }
 
 TEST(ModelHealthReading, AWindowNoWiderThanTheUnchangedAxisWindowsIsNoDrift) {
