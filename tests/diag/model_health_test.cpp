@@ -209,6 +209,15 @@ TEST(ModelHealthWords, ADriftIsToldAsFoundAgainstTheBaselineAndPlacedAgainstTheC
   now.static_mm = baseline.static_mm * 1.8;
   EXPECT_EQ(drift_words(ChangeTerm::kFriction, baseline, now, commissioned),
             "friction up 80 % since the baseline (breakaway wind-up 14.4 mm now, breakaway wind-up 8 mm as commissioned)");
+  now = baseline;
+  now.spring_rad_s = 35.0;
+  EXPECT_EQ(drift_words(ChangeTerm::kSupply, baseline, now, commissioned),
+            "air spring softer: 50 -> 35 rad/s (supply pressure down) since the baseline (air spring 35 rad/s now, air spring 50 rad/s as "
+            "commissioned)");
+  now = baseline;
+  now.delay_samples = 3;
+  EXPECT_EQ(drift_words(ChangeTerm::kDeadTime, baseline, now, commissioned),
+            "line longer: dead time 1 -> 3 samples since the baseline (dead time 3 samples now, dead time 1 samples as commissioned)");
 }
 
 TEST(ModelHealth, ABadConfigurationIsRefusedNamingTheField) {
