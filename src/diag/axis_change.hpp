@@ -66,8 +66,9 @@ AxisChange change_between(ChangeTerm term, const core::StickSlipParams& from, co
 // Whether the change of `term` lies beyond what the commissioned model's own uncertainty allows:
 // beyond kSpreadMargin times the spread of its terms over parts of its identification runs, and
 // beyond these floors (friction or gain ratio, a break point, the lag; the dead time by more than
-// a sample); the supply to friction's (tolerance_term). The spread is the largest of a handful of parts' fits: new runs of the same axis land beyond it about one
-// time in (parts + 1) each way, beyond twice it rarely.
+// a sample); the supply to friction's (tolerance_term). The spread is the largest of a handful of
+// parts' fits: new runs of the same axis land beyond it about one time in (parts + 1) each way,
+// beyond twice it rarely.
 inline constexpr double kSpreadMargin = 2.0;
 inline constexpr double kFrictionRatioTolerance = 0.2;
 inline constexpr double kGainRatioTolerance = 0.08;
